@@ -1,0 +1,7 @@
+//! Shared math for every stage: polygon meshes with edge adjacency ([`mesh`]), 2D polygons and
+//! their tests ([`polygon`]), and a single-stroke font for labels a pen or knife can draw
+//! ([`font`]). Millimetres and `f64` throughout (glam `DVec2`/`DVec3`).
+
+pub mod font;
+pub mod mesh;
+pub mod polygon;

@@ -1,0 +1,312 @@
+//! 2D polygons: signed area, containment, convex hull, minimum-area bounding rectangle,
+//! ear-clipping triangulation and a separating-axis overlap test for triangles.
+//!
+//! Conventions: a polygon is a slice of points without the closing duplicate; counter-clockwise
+//! rings have positive area. Overlap tests take a tolerance: shapes that only touch (share an
+//! edge or a vertex, or overlap by less than `eps` in depth) do not overlap, which is what a
+//! cutter needs (two faces joined along a fold touch but never cover each other).
+
+use glam::DVec2;
+
+/// Signed area (positive for counter-clockwise).
+pub fn signed_area(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    let mut s = 0.0;
+    for i in 0..n {
+        s += poly[i].perp_dot(poly[(i + 1) % n]);
+    }
+    0.5 * s
+}
+
+/// Perimeter of a closed polygon.
+pub fn perimeter(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    (0..n).map(|i| poly[i].distance(poly[(i + 1) % n])).sum()
+}
+
+/// Axis-aligned bounds (min, max) of points; `None` when empty.
+pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> Option<(DVec2, DVec2)> {
+    let mut it = points.into_iter();
+    let first = it.next()?;
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+/// Even-odd point-in-polygon test (points on the boundary may go either way).
+pub fn contains(poly: &[DVec2], p: DVec2) -> bool {
+    let n = poly.len();
+    let mut inside = false;
+    let mut j = n.wrapping_sub(1);
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if p.x < x {
+                inside = !inside;
+            }
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Convex hull, counter-clockwise, without collinear points (Andrew's monotone chain).
+pub fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
+    let mut pts: Vec<DVec2> = points.iter().copied().filter(|p| p.is_finite()).collect();
+    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 {
+            Box::new(pts.iter())
+        } else {
+            Box::new(pts.iter().rev())
+        };
+        for &p in iter {
+            while hull.len() >= start + 2 {
+                let a = hull[hull.len() - 2];
+                let b = hull[hull.len() - 1];
+                if (b - a).perp_dot(p - a) <= 0.0 {
+                    hull.pop();
+                } else {
+                    break;
+                }
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// Rotation angle (radians) that turns the points so that their axis-aligned bounding box has
+/// the least area (rotating calipers over the hull edges), with the longer side along x.
+pub fn min_area_rect_angle(points: &[DVec2]) -> f64 {
+    let hull = convex_hull(points);
+    if hull.len() < 2 {
+        return 0.0;
+    }
+    let mut best = (f64::INFINITY, 0.0);
+    for i in 0..hull.len() {
+        let d = hull[(i + 1) % hull.len()] - hull[i];
+        if d.length_squared() == 0.0 {
+            continue;
+        }
+        // Rotate by -atan2(d): this edge becomes horizontal.
+        let angle = -d.y.atan2(d.x);
+        let rot = DVec2::from_angle(angle);
+        let Some((lo, hi)) = bounds(hull.iter().map(|p| rot.rotate(*p))) else {
+            continue;
+        };
+        let size = hi - lo;
+        let area = size.x * size.y;
+        // Prefer a strictly smaller area; ties keep the first edge (deterministic).
+        if area < best.0 * (1.0 - 1e-12) {
+            let angle = if size.y > size.x {
+                angle + std::f64::consts::FRAC_PI_2
+            } else {
+                angle
+            };
+            best = (area, angle);
+        }
+    }
+    best.1
+}
+
+/// Ear-clipping triangulation of a simple polygon (either orientation). Returns index triples
+/// in the polygon's own orientation. Falls back to a fan when no ear is found (degenerate
+/// input), so it always returns `n - 2` triangles for `n >= 3`.
+pub fn triangulate(poly: &[DVec2]) -> Vec<[usize; 3]> {
+    let n = poly.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    if n == 3 {
+        return vec![[0, 1, 2]];
+    }
+    let sign = if signed_area(poly) >= 0.0 { 1.0 } else { -1.0 };
+    let mut idx: Vec<usize> = (0..n).collect();
+    let mut out = Vec::with_capacity(n - 2);
+    while idx.len() > 3 {
+        let m = idx.len();
+        let mut clipped = false;
+        for k in 0..m {
+            let (ia, ib, ic) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
+            let (a, b, c) = (poly[ia], poly[ib], poly[ic]);
+            if sign * (b - a).perp_dot(c - b) <= 0.0 {
+                continue; // reflex or flat corner
+            }
+            let tri = [a, b, c];
+            let blocked = idx.iter().any(|&j| {
+                j != ia && j != ib && j != ic && point_in_triangle_closed(poly[j], &tri, sign)
+            });
+            if !blocked {
+                out.push([ia, ib, ic]);
+                idx.remove(k);
+                clipped = true;
+                break;
+            }
+        }
+        if !clipped {
+            for k in 1..idx.len() - 1 {
+                out.push([idx[0], idx[k], idx[k + 1]]);
+            }
+            return out;
+        }
+    }
+    out.push([idx[0], idx[1], idx[2]]);
+    out
+}
+
+fn point_in_triangle_closed(p: DVec2, t: &[DVec2; 3], sign: f64) -> bool {
+    (0..3).all(|i| sign * (t[(i + 1) % 3] - t[i]).perp_dot(p - t[i]) >= 0.0)
+}
+
+/// Whether two triangles overlap by more than `eps` (separating axis theorem on the six edge
+/// normals): touching along an edge or at a vertex is not an overlap.
+pub fn triangles_overlap(a: &[DVec2; 3], b: &[DVec2; 3], eps: f64) -> bool {
+    for tri in [a, b] {
+        for i in 0..3 {
+            let d = tri[(i + 1) % 3] - tri[i];
+            let len = d.length();
+            if len == 0.0 {
+                continue;
+            }
+            let axis = d.perp() / len;
+            let (a0, a1) = project(a, axis);
+            let (b0, b1) = project(b, axis);
+            if a1 <= b0 + eps || b1 <= a0 + eps {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+fn project(t: &[DVec2; 3], axis: DVec2) -> (f64, f64) {
+    let p = [t[0].dot(axis), t[1].dot(axis), t[2].dot(axis)];
+    (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+}
+
+/// Whether segments `ab` and `cd` cross or touch (closed segments).
+pub fn segments_intersect(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    let o1 = orient(a, b, c);
+    let o2 = orient(a, b, d);
+    let o3 = orient(c, d, a);
+    let o4 = orient(c, d, b);
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return true;
+    }
+    (o1 == 0.0 && on_segment(a, b, c))
+        || (o2 == 0.0 && on_segment(a, b, d))
+        || (o3 == 0.0 && on_segment(c, d, a))
+        || (o4 == 0.0 && on_segment(c, d, b))
+}
+
+fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+fn on_segment(a: DVec2, b: DVec2, p: DVec2) -> bool {
+    p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
+}
+
+/// Whether a closed ring is simple: no two non-adjacent edges touch or cross (O(n²); for tests
+/// and reports, not for hot loops).
+pub fn is_simple_ring(ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    if n < 3 {
+        return false;
+    }
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        for j in i + 1..n {
+            if j == i + 1 || (i == 0 && j == n - 1) {
+                continue;
+            }
+            let (c, d) = (ring[j], ring[(j + 1) % n]);
+            if segments_intersect(a, b, c, d) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64) -> DVec2 {
+        DVec2::new(x, y)
+    }
+
+    #[test]
+    fn area_hull_and_rect() {
+        let sq = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 1.0), v(0.0, 1.0)];
+        assert_eq!(signed_area(&sq), 2.0);
+        assert_eq!(perimeter(&sq), 6.0);
+        assert!(contains(&sq, v(1.0, 0.5)));
+        assert!(!contains(&sq, v(3.0, 0.5)));
+        let mut pts = sq.to_vec();
+        pts.push(v(1.0, 0.5));
+        pts.push(v(1.0, 0.0));
+        assert_eq!(convex_hull(&pts).len(), 4);
+        // A rectangle 4 x 1 turned by 30 degrees comes back axis aligned, long side along x.
+        let r = DVec2::from_angle(0.5236);
+        let rect: Vec<_> = [v(0.0, 0.0), v(4.0, 0.0), v(4.0, 1.0), v(0.0, 1.0)]
+            .iter()
+            .map(|p| r.rotate(*p))
+            .collect();
+        let a = min_area_rect_angle(&rect);
+        let back = DVec2::from_angle(a);
+        let (lo, hi) = bounds(rect.iter().map(|p| back.rotate(*p))).unwrap();
+        let size = hi - lo;
+        assert!((size.x - 4.0).abs() < 1e-9 && (size.y - 1.0).abs() < 1e-9, "{size}");
+    }
+
+    #[test]
+    fn ear_clipping_concave() {
+        // An L shape: 6 vertices, 4 triangles whose areas add up.
+        let l = [
+            v(0.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 1.0),
+            v(1.0, 1.0),
+            v(1.0, 2.0),
+            v(0.0, 2.0),
+        ];
+        let t = triangulate(&l);
+        assert_eq!(t.len(), 4);
+        let total: f64 = t
+            .iter()
+            .map(|k| signed_area(&[l[k[0]], l[k[1]], l[k[2]]]))
+            .sum();
+        assert!((total - 3.0).abs() < 1e-12);
+        assert!(t
+            .iter()
+            .all(|k| signed_area(&[l[k[0]], l[k[1]], l[k[2]]]) > 0.0));
+    }
+
+    #[test]
+    fn sat_touching_is_not_overlap() {
+        let a = [v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        let b = [v(1.0, 0.0), v(0.0, 1.0), v(1.0, 1.0)];
+        assert!(!triangles_overlap(&a, &b, 1e-9));
+        let c = [v(0.2, 0.2), v(1.0, 0.2), v(0.2, 1.0)];
+        assert!(triangles_overlap(&a, &c, 1e-9));
+        let far = [v(5.0, 5.0), v(6.0, 5.0), v(5.0, 6.0)];
+        assert!(!triangles_overlap(&a, &far, 1e-9));
+    }
+
+    #[test]
+    fn simple_rings() {
+        let sq = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
+        assert!(is_simple_ring(&sq));
+        let bow = [v(0.0, 0.0), v(1.0, 1.0), v(1.0, 0.0), v(0.0, 1.0)];
+        assert!(!is_simple_ring(&bow));
+    }
+}
