@@ -14,4 +14,6 @@ pub mod geom;
 pub mod spec;
 pub mod surface;
 pub mod flatten;
+pub mod pattern;
+pub mod nest;
 pub mod toolpath;

@@ -393,7 +393,7 @@ pub fn find_overlap(flat: &Flat) -> Option<(usize, usize)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::geom::mesh::{Face, Mesh};
     use std::path::PathBuf;
