@@ -17,3 +17,49 @@ pub mod flatten;
 pub mod pattern;
 pub mod nest;
 pub mod toolpath;
+pub mod output;
+pub mod device;
+pub mod cli;
+
+/// Any error of a run, by stage. Each message is one line that names the file, piece or line
+/// concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Spec(#[from] spec::SpecError),
+    #[error(transparent)]
+    Surface(#[from] surface::SurfaceError),
+    #[error(transparent)]
+    Flatten(#[from] flatten::FlattenError),
+    #[error(transparent)]
+    Pattern(#[from] pattern::PatternError),
+    #[error(transparent)]
+    Nest(#[from] nest::NestError),
+    #[error(transparent)]
+    Output(#[from] output::OutputError),
+    #[error(transparent)]
+    Profile(#[from] device::ProfileError),
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", file.display())]
+    In {
+        file: std::path::PathBuf,
+        source: Box<Error>,
+    },
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl Error {
+    /// 2 for a bug in flatcut, 1 for everything the user or the environment can fix.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Pattern(_) => 2,
+            Error::In { source, .. } => source.exit_code(),
+            _ => 1,
+        }
+    }
+}

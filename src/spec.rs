@@ -1,8 +1,1591 @@
-//! stub until the spec module lands
-use std::path::PathBuf;
+//! The job spec: a TOML file (`patterns/*.toml`) naming the surfaces to cut and the material,
+//! sheet and pattern settings to cut them with.
+//!
+//! ```toml
+//! name = "cube"            # optional; default: the spec file's stem
+//! device = "hpgl-pens"     # optional device profile name
+//!
+//! [[surface]]              # one or more
+//! kind = "mesh"            # required; only "mesh" for now (later: "strip", "fitting", ...)
+//! path = "cube.obj"        # required for mesh; relative to the spec file's directory
+//! scale = 1.0              # optional, > 0, finite; default 1
+//! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
+//! name = "box"             # optional; default: the mesh file stem
+//!
+//! [material]               # optional table
+//! kind = "paper"           # "paper" | "fabric" | "metal"; default paper
+//! thickness = 0.25         # mm, > 0, finite; default by kind: paper 0.25, fabric 0.5, metal 1.0
+//!
+//! [sheet]                  # optional table
+//! width = 210              # mm > 0; default 210 (A4 portrait)
+//! height = 297             # mm > 0; default 297; not allowed together with roll = true
+//! roll = false             # true: a roll of `width`, unlimited length
+//! margin = 5               # mm >= 0; default 5
+//! spacing = 3              # mm >= 0; default 3
+//!
+//! [pattern]                # optional table
+//! fold_threshold = 1.0     # degrees, >= 0 and < 180; default 1: joined edges bending more
+//!                          # than this become fold lines
+//! ```
+//!
+//! [`load`] reads a spec file; a `.obj` file (any letter case) given instead stands for a
+//! spec with that one mesh and every default ([`Spec::from_mesh`]). Every other extension is
+//! read as TOML.
+//!
+//! # Precedence
+//!
+//! Settings come from three places, each overriding the one before: the spec file, then the
+//! device profile it names (or the CLI picks), then command-line flags. This module only reads
+//! the spec and fills in its own defaults; the CLI applies the profile and the flags on top.
+//!
+//! # Choices
+//!
+//! - Unknown keys, in any table, are errors rather than ignored, so a typo (`colour`,
+//!   `widht`) never silently falls back to a default.
+//! - Every error is one line, `FILE:LINE: ...`, naming the key as a dotted path
+//!   (`sheet.width`, `surface[2].scale`) and saying what is expected. Lines are 1-based and
+//!   point at the offending value (or, for a missing key, at its table's header).
+//!   `[[surface]]` entries are counted from 1 in keys: the second one is `surface[2]`.
+//! - A value of the wrong type (`width = "wide"`, `surface = "cube.obj"`) is reported as an
+//!   invalid value of that key, not as a bare TOML type error.
+//! - Numbers may be written as integers or floats (`width = 210` or `210.0`); `nan` and
+//!   `inf` are never accepted.
+//! - Enumerated values (`kind`, `units`) are matched ignoring ASCII case; an unknown one lists
+//!   the allowed values.
+//! - `name` (spec and surface), `device` and `path` must not be empty strings.
+//! - `margin`: twice the margin must be less than the sheet width and, for a sheet (not a
+//!   roll), the sheet height, so some area is left to cut in.
+//! - [`SurfaceSpec::line`] is the line of the surface's `path` value (where to look when its
+//!   mesh cannot be read), or 0 for a spec made from a mesh file by [`Spec::from_mesh`].
+//! - Surface paths are resolved against the spec file's directory as written (no
+//!   canonicalising, no `~` expansion); an absolute path stays as it is.
+
+use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use std::fmt;
+use std::marker::PhantomData;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use toml::Spanned;
+
+// ---------------------------------------------------------------------------------------------
+// Public data types
+// ---------------------------------------------------------------------------------------------
+
+/// A whole job: what to cut and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spec {
+    /// Job name, used in output file names and labels.
+    pub name: String,
+    /// The file the spec came from (a `.toml` spec or, via [`Spec::from_mesh`], a mesh).
+    pub path: PathBuf,
+    /// Device profile named by the spec, if any.
+    pub device: Option<String>,
+    /// One or more surfaces to flatten, in file order.
+    pub surfaces: Vec<SurfaceSpec>,
+    pub material: Material,
+    pub sheet: SheetSpec,
+    pub pattern: PatternSpec,
+}
+
+/// One `[[surface]]` entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceSpec {
+    pub kind: SurfaceKind,
+    /// Source file, resolved against the spec file's directory.
+    pub path: PathBuf,
+    /// Factor applied to the coordinates, on top of [`SurfaceSpec::units`].
+    pub scale: f64,
+    /// Units the file's coordinates are in.
+    pub units: Units,
+    /// Name shown in labels; default: the source file's stem.
+    pub name: String,
+    /// 1-based line of this entry's `path` value in the spec; 0 when there is no spec file.
+    pub line: usize,
+}
+
+/// How a surface is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum SurfaceKind {
+    /// A polyhedral mesh file (OBJ) whose faces are flat panels.
+    #[default]
+    Mesh,
+}
+
+/// Length units of a surface's source coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Units {
+    #[default]
+    Mm,
+    Cm,
+    M,
+    In,
+}
+
+/// The material the pattern is cut from.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SurfaceKind { Mesh }
+pub struct Material {
+    pub kind: MaterialKind,
+    /// Thickness in millimetres.
+    pub thickness: f64,
+}
+
+/// Kinds of sheet material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum MaterialKind {
+    #[default]
+    Paper,
+    Fabric,
+    Metal,
+}
+
+/// The sheet (or roll) the pieces are nested on, in millimetres.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Units { Mm }
-impl Units { pub fn mm(self) -> f64 { 1.0 } }
-pub struct SurfaceSpec { pub kind: SurfaceKind, pub path: PathBuf, pub scale: f64, pub units: Units, pub name: String, pub line: usize }
+pub struct SheetSpec {
+    pub width: f64,
+    /// Sheet height; `None` for a roll of unlimited length.
+    pub height: Option<f64>,
+    /// Blank border kept on every side.
+    pub margin: f64,
+    /// Minimum gap between pieces.
+    pub spacing: f64,
+}
+
+/// Settings for turning a flattened surface into a pattern.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatternSpec {
+    /// Joined edges whose faces bend by more than this many degrees become fold lines.
+    pub fold_threshold_deg: f64,
+}
+
+/// Everything that can be wrong with a spec. Each message is one line starting with the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecError {
+    #[error("{}: cannot read spec: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}:{line}: {message}", path.display())]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{}:{line}: `{key}`: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        line: usize,
+        key: String,
+        message: String,
+    },
+}
+
+// ---------------------------------------------------------------------------------------------
+// Enum names, defaults, conversions
+// ---------------------------------------------------------------------------------------------
+
+/// "one of a, b, c"
+fn one_of(names: &[&str]) -> String {
+    format!("one of {}", names.join(", "))
+}
+
+/// Finds `s` among `(name, value)` pairs, ignoring ASCII case; the error lists the names.
+fn pick<T: Copy>(s: &str, table: &[(&str, T)]) -> Result<T, String> {
+    table
+        .iter()
+        .find(|(name, _)| name.eq_ignore_ascii_case(s.trim()))
+        .map(|&(_, v)| v)
+        .ok_or_else(|| {
+            let names: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
+            format!("expected {}, got {s:?}", one_of(&names))
+        })
+}
+
+impl SurfaceKind {
+    const NAMES: [(&'static str, SurfaceKind); 1] = [("mesh", SurfaceKind::Mesh)];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SurfaceKind::Mesh => "mesh",
+        }
+    }
+}
+
+impl fmt::Display for SurfaceKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for SurfaceKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        pick(s, &Self::NAMES)
+    }
+}
+
+impl Units {
+    const NAMES: [(&'static str, Units); 4] = [
+        ("mm", Units::Mm),
+        ("cm", Units::Cm),
+        ("m", Units::M),
+        ("in", Units::In),
+    ];
+
+    /// Millimetres in one of these units.
+    pub fn mm(self) -> f64 {
+        match self {
+            Units::Mm => 1.0,
+            Units::Cm => 10.0,
+            Units::M => 1000.0,
+            Units::In => 25.4,
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Units::Mm => "mm",
+            Units::Cm => "cm",
+            Units::M => "m",
+            Units::In => "in",
+        }
+    }
+}
+
+impl fmt::Display for Units {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for Units {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        pick(s, &Self::NAMES)
+    }
+}
+
+impl MaterialKind {
+    const NAMES: [(&'static str, MaterialKind); 3] = [
+        ("paper", MaterialKind::Paper),
+        ("fabric", MaterialKind::Fabric),
+        ("metal", MaterialKind::Metal),
+    ];
+
+    /// Thickness in millimetres assumed when none is given.
+    pub fn default_thickness(self) -> f64 {
+        match self {
+            MaterialKind::Paper => 0.25,
+            MaterialKind::Fabric => 0.5,
+            MaterialKind::Metal => 1.0,
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MaterialKind::Paper => "paper",
+            MaterialKind::Fabric => "fabric",
+            MaterialKind::Metal => "metal",
+        }
+    }
+}
+
+impl fmt::Display for MaterialKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Parses `paper`, `fabric` or `metal` (any ASCII case); the error lists the allowed values.
+impl FromStr for MaterialKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        pick(s, &Self::NAMES)
+    }
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            kind: MaterialKind::Paper,
+            thickness: MaterialKind::Paper.default_thickness(),
+        }
+    }
+}
+
+impl Default for SheetSpec {
+    /// A4 portrait, 5 mm margin, 3 mm between pieces.
+    fn default() -> Self {
+        SheetSpec {
+            width: 210.0,
+            height: Some(297.0),
+            margin: 5.0,
+            spacing: 3.0,
+        }
+    }
+}
+
+impl SheetSpec {
+    /// True for a roll: fixed width, unlimited length.
+    pub fn is_roll(&self) -> bool {
+        self.height.is_none()
+    }
+}
+
+impl Default for PatternSpec {
+    fn default() -> Self {
+        PatternSpec {
+            fold_threshold_deg: 1.0,
+        }
+    }
+}
+
+/// The file's stem as a string, or `fallback` when it has none.
+fn stem_or(path: &Path, fallback: &str) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| fallback.to_string())
+}
+
+impl Spec {
+    /// A spec for a single mesh file with every default: paper, A4 portrait, 5 mm margin,
+    /// 3 mm spacing, scale 1 in millimetres, named after the file's stem.
+    pub fn from_mesh(path: &Path) -> Spec {
+        let name = stem_or(path, "mesh");
+        Spec {
+            name: name.clone(),
+            path: path.to_path_buf(),
+            device: None,
+            surfaces: vec![SurfaceSpec {
+                kind: SurfaceKind::Mesh,
+                path: path.to_path_buf(),
+                scale: 1.0,
+                units: Units::Mm,
+                name,
+                line: 0,
+            }],
+            material: Material::default(),
+            sheet: SheetSpec::default(),
+            pattern: PatternSpec::default(),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading and parsing
+// ---------------------------------------------------------------------------------------------
+
+/// Reads a spec file. A `.obj` path (any case) gives [`Spec::from_mesh`]; anything else is
+/// read as TOML.
+pub fn load(path: &Path) -> Result<Spec, SpecError> {
+    let is_obj = path
+        .extension()
+        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("obj"));
+    if is_obj {
+        return Ok(Spec::from_mesh(path));
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&text, path)
+}
+
+/// Parses spec text; `path` is the file it came from, used for messages, the default name and
+/// resolving surface paths.
+pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
+    let ctx = Ctx { text, path };
+    let raw: RawSpec = toml::from_str(text).map_err(|e| ctx.syntax(&e))?;
+    ctx.build(raw)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Raw (serde) form: every value spanned, every value of any type accepted so that type
+// mistakes are reported with their key.
+// ---------------------------------------------------------------------------------------------
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSpec {
+    name: Option<Spanned<Val>>,
+    device: Option<Spanned<Val>>,
+    surface: Option<Spanned<List<Spanned<Tab<RawSurface>>>>>,
+    material: Option<Spanned<Tab<RawMaterial>>>,
+    sheet: Option<Spanned<Tab<RawSheet>>>,
+    pattern: Option<Spanned<Tab<RawPattern>>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSurface {
+    kind: Option<Spanned<Val>>,
+    path: Option<Spanned<Val>>,
+    scale: Option<Spanned<Val>>,
+    units: Option<Spanned<Val>>,
+    name: Option<Spanned<Val>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    kind: Option<Spanned<Val>>,
+    thickness: Option<Spanned<Val>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSheet {
+    width: Option<Spanned<Val>>,
+    height: Option<Spanned<Val>>,
+    roll: Option<Spanned<Val>>,
+    margin: Option<Spanned<Val>>,
+    spacing: Option<Spanned<Val>>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPattern {
+    fold_threshold: Option<Spanned<Val>>,
+}
+
+/// Any TOML value, reduced to what the checks need. Integers and floats both become `Num`.
+#[derive(Debug, Clone, PartialEq)]
+enum Val {
+    Num(f64),
+    Str(String),
+    Bool(bool),
+    /// A value of another type, described for messages ("a table", "an array", ...).
+    Other(&'static str),
+}
+
+/// A number as TOML would write it (`nan`, `inf`, `-3`, `0.25`).
+fn fmt_num(v: f64) -> String {
+    if v.is_nan() {
+        "nan".to_string()
+    } else if v.is_infinite() {
+        if v > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        format!("{v}")
+    }
+}
+
+impl fmt::Display for Val {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Val::Num(v) => f.write_str(&fmt_num(*v)),
+            Val::Str(s) => write!(f, "{s:?}"),
+            Val::Bool(b) => write!(f, "{b}"),
+            Val::Other(what) => f.write_str(what),
+        }
+    }
+}
+
+/// Name under which toml hands a date-time to `deserialize_any` (as a one-entry map).
+const TOML_DATETIME_KEY: &str = "$__toml_private_datetime";
+
+struct ValVisitor;
+
+impl<'de> Visitor<'de> for ValVisitor {
+    type Value = Val;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("any value")
+    }
+    fn visit_bool<E>(self, v: bool) -> Result<Val, E> {
+        Ok(Val::Bool(v))
+    }
+    fn visit_i64<E>(self, v: i64) -> Result<Val, E> {
+        Ok(Val::Num(v as f64))
+    }
+    fn visit_u64<E>(self, v: u64) -> Result<Val, E> {
+        Ok(Val::Num(v as f64))
+    }
+    fn visit_f64<E>(self, v: f64) -> Result<Val, E> {
+        Ok(Val::Num(v))
+    }
+    fn visit_str<E>(self, v: &str) -> Result<Val, E> {
+        Ok(Val::Str(v.to_string()))
+    }
+    fn visit_string<E>(self, v: String) -> Result<Val, E> {
+        Ok(Val::Str(v))
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Val, A::Error> {
+        while seq.next_element::<IgnoredAny>()?.is_some() {}
+        Ok(Val::Other("an array"))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Val, A::Error> {
+        let mut what = "a table";
+        if let Some(key) = map.next_key::<String>()? {
+            if key == TOML_DATETIME_KEY {
+                what = "a date-time";
+            }
+            map.next_value::<IgnoredAny>()?;
+            while map.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
+        }
+        Ok(Val::Other(what))
+    }
+}
+
+impl<'de> Deserialize<'de> for Val {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(ValVisitor)
+    }
+}
+
+/// Scalar `visit_*` methods that turn the value into `$wrap(Val)`.
+macro_rules! wrong_scalars {
+    ($wrap:path) => {
+        fn visit_bool<E>(self, v: bool) -> Result<Self::Value, E> {
+            Ok($wrap(Val::Bool(v)))
+        }
+        fn visit_i64<E>(self, v: i64) -> Result<Self::Value, E> {
+            Ok($wrap(Val::Num(v as f64)))
+        }
+        fn visit_u64<E>(self, v: u64) -> Result<Self::Value, E> {
+            Ok($wrap(Val::Num(v as f64)))
+        }
+        fn visit_f64<E>(self, v: f64) -> Result<Self::Value, E> {
+            Ok($wrap(Val::Num(v)))
+        }
+        fn visit_str<E>(self, v: &str) -> Result<Self::Value, E> {
+            Ok($wrap(Val::Str(v.to_string())))
+        }
+    };
+}
+
+/// A table deserialised as `T`, or a value of another type kept for the message.
+enum Tab<T> {
+    Table(T),
+    Wrong(Val),
+}
+
+struct TabVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Deserialize<'de>> Visitor<'de> for TabVisitor<T> {
+    type Value = Tab<T>;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a table")
+    }
+    wrong_scalars!(Tab::Wrong);
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+        ValVisitor.visit_seq(seq).map(Tab::Wrong)
+    }
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+        T::deserialize(de::value::MapAccessDeserializer::new(map)).map(Tab::Table)
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Tab<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TabVisitor(PhantomData))
+    }
+}
+
+/// An array of `T`, or a value of another type kept for the message.
+enum List<T> {
+    Items(Vec<T>),
+    Wrong(Val),
+}
+
+struct ListVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Deserialize<'de>> Visitor<'de> for ListVisitor<T> {
+    type Value = List<T>;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("an array")
+    }
+    wrong_scalars!(List::Wrong);
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+        Vec::<T>::deserialize(de::value::SeqAccessDeserializer::new(seq)).map(List::Items)
+    }
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+        ValVisitor.visit_map(map).map(List::Wrong)
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for List<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(ListVisitor(PhantomData))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checks
+// ---------------------------------------------------------------------------------------------
+
+type Opt = Option<Spanned<Val>>;
+
+const MM_POSITIVE: &str = "a positive number of millimetres";
+const MM_NON_NEGATIVE: &str = "a number of millimetres, zero or more";
+const NON_EMPTY: &str = "a non-empty string";
+
+struct Ctx<'a> {
+    text: &'a str,
+    path: &'a Path,
+}
+
+impl Ctx<'_> {
+    /// 1-based line of a byte offset into the text.
+    fn line_at(&self, offset: usize) -> usize {
+        let end = offset.min(self.text.len());
+        1 + self.text.as_bytes()[..end]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+    }
+
+    fn line(&self, span: Range<usize>) -> usize {
+        self.line_at(span.start)
+    }
+
+    fn syntax(&self, err: &toml::de::Error) -> SpecError {
+        let span = err.span();
+        let line = span.clone().map_or(1, |s| self.line(s));
+        let mut message = one_line(err.message());
+        // toml says only "duplicate key"; its span covers the key, so name it.
+        if message == "duplicate key" {
+            if let Some(key) = span.and_then(|s| self.text.get(s)) {
+                let key = key.trim();
+                if !key.is_empty() && key.len() <= 80 && !key.contains('\n') {
+                    message = format!("duplicate key `{key}`");
+                }
+            }
+        }
+        // A date-time where a table belongs reaches the table as toml's private key.
+        if message.contains(TOML_DATETIME_KEY) {
+            message = "expected a table, got a date-time".to_string();
+        }
+        SpecError::Syntax {
+            path: self.path.to_path_buf(),
+            line,
+            message,
+        }
+    }
+
+    fn invalid(&self, line: usize, key: &str, message: String) -> SpecError {
+        SpecError::Invalid {
+            path: self.path.to_path_buf(),
+            line,
+            key: key.to_string(),
+            message,
+        }
+    }
+
+    /// "must be EXPECTED, got VALUE" as an `Invalid` error at the value's line.
+    fn expected(&self, v: &Spanned<Val>, key: &str, expected: &str) -> SpecError {
+        let mut message = format!("must be {expected}, got {}", v.get_ref());
+        if matches!(v.get_ref(), Val::Num(n) if !n.is_finite()) {
+            message.push_str(" (not a finite number)");
+        }
+        self.invalid(self.line(v.span()), key, message)
+    }
+
+    /// A finite number accepted by `ok`, with its line.
+    fn number(
+        &self,
+        v: &Opt,
+        key: &str,
+        expected: &str,
+        ok: impl Fn(f64) -> bool,
+    ) -> Result<Option<(f64, usize)>, SpecError> {
+        let Some(v) = v else { return Ok(None) };
+        match *v.get_ref() {
+            Val::Num(n) if n.is_finite() && ok(n) => Ok(Some((n, self.line(v.span())))),
+            _ => Err(self.expected(v, key, expected)),
+        }
+    }
+
+    fn string(&self, v: &Opt, key: &str, expected: &str) -> Result<Option<String>, SpecError> {
+        let Some(v) = v else { return Ok(None) };
+        match v.get_ref() {
+            Val::Str(s) if !s.trim().is_empty() => Ok(Some(s.clone())),
+            _ => Err(self.expected(v, key, expected)),
+        }
+    }
+
+    fn boolean(&self, v: &Opt, key: &str) -> Result<Option<bool>, SpecError> {
+        let Some(v) = v else { return Ok(None) };
+        match v.get_ref() {
+            Val::Bool(b) => Ok(Some(*b)),
+            _ => Err(self.expected(v, key, "true or false")),
+        }
+    }
+
+    /// One of an enum's names (ASCII case ignored).
+    fn choice<T: Copy>(
+        &self,
+        v: &Opt,
+        key: &str,
+        table: &[(&str, T)],
+    ) -> Result<Option<T>, SpecError> {
+        let Some(v) = v else { return Ok(None) };
+        let found = match v.get_ref() {
+            Val::Str(s) => pick(s, table).ok(),
+            _ => None,
+        };
+        match found {
+            Some(t) => Ok(Some(t)),
+            None => {
+                let names: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
+                Err(self.expected(v, key, &one_of(&names)))
+            }
+        }
+    }
+
+    /// The table, `None` if absent, or an error if the key holds another type.
+    fn table<'t, T>(
+        &self,
+        t: &'t Option<Spanned<Tab<T>>>,
+        key: &str,
+    ) -> Result<Option<(&'t T, usize)>, SpecError> {
+        let Some(t) = t else { return Ok(None) };
+        match t.get_ref() {
+            Tab::Table(inner) => Ok(Some((inner, self.line(t.span())))),
+            Tab::Wrong(v) => Err(self.invalid(
+                self.line(t.span()),
+                key,
+                format!("must be a table ([{key}]), got {v}"),
+            )),
+        }
+    }
+
+    fn build(&self, raw: RawSpec) -> Result<Spec, SpecError> {
+        let name = self
+            .string(&raw.name, "name", NON_EMPTY)?
+            .unwrap_or_else(|| stem_or(self.path, "pattern"));
+        let device = self.string(&raw.device, "device", "a non-empty device profile name")?;
+
+        let surfaces = self.surfaces(&raw.surface)?;
+        let material = self.material(&raw.material)?;
+        let sheet = self.sheet(&raw.sheet)?;
+        let pattern = self.pattern(&raw.pattern)?;
+
+        Ok(Spec {
+            name,
+            path: self.path.to_path_buf(),
+            device,
+            surfaces,
+            material,
+            sheet,
+            pattern,
+        })
+    }
+
+    fn surfaces(
+        &self,
+        raw: &Option<Spanned<List<Spanned<Tab<RawSurface>>>>>,
+    ) -> Result<Vec<SurfaceSpec>, SpecError> {
+        const ONE_OR_MORE: &str = "one or more [[surface]] tables, each with `kind` and `path`";
+        let entries = match raw {
+            None => {
+                return Err(self.invalid(
+                    1,
+                    "surface",
+                    format!("missing: the spec needs {ONE_OR_MORE}"),
+                ))
+            }
+            Some(list) => match list.get_ref() {
+                List::Items(items) if !items.is_empty() => items,
+                List::Items(_) => {
+                    return Err(self.invalid(
+                        self.line(list.span()),
+                        "surface",
+                        format!("must be {ONE_OR_MORE}, got an empty array"),
+                    ))
+                }
+                List::Wrong(v) => {
+                    return Err(self.invalid(
+                        self.line(list.span()),
+                        "surface",
+                        format!("must be {ONE_OR_MORE}, got {v}"),
+                    ))
+                }
+            },
+        };
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        let mut out = Vec::with_capacity(entries.len());
+        for (i, entry) in entries.iter().enumerate() {
+            let key = format!("surface[{}]", i + 1);
+            let header_line = self.line(entry.span());
+            let s = match entry.get_ref() {
+                Tab::Table(s) => s,
+                Tab::Wrong(v) => {
+                    return Err(self.invalid(
+                        header_line,
+                        &key,
+                        format!("must be a table with `kind` and `path`, got {v}"),
+                    ))
+                }
+            };
+            let kind_key = format!("{key}.kind");
+            let kind = self
+                .choice(&s.kind, &kind_key, &SurfaceKind::NAMES)?
+                .ok_or_else(|| {
+                    self.invalid(
+                        header_line,
+                        &kind_key,
+                        format!(
+                            "missing: each [[surface]] needs a `kind`, {}",
+                            one_of(&["mesh"])
+                        ),
+                    )
+                })?;
+            match kind {
+                SurfaceKind::Mesh => {
+                    let path_key = format!("{key}.path");
+                    let rel = self.string(
+                        &s.path,
+                        &path_key,
+                        "a non-empty string naming the mesh file, relative to the spec's folder",
+                    )?;
+                    let (rel, line) = match (rel, &s.path) {
+                        (Some(rel), Some(p)) => (rel, self.line(p.span())),
+                        _ => {
+                            return Err(self.invalid(
+                                header_line,
+                                &path_key,
+                                "missing: a mesh surface needs the path of its .obj file, \
+                                 relative to the spec's folder"
+                                    .to_string(),
+                            ))
+                        }
+                    };
+                    let path = dir.join(&rel);
+                    let scale = self
+                        .number(
+                            &s.scale,
+                            &format!("{key}.scale"),
+                            "a positive number",
+                            |v| v > 0.0,
+                        )?
+                        .map_or(1.0, |(v, _)| v);
+                    let units = self
+                        .choice(&s.units, &format!("{key}.units"), &Units::NAMES)?
+                        .unwrap_or_default();
+                    let name = self
+                        .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+                        .unwrap_or_else(|| stem_or(&path, &key));
+                    out.push(SurfaceSpec {
+                        kind,
+                        path,
+                        scale,
+                        units,
+                        name,
+                        line,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn material(&self, raw: &Option<Spanned<Tab<RawMaterial>>>) -> Result<Material, SpecError> {
+        let Some((m, _)) = self.table(raw, "material")? else {
+            return Ok(Material::default());
+        };
+        let kind = self
+            .choice(&m.kind, "material.kind", &MaterialKind::NAMES)?
+            .unwrap_or_default();
+        let thickness = self
+            .number(&m.thickness, "material.thickness", MM_POSITIVE, |v| v > 0.0)?
+            .map_or(kind.default_thickness(), |(v, _)| v);
+        Ok(Material { kind, thickness })
+    }
+
+    fn sheet(&self, raw: &Option<Spanned<Tab<RawSheet>>>) -> Result<SheetSpec, SpecError> {
+        let Some((s, header_line)) = self.table(raw, "sheet")? else {
+            return Ok(SheetSpec::default());
+        };
+        let d = SheetSpec::default();
+        let positive = |v: f64| v > 0.0;
+        let non_negative = |v: f64| v >= 0.0;
+        let width = self.number(&s.width, "sheet.width", MM_POSITIVE, positive)?;
+        let height = self.number(&s.height, "sheet.height", MM_POSITIVE, positive)?;
+        let roll = self.boolean(&s.roll, "sheet.roll")?.unwrap_or(false);
+        let margin = self.number(&s.margin, "sheet.margin", MM_NON_NEGATIVE, non_negative)?;
+        let spacing = self.number(&s.spacing, "sheet.spacing", MM_NON_NEGATIVE, non_negative)?;
+
+        if let (true, Some((_, line))) = (roll, height) {
+            return Err(self.invalid(
+                line,
+                "sheet.height",
+                "not allowed with `roll = true` (a roll has no fixed length); \
+                 remove `height` or set `roll = false`"
+                    .to_string(),
+            ));
+        }
+        let (width, width_line) = width.unwrap_or((d.width, header_line));
+        let height = if roll {
+            None
+        } else {
+            Some(height.unwrap_or((d.height.unwrap_or(297.0), header_line)))
+        };
+        let margin_given = margin.is_some();
+        let (margin, margin_line) = margin.unwrap_or((d.margin, header_line));
+        let spacing = spacing.map_or(d.spacing, |(v, _)| v);
+
+        let limits = std::iter::once(("width", width, width_line))
+            .chain(height.map(|(h, l)| ("height", h, l)));
+        for (what, size, size_line) in limits {
+            if 2.0 * margin >= size {
+                let (line, default_note) = if margin_given {
+                    (margin_line, "")
+                } else {
+                    (size_line, " (the default)")
+                };
+                return Err(self.invalid(
+                    line,
+                    "sheet.margin",
+                    format!(
+                        "must be less than half the sheet {what} ({} mm), got {}{default_note}",
+                        fmt_num(size),
+                        fmt_num(margin)
+                    ),
+                ));
+            }
+        }
+        Ok(SheetSpec {
+            width,
+            height: height.map(|(h, _)| h),
+            margin,
+            spacing,
+        })
+    }
+
+    fn pattern(&self, raw: &Option<Spanned<Tab<RawPattern>>>) -> Result<PatternSpec, SpecError> {
+        let Some((p, _)) = self.table(raw, "pattern")? else {
+            return Ok(PatternSpec::default());
+        };
+        let fold_threshold_deg = self
+            .number(
+                &p.fold_threshold,
+                "pattern.fold_threshold",
+                "a number of degrees, at least 0 and less than 180",
+                |v| (0.0..180.0).contains(&v),
+            )?
+            .map_or(PatternSpec::default().fold_threshold_deg, |(v, _)| v);
+        Ok(PatternSpec { fold_threshold_deg })
+    }
+}
+
+/// Joins a multi-line message into one line.
+fn one_line(s: &str) -> String {
+    s.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tests
+// ---------------------------------------------------------------------------------------------
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FULL: &str = r#"name = "cube"            # optional; default: the spec file's stem
+device = "hpgl-pens"     # optional device profile name
+
+[[surface]]              # one or more
+kind = "mesh"
+path = "cube.obj"
+scale = 1.0
+units = "mm"
+name = "box"
+
+[material]
+kind = "paper"
+thickness = 0.25
+
+[sheet]
+width = 210
+height = 297
+roll = false
+margin = 5
+spacing = 3
+
+[pattern]
+fold_threshold = 1.0
+"#;
+
+    const MINIMAL: &str = "[[surface]]\nkind = \"mesh\"\npath = \"lamp.obj\"\n";
+
+    fn p(text: &str) -> Result<Spec, SpecError> {
+        parse(text, Path::new("patterns/lamp.toml"))
+    }
+
+    /// Parses `text`, which must fail; returns (line, key or "", message, Display).
+    fn fail(text: &str) -> (SpecError, String) {
+        match p(text) {
+            Ok(spec) => panic!("expected an error, got {spec:?}"),
+            Err(e) => {
+                let shown = e.to_string();
+                (e, shown)
+            }
+        }
+    }
+
+    fn invalid(text: &str) -> (usize, String, String) {
+        match fail(text) {
+            (
+                SpecError::Invalid {
+                    line, key, message, ..
+                },
+                shown,
+            ) => {
+                assert_single_line(&shown);
+                assert!(shown.starts_with("patterns/lamp.toml:"), "{shown}");
+                (line, key, message)
+            }
+            (other, _) => panic!("expected Invalid, got {other:?}"),
+        }
+    }
+
+    fn syntax(text: &str) -> (usize, String) {
+        match fail(text) {
+            (SpecError::Syntax { line, message, .. }, shown) => {
+                assert_single_line(&shown);
+                assert!(shown.starts_with("patterns/lamp.toml:"), "{shown}");
+                (line, message)
+            }
+            (other, _) => panic!("expected Syntax, got {other:?}"),
+        }
+    }
+
+    fn assert_single_line(s: &str) {
+        assert!(!s.contains('\n') && !s.contains('\r'), "multi-line: {s:?}");
+    }
+
+    #[test]
+    fn full_example_parses_exactly() {
+        let spec = p(FULL).unwrap();
+        assert_eq!(
+            spec,
+            Spec {
+                name: "cube".into(),
+                path: PathBuf::from("patterns/lamp.toml"),
+                device: Some("hpgl-pens".into()),
+                surfaces: vec![SurfaceSpec {
+                    kind: SurfaceKind::Mesh,
+                    path: PathBuf::from("patterns/cube.obj"),
+                    scale: 1.0,
+                    units: Units::Mm,
+                    name: "box".into(),
+                    line: 6,
+                }],
+                material: Material {
+                    kind: MaterialKind::Paper,
+                    thickness: 0.25
+                },
+                sheet: SheetSpec {
+                    width: 210.0,
+                    height: Some(297.0),
+                    margin: 5.0,
+                    spacing: 3.0
+                },
+                pattern: PatternSpec {
+                    fold_threshold_deg: 1.0
+                },
+            }
+        );
+        assert!(!spec.sheet.is_roll());
+    }
+
+    #[test]
+    fn full_example_with_other_values() {
+        let text = r#"
+[[surface]]
+kind = "MESH"
+path = "a/b.obj"
+scale = 2.5
+units = "in"
+
+[[surface]]
+kind = "mesh"
+path = "/abs/c.obj"
+units = "cm"
+
+[material]
+kind = "metal"
+
+[sheet]
+width = 600.5
+roll = true
+margin = 0
+spacing = 1.5
+
+[pattern]
+fold_threshold = 179.5
+"#;
+        let spec = p(text).unwrap();
+        assert_eq!(spec.name, "lamp");
+        assert_eq!(spec.device, None);
+        assert_eq!(spec.surfaces.len(), 2);
+        let a = &spec.surfaces[0];
+        assert_eq!(a.path, PathBuf::from("patterns/a/b.obj"));
+        assert_eq!(
+            (a.scale, a.units, a.name.as_str(), a.line),
+            (2.5, Units::In, "b", 4)
+        );
+        let c = &spec.surfaces[1];
+        assert_eq!(c.path, PathBuf::from("/abs/c.obj"));
+        assert_eq!(
+            (c.scale, c.units, c.name.as_str(), c.line),
+            (1.0, Units::Cm, "c", 10)
+        );
+        assert_eq!(
+            spec.material,
+            Material {
+                kind: MaterialKind::Metal,
+                thickness: 1.0
+            }
+        );
+        assert_eq!(
+            spec.sheet,
+            SheetSpec {
+                width: 600.5,
+                height: None,
+                margin: 0.0,
+                spacing: 1.5
+            }
+        );
+        assert!(spec.sheet.is_roll());
+        assert_eq!(spec.pattern.fold_threshold_deg, 179.5);
+    }
+
+    #[test]
+    fn minimal_spec_gets_all_defaults() {
+        let spec = p(MINIMAL).unwrap();
+        assert_eq!(spec.name, "lamp");
+        assert_eq!(spec.path, PathBuf::from("patterns/lamp.toml"));
+        assert_eq!(spec.device, None);
+        assert_eq!(
+            spec.surfaces,
+            vec![SurfaceSpec {
+                kind: SurfaceKind::Mesh,
+                path: PathBuf::from("patterns/lamp.obj"),
+                scale: 1.0,
+                units: Units::Mm,
+                name: "lamp".into(),
+                line: 3,
+            }]
+        );
+        assert_eq!(
+            spec.material,
+            Material {
+                kind: MaterialKind::Paper,
+                thickness: 0.25
+            }
+        );
+        assert_eq!(
+            spec.sheet,
+            SheetSpec {
+                width: 210.0,
+                height: Some(297.0),
+                margin: 5.0,
+                spacing: 3.0
+            }
+        );
+        assert_eq!(spec.pattern.fold_threshold_deg, 1.0);
+        assert_eq!(spec.material, Material::default());
+        assert_eq!(spec.sheet, SheetSpec::default());
+        assert_eq!(spec.pattern, PatternSpec::default());
+    }
+
+    #[test]
+    fn material_thickness_defaults_by_kind() {
+        for (kind, t) in [("paper", 0.25), ("fabric", 0.5), ("metal", 1.0)] {
+            let text = format!("{MINIMAL}[material]\nkind = \"{kind}\"\n");
+            let spec = p(&text).unwrap();
+            assert_eq!(spec.material.thickness, t, "{kind}");
+            assert_eq!(spec.material.kind.to_string(), kind);
+            assert_eq!(spec.material.kind.default_thickness(), t);
+        }
+        let spec = p(&format!(
+            "{MINIMAL}[material]\nkind = \"fabric\"\nthickness = 2\n"
+        ))
+        .unwrap();
+        assert_eq!(spec.material.thickness, 2.0);
+    }
+
+    #[test]
+    fn relative_path_resolved_against_spec_dir() {
+        let text = "[[surface]]\nkind = \"mesh\"\npath = \"../meshes/lamp shade.obj\"\n";
+        let spec = parse(text, Path::new("/home/u/patterns/lamp.toml")).unwrap();
+        assert_eq!(
+            spec.surfaces[0].path,
+            PathBuf::from("/home/u/patterns/../meshes/lamp shade.obj")
+        );
+        assert_eq!(spec.surfaces[0].name, "lamp shade");
+        // A spec in the current directory leaves the path as written.
+        let spec = parse(text, Path::new("lamp.toml")).unwrap();
+        assert_eq!(
+            spec.surfaces[0].path,
+            PathBuf::from("../meshes/lamp shade.obj")
+        );
+    }
+
+    #[test]
+    fn units_conversions() {
+        assert_eq!(Units::Mm.mm(), 1.0);
+        assert_eq!(Units::Cm.mm(), 10.0);
+        assert_eq!(Units::M.mm(), 1000.0);
+        assert_eq!(Units::In.mm(), 25.4);
+        for (name, u, mm) in [
+            ("mm", Units::Mm, 1.0),
+            ("cm", Units::Cm, 10.0),
+            ("m", Units::M, 1000.0),
+            ("in", Units::In, 25.4),
+        ] {
+            let spec = p(&format!("{MINIMAL}units = \"{name}\"\n")).unwrap();
+            assert_eq!(spec.surfaces[0].units, u);
+            assert_eq!(spec.surfaces[0].units.mm(), mm);
+            assert_eq!(u.to_string(), name);
+            assert_eq!(name.parse::<Units>(), Ok(u));
+        }
+        let (line, key, message) = invalid(&format!("{MINIMAL}units = \"ft\"\n"));
+        assert_eq!((line, key.as_str()), (4, "surface[1].units"));
+        assert_eq!(message, "must be one of mm, cm, m, in, got \"ft\"");
+    }
+
+    #[test]
+    fn integer_and_float_numbers() {
+        let ints = p(&format!(
+            "{MINIMAL}scale = 2\n[sheet]\nwidth = 300\nheight = 400\nmargin = 0\nspacing = 4\n\
+             [material]\nthickness = 1\n[pattern]\nfold_threshold = 5\n"
+        ))
+        .unwrap();
+        let floats = p(&format!(
+            "{MINIMAL}scale = 2.0\n[sheet]\nwidth = 300.0\nheight = 4e2\nmargin = 0.0\n\
+             spacing = 4.0\n[material]\nthickness = 1.0\n[pattern]\nfold_threshold = 5.0\n"
+        ))
+        .unwrap();
+        assert_eq!(ints, floats);
+        assert_eq!(ints.surfaces[0].scale, 2.0);
+        assert_eq!(
+            ints.sheet,
+            SheetSpec {
+                width: 300.0,
+                height: Some(400.0),
+                margin: 0.0,
+                spacing: 4.0
+            }
+        );
+        assert_eq!(ints.material.thickness, 1.0);
+        assert_eq!(ints.pattern.fold_threshold_deg, 5.0);
+    }
+
+    #[test]
+    fn unknown_top_level_key() {
+        let text = format!("name = \"x\"\n\ncolour = \"red\"\n{MINIMAL}");
+        let (line, message) = syntax(&text);
+        assert_eq!(line, 3);
+        assert!(
+            message.starts_with("unknown field `colour`, expected one of"),
+            "{message}"
+        );
+        assert!(message.contains("`surface`"), "{message}");
+        let shown = p(&text).unwrap_err().to_string();
+        assert!(
+            shown.starts_with("patterns/lamp.toml:3: unknown field `colour`"),
+            "{shown}"
+        );
+    }
+
+    #[test]
+    fn unknown_key_in_sheet() {
+        let (line, message) = syntax(&format!("{MINIMAL}[sheet]\nwidth = 200\nwidht = 300\n"));
+        assert_eq!(line, 6);
+        assert!(message.starts_with("unknown field `widht`"), "{message}");
+        assert!(
+            message.contains("`width`") && message.contains("`roll`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn unknown_key_in_surface() {
+        let text = format!("{MINIMAL}\n[[surface]]\nkind = \"mesh\"\npath = \"b.obj\"\nscal = 2\n");
+        let (line, message) = syntax(&text);
+        assert_eq!(line, 8);
+        assert!(message.starts_with("unknown field `scal`"), "{message}");
+        assert!(message.contains("`scale`"), "{message}");
+    }
+
+    #[test]
+    fn negative_width_is_invalid() {
+        let text = format!("{MINIMAL}[sheet]\nheight = 100\nwidth = -3\n");
+        let (line, key, message) = invalid(&text);
+        assert_eq!((line, key.as_str()), (6, "sheet.width"));
+        assert_eq!(message, "must be a positive number of millimetres, got -3");
+        assert_eq!(
+            p(&text).unwrap_err().to_string(),
+            "patterns/lamp.toml:6: `sheet.width`: must be a positive number of millimetres, got -3"
+        );
+    }
+
+    #[test]
+    fn wrong_types_name_the_key() {
+        let (line, key, message) = invalid(&format!("{MINIMAL}[sheet]\nwidth = \"wide\"\n"));
+        assert_eq!((line, key.as_str()), (5, "sheet.width"));
+        assert_eq!(
+            message,
+            "must be a positive number of millimetres, got \"wide\""
+        );
+
+        let (line, key, message) =
+            invalid(&format!("{MINIMAL}[sheet]\nroll = \"yes\"\nheight = 5\n"));
+        assert_eq!((line, key.as_str()), (5, "sheet.roll"));
+        assert_eq!(message, "must be true or false, got \"yes\"");
+
+        let (line, key, message) = invalid("surface = \"cube.obj\"\n");
+        assert_eq!((line, key.as_str()), (1, "surface"));
+        assert!(message.ends_with("got \"cube.obj\""), "{message}");
+
+        let (line, key, message) = invalid(&format!("sheet = 5\n{MINIMAL}"));
+        assert_eq!((line, key.as_str()), (1, "sheet"));
+        assert_eq!(message, "must be a table ([sheet]), got 5");
+
+        let (line, key, message) = invalid(&format!("{MINIMAL}scale = [1, 2]\n"));
+        assert_eq!((line, key.as_str()), (4, "surface[1].scale"));
+        assert_eq!(message, "must be a positive number, got an array");
+
+        let (line, key, message) = invalid(&format!("name = 1979-05-27\n{MINIMAL}"));
+        assert_eq!((line, key.as_str()), (1, "name"));
+        assert_eq!(message, "must be a non-empty string, got a date-time");
+
+        let (line, key, _) = invalid(&format!("name = \"\"\n{MINIMAL}"));
+        assert_eq!((line, key.as_str()), (1, "name"));
+    }
+
+    #[test]
+    fn roll_with_height_is_invalid() {
+        let (line, key, message) =
+            invalid(&format!("{MINIMAL}[sheet]\nroll = true\nheight = 500\n"));
+        assert_eq!((line, key.as_str()), (6, "sheet.height"));
+        assert!(message.contains("roll = true"), "{message}");
+    }
+
+    #[test]
+    fn roll_gives_no_height() {
+        let spec = p(&format!("{MINIMAL}[sheet]\nwidth = 610\nroll = true\n")).unwrap();
+        assert_eq!(spec.sheet.height, None);
+        assert_eq!(spec.sheet.width, 610.0);
+        assert!(spec.sheet.is_roll());
+        let spec = p(&format!("{MINIMAL}[sheet]\nroll = false\n")).unwrap();
+        assert_eq!(spec.sheet.height, Some(297.0));
+    }
+
+    #[test]
+    fn margin_must_leave_room() {
+        let (line, key, message) =
+            invalid(&format!("{MINIMAL}[sheet]\nwidth = 100\nmargin = 50\n"));
+        assert_eq!((line, key.as_str()), (6, "sheet.margin"));
+        assert_eq!(
+            message,
+            "must be less than half the sheet width (100 mm), got 50"
+        );
+
+        let (line, key, message) = invalid(&format!("{MINIMAL}[sheet]\nheight = 8\n"));
+        assert_eq!((line, key.as_str()), (5, "sheet.margin"));
+        assert_eq!(
+            message,
+            "must be less than half the sheet height (8 mm), got 5 (the default)"
+        );
+
+        // A roll has no height to check against.
+        let spec = p(&format!(
+            "{MINIMAL}[sheet]\nwidth = 100\nmargin = 49.5\nroll = true\n"
+        ))
+        .unwrap();
+        assert_eq!(spec.sheet.margin, 49.5);
+    }
+
+    #[test]
+    fn other_range_checks() {
+        let (line, key, message) = invalid(&format!("{MINIMAL}[pattern]\nfold_threshold = 180\n"));
+        assert_eq!((line, key.as_str()), (5, "pattern.fold_threshold"));
+        assert_eq!(
+            message,
+            "must be a number of degrees, at least 0 and less than 180, got 180"
+        );
+
+        let (line, key, _) = invalid(&format!("{MINIMAL}[sheet]\nspacing = -0.5\n"));
+        assert_eq!((line, key.as_str()), (5, "sheet.spacing"));
+
+        let (line, key, message) = invalid(&format!("{MINIMAL}[material]\nthickness = 0\n"));
+        assert_eq!((line, key.as_str()), (5, "material.thickness"));
+        assert_eq!(message, "must be a positive number of millimetres, got 0");
+
+        let (line, key, message) = invalid(&format!("{MINIMAL}[sheet]\nwidth = inf\n"));
+        assert_eq!((line, key.as_str()), (5, "sheet.width"));
+        assert_eq!(
+            message,
+            "must be a positive number of millimetres, got inf (not a finite number)"
+        );
+    }
+
+    #[test]
+    fn bad_material_kind_lists_allowed() {
+        let (line, key, message) = invalid(&format!("{MINIMAL}[material]\nkind = \"wood\"\n"));
+        assert_eq!((line, key.as_str()), (5, "material.kind"));
+        assert_eq!(message, "must be one of paper, fabric, metal, got \"wood\"");
+
+        assert_eq!("Fabric".parse::<MaterialKind>(), Ok(MaterialKind::Fabric));
+        assert_eq!(
+            "wood".parse::<MaterialKind>(),
+            Err("expected one of paper, fabric, metal, got \"wood\"".to_string())
+        );
+        assert_eq!(MaterialKind::Metal.to_string(), "metal");
+    }
+
+    #[test]
+    fn bad_surface_kind_lists_allowed() {
+        let (line, key, message) = invalid("[[surface]]\nkind = \"strip\"\npath = \"a.obj\"\n");
+        assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
+        assert_eq!(message, "must be one of mesh, got \"strip\"");
+    }
+
+    #[test]
+    fn missing_surface_keys() {
+        let (line, key, message) = invalid(&format!("{MINIMAL}\n[[surface]]\nkind = \"mesh\"\n"));
+        assert_eq!((line, key.as_str()), (5, "surface[2].path"));
+        assert!(message.starts_with("missing"), "{message}");
+
+        let (line, key, message) = invalid("\n[[surface]]\npath = \"a.obj\"\n");
+        assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
+        assert!(message.contains("mesh"), "{message}");
+    }
+
+    #[test]
+    fn no_surfaces_is_an_error() {
+        let (line, key, message) = invalid("name = \"x\"\n[sheet]\nwidth = 200\n");
+        assert_eq!((line, key.as_str()), (1, "surface"));
+        assert!(message.contains("[[surface]]"), "{message}");
+
+        let (line, key, message) = invalid("name = \"x\"\nsurface = []\n");
+        assert_eq!((line, key.as_str()), (2, "surface"));
+        assert!(message.ends_with("got an empty array"), "{message}");
+    }
+
+    #[test]
+    fn malformed_toml_is_syntax_error() {
+        let (line, message) = syntax(&format!("{MINIMAL}[sheet\nwidth = 1\n"));
+        assert_eq!(line, 4);
+        assert!(!message.is_empty());
+
+        let (line, message) = syntax(&format!("{MINIMAL}scale = \n"));
+        assert_eq!(line, 4);
+        assert!(!message.is_empty());
+
+        let (line, message) = syntax(&format!(
+            "name = \"a\"\n{MINIMAL}name = \"b\"\nname = \"c\"\n"
+        ));
+        assert_eq!(line, 6);
+        assert_eq!(message, "duplicate key `name`");
+    }
+
+    #[test]
+    fn nan_is_invalid() {
+        let (line, key, message) = invalid(&format!("{MINIMAL}scale = nan\n"));
+        assert_eq!((line, key.as_str()), (4, "surface[1].scale"));
+        assert_eq!(
+            message,
+            "must be a positive number, got nan (not a finite number)"
+        );
+    }
+
+    #[test]
+    fn missing_file_is_io() {
+        let path = Path::new("/nonexistent/flatcut/spec-test/lamp.toml");
+        match load(path) {
+            Err(e @ SpecError::Io { .. }) => {
+                let shown = e.to_string();
+                assert!(
+                    shown.starts_with(
+                        "/nonexistent/flatcut/spec-test/lamp.toml: cannot read spec: "
+                    ),
+                    "{shown}"
+                );
+                assert_single_line(&shown);
+            }
+            other => panic!("expected Io, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn load_reads_toml_file() {
+        let dir = std::env::temp_dir().join(format!("flatcut-spec-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("job.spec");
+        std::fs::write(&file, MINIMAL).unwrap();
+        let spec = load(&file);
+        let _ = std::fs::remove_dir_all(&dir);
+        let spec = spec.unwrap();
+        assert_eq!(spec.name, "job");
+        assert_eq!(spec.surfaces[0].path, dir.join("lamp.obj"));
+    }
+
+    #[test]
+    fn obj_path_gives_mesh_defaults() {
+        for name in ["models/Cube.obj", "models/Cube.OBJ"] {
+            let path = Path::new(name);
+            let spec = load(path).unwrap();
+            assert_eq!(spec, Spec::from_mesh(path));
+            assert_eq!(spec.name, "Cube");
+            assert_eq!(spec.path, PathBuf::from(name));
+            assert_eq!(spec.device, None);
+            assert_eq!(
+                spec.surfaces,
+                vec![SurfaceSpec {
+                    kind: SurfaceKind::Mesh,
+                    path: PathBuf::from(name),
+                    scale: 1.0,
+                    units: Units::Mm,
+                    name: "Cube".into(),
+                    line: 0,
+                }]
+            );
+            assert_eq!(
+                spec.material,
+                Material {
+                    kind: MaterialKind::Paper,
+                    thickness: 0.25
+                }
+            );
+            assert_eq!(
+                spec.sheet,
+                SheetSpec {
+                    width: 210.0,
+                    height: Some(297.0),
+                    margin: 5.0,
+                    spacing: 3.0
+                }
+            );
+            assert_eq!(spec.pattern.fold_threshold_deg, 1.0);
+        }
+    }
+
+    #[test]
+    fn error_display_is_one_line_with_path() {
+        let cases = [
+            format!("{MINIMAL}colour = 1\n"),
+            format!("{MINIMAL}[sheet]\nwidth = -1\n"),
+            "[[surface]]\nkind = \"mesh\"\npath = \"a\nb\"\n".to_string(),
+            "x = [\n1,\n".to_string(),
+            "a = \"\"\"\nmulti\nline\n".to_string(),
+            String::new(),
+        ];
+        for text in cases {
+            let shown = p(&text).unwrap_err().to_string();
+            assert!(shown.starts_with("patterns/lamp.toml:"), "{shown}");
+            assert_single_line(&shown);
+        }
+    }
+}

@@ -6,6 +6,7 @@
 //! geodesic developables will add files here (see shared/seeds/README.md).
 
 pub mod obj;
+pub mod solids;
 
 use crate::geom::mesh::Mesh;
 use crate::spec::{SurfaceKind, SurfaceSpec};

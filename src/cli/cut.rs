@@ -1,0 +1,141 @@
+//! `flatcut cut SPEC|OBJ`: the whole pipeline. Reads the spec (or a bare OBJ with defaults),
+//! applies the device profile and the flags (flags win), unfolds, nests, orders the strokes and
+//! writes into `-o DIR`: the program for the device (`<name>.plt`, or `<name>-<k>.plt` per sheet
+//! when there are several), `<name>.svg`, `<name>-<k>.png` per sheet and `report.json`, each
+//! written whole or not at all. `--dry-run` writes everything and sends nothing; until the
+//! serial transport lands every run behaves so, and says it.
+
+use super::{create_dir, write_atomic};
+use crate::output::report::{self, RunInfo};
+use crate::spec::MaterialKind;
+use crate::toolpath::{StrokeKind, ToolpathOptions};
+use crate::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+pub struct CutArgs {
+    /// Spec file (`.toml`) or a mesh (`.obj`) to cut with default settings.
+    pub input: PathBuf,
+    /// Directory for the program, pictures and report (default: out/<name>).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Device profile (see devices/; default: the spec's, else `sim`).
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Material: paper, fabric or metal (overrides the spec).
+    #[arg(long)]
+    pub material: Option<MaterialKind>,
+    /// Write the program and pictures but send nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Default output directory for a job name.
+pub fn default_dir(name: &str) -> PathBuf {
+    Path::new("out").join(name)
+}
+
+pub fn run(a: &CutArgs) -> Result<(), Error> {
+    let mut spec = crate::spec::load(&a.input)?;
+    if let Some(m) = a.material {
+        spec.material.kind = m;
+    }
+    let device = a
+        .device
+        .clone()
+        .or_else(|| spec.device.clone())
+        .unwrap_or_else(|| "sim".to_string());
+    let profile = crate::device::profile::find(&device)?;
+    let (flats, pieces) = super::pieces(&spec, a.quiet)?;
+    let nest_opts = crate::nest::NestOptions {
+        width: spec.sheet.width,
+        height: spec.sheet.height,
+        margin: spec.sheet.margin,
+        spacing: spec.sheet.spacing,
+    };
+    let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
+        file: spec.path.clone(),
+        source: Box::new(e.into()),
+    })?;
+    let tp = ToolpathOptions {
+        skip_folds: profile.tool(StrokeKind::Score).is_none(),
+        skip_drawing: profile.tool(StrokeKind::Draw).is_none(),
+    };
+    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+
+    let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
+    create_dir(&dir)?;
+    let mut files = Vec::new();
+    let ext = profile.language.extension();
+    let n = job.sheets.len();
+    for (i, sheet) in job.sheets.iter().enumerate() {
+        let name = if n == 1 {
+            format!("{}.{ext}", spec.name)
+        } else {
+            format!("{}-{}.{ext}", spec.name, i + 1)
+        };
+        let bytes = match profile.language {
+            crate::device::Language::Hpgl => crate::output::hpgl::emit(sheet, &profile),
+            crate::device::Language::Gcode => {
+                return Err(Error::Usage(format!(
+                    "device `{}` speaks G-code, which this flatcut cannot write yet; use an HP-GL device such as hpgl-pens",
+                    profile.name
+                )))
+            }
+        };
+        write_atomic(&dir.join(&name), &bytes)?;
+        files.push(name);
+    }
+    files.extend(super::flatten::write_pictures(&dir, &spec.name, &job)?);
+    files.push("report.json".into());
+    let info = RunInfo {
+        name: spec.name.clone(),
+        spec: spec.path.display().to_string(),
+        device: profile.name.clone(),
+        material: spec.material.kind.to_string(),
+        thickness_mm: spec.material.thickness,
+        files: files.clone(),
+    };
+    let rep = report::build(&info, &flats, &layout);
+    let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
+    write_atomic(&dir.join("report.json"), text.as_bytes())?;
+
+    if !a.quiet {
+        let cut: f64 = layout.pieces.iter().map(|p| p.cut_length()).sum();
+        let fold: f64 = layout.pieces.iter().map(|p| p.fold_length()).sum();
+        println!(
+            "{}: {} pieces on {} {} ({:.0} mm cut, {:.0} mm folds), device {}",
+            spec.name,
+            layout.pieces.len(),
+            layout.sheets.len(),
+            if layout.roll { "roll" } else if n == 1 { "sheet" } else { "sheets" },
+            cut,
+            fold,
+            profile.name
+        );
+        for i in 0..layout.sheets.len() {
+            println!(
+                "  sheet {}: {:.0} × {:.0} mm, {:.1} % used",
+                i + 1,
+                layout.sheets[i].width,
+                layout.sheets[i].height,
+                100.0 * layout.utilisation(i)
+            );
+        }
+        println!("wrote {}: {}", dir.display(), files.join(", "));
+        if a.dry_run {
+            println!("dry run: nothing sent");
+        } else {
+            println!(
+                "nothing sent: streaming to `{}` is not available in this version; the program is in {}",
+                profile.name,
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,91 @@
+//! `flatcut flatten SPEC|OBJ`: stops after the pattern stage and writes the pieces as SVG and
+//! PNG (laid side by side on one long strip, no sheet limits) plus `report.json`.
+
+use super::{create_dir, write_atomic};
+use crate::output::report::{self, RunInfo};
+use crate::toolpath::{Job, ToolpathOptions};
+use crate::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+pub struct FlattenArgs {
+    /// Spec file (`.toml`) or a mesh (`.obj`).
+    pub input: PathBuf,
+    /// Directory for the pictures and report (default: out/<name>).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
+pub fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, Error> {
+    let mut files = Vec::new();
+    let svg = format!("{name}.svg");
+    write_atomic(&dir.join(&svg), crate::output::svg::render(job).as_bytes())?;
+    files.push(svg);
+    for (i, sheet) in job.sheets.iter().enumerate() {
+        let png = format!("{name}-{}.png", i + 1);
+        let bytes =
+            crate::output::png::render(sheet, i + 1, crate::output::png::DEFAULT_PX_PER_MM)?;
+        write_atomic(&dir.join(&png), &bytes)?;
+        files.push(png);
+    }
+    Ok(files)
+}
+
+pub fn run(a: &FlattenArgs) -> Result<(), Error> {
+    let spec = crate::spec::load(&a.input)?;
+    let (flats, pieces) = super::pieces(&spec, a.quiet)?;
+    // One strip wide enough for the widest piece: the pieces, not the sheets, are the result.
+    let widest = pieces
+        .iter()
+        .filter_map(|p| {
+            let pts: Vec<_> = p.points().collect();
+            let r = glam::DVec2::from_angle(crate::geom::polygon::min_area_rect_angle(&pts));
+            crate::geom::polygon::bounds(pts.iter().map(|q| r.rotate(*q))).map(|(lo, hi)| (hi - lo).x)
+        })
+        .fold(0.0, f64::max);
+    let opts = crate::nest::NestOptions {
+        width: spec.sheet.width.max(widest + 2.0 * spec.sheet.margin + 1.0),
+        height: None,
+        margin: spec.sheet.margin,
+        spacing: spec.sheet.spacing,
+    };
+    let layout = crate::nest::nest(pieces, &opts).map_err(|e| Error::In {
+        file: spec.path.clone(),
+        source: Box::new(e.into()),
+    })?;
+    let job = crate::toolpath::plan(&layout, &spec.name, &ToolpathOptions::default());
+    let dir = a
+        .output
+        .clone()
+        .unwrap_or_else(|| super::cut::default_dir(&spec.name));
+    create_dir(&dir)?;
+    let mut files = write_pictures(&dir, &spec.name, &job)?;
+    files.push("report.json".into());
+    let info = RunInfo {
+        name: spec.name.clone(),
+        spec: spec.path.display().to_string(),
+        device: String::new(),
+        material: spec.material.kind.to_string(),
+        thickness_mm: spec.material.thickness,
+        files: files.clone(),
+    };
+    let text = serde_json::to_string_pretty(&report::build(&info, &flats, &layout))
+        .unwrap_or_default()
+        + "\n";
+    write_atomic(&dir.join("report.json"), text.as_bytes())?;
+    if !a.quiet {
+        println!(
+            "{}: {} pieces; wrote {}: {}",
+            spec.name,
+            layout.pieces.len(),
+            dir.display(),
+            files.join(", ")
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,106 @@
+//! Command line: clap argument structs, one file per subcommand, and the composition of the
+//! pipeline stages that the subcommands share. `main.rs` only parses and maps errors to exit
+//! codes.
+
+pub mod check;
+pub mod cut;
+pub mod flatten;
+
+use crate::flatten::{Flat, UnfoldOptions};
+use crate::pattern::{PatternOptions, Piece};
+use crate::spec::Spec;
+use crate::Error;
+use clap::{Parser, Subcommand};
+use std::path::Path;
+
+const EXAMPLES: &str = "\
+Examples:
+  flatcut cut patterns/cube.toml -o out/cube          nest, write HPGL/SVG/PNG/report for the default device
+  flatcut cut lamp.obj --device hpgl-pens --dry-run   a bare OBJ with defaults (paper, A4, 5 mm margin)
+  flatcut cut box.toml --material fabric -o out       flags override the spec file
+  flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
+  flatcut check model.obj                             faces, edges, boundary loops, angle defect";
+
+/// flatcut: developable surfaces to nested flat patterns for cutter plotters.
+#[derive(Debug, Parser)]
+#[command(name = "flatcut", version, about, after_help = EXAMPLES)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Unfold, nest and write the cut program (and pictures, report) for a spec or an OBJ.
+    #[command(after_help = EXAMPLES)]
+    Cut(cut::CutArgs),
+    /// Unfold and write the pieces (SVG, PNG, report) without nesting on sheets.
+    #[command(after_help = EXAMPLES)]
+    Flatten(flatten::FlattenArgs),
+    /// Report what a mesh is made of and whether it can be unfolded exactly.
+    #[command(after_help = EXAMPLES)]
+    Check(check::CheckArgs),
+}
+
+/// Run a parsed command line.
+pub fn run(cli: Cli) -> Result<(), Error> {
+    match cli.command {
+        Command::Cut(a) => cut::run(&a),
+        Command::Flatten(a) => flatten::run(&a),
+        Command::Check(a) => check::run(&a),
+    }
+}
+
+/// Surfaces → flats → pieces for a spec; prints import warnings to stderr.
+pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
+    let mut flats = Vec::new();
+    for s in &spec.surfaces {
+        let surface = crate::surface::build(s)?;
+        if !quiet {
+            for w in &surface.warnings {
+                eprintln!("flatcut: warning: {w}");
+            }
+        }
+        flats.push(crate::flatten::unfold(surface, &UnfoldOptions::default())?);
+    }
+    let opts = PatternOptions {
+        fold_threshold_deg: spec.pattern.fold_threshold_deg,
+        ..PatternOptions::default()
+    };
+    let pieces = crate::pattern::build(&flats, &opts)?;
+    Ok((flats, pieces))
+}
+
+/// Write a file so that it is either complete or absent: write a hidden temporary file beside
+/// it, flush it to disk, then rename it over the final name.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    use std::io::Write;
+    let err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(err(e));
+    }
+    Ok(())
+}
+
+/// Create the output directory.
+pub fn create_dir(dir: &Path) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+        path: dir.to_path_buf(),
+        source,
+    })
+}

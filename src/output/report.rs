@@ -1,0 +1,103 @@
+//! `report.json`: what a run made, for people and for scripts. Pieces (id, name, surface,
+//! area, cut and fold lengths, sheet and placement), sheets (size, pieces, utilisation),
+//! surfaces (source, faces, pieces, repairs made on import) and the files written.
+//!
+//! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
+//! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
+
+use crate::flatten::Flat;
+use crate::nest::Layout;
+use crate::pattern::FoldKind;
+use serde_json::{json, Value};
+
+/// What the report says about the run besides the layout.
+#[derive(Debug, Clone, Default)]
+pub struct RunInfo {
+    pub name: String,
+    pub spec: String,
+    pub device: String,
+    pub material: String,
+    pub thickness_mm: f64,
+    pub files: Vec<String>,
+}
+
+fn r6(v: f64) -> f64 {
+    (v * 1e6).round() / 1e6
+}
+
+/// Build the report.
+pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
+    let pieces: Vec<Value> = layout
+        .pieces
+        .iter()
+        .zip(&layout.placements)
+        .map(|(p, at)| {
+            let pts: Vec<_> = p.outline.iter().flatten().map(|q| at.apply(*q)).collect();
+            let (lo, hi) = crate::geom::polygon::bounds(pts).unwrap_or_default();
+            let count = |k| p.folds.iter().filter(|f| f.kind == k).count();
+            json!({
+                "id": p.id,
+                "name": p.name,
+                "surface": p.surface,
+                "faces": p.faces.len(),
+                "area_mm2": r6(p.area),
+                "cut_length_mm": r6(p.cut_length()),
+                "fold_length_mm": r6(p.fold_length()),
+                "folds": { "mountain": count(FoldKind::Mountain), "valley": count(FoldKind::Valley) },
+                "contours": p.outline.len(),
+                "edge_ids": p.marks.len(),
+                "sheet": at.sheet + 1,
+                "rotation_deg": r6(at.rotation.to_degrees()),
+                "offset_mm": [r6(at.offset.x), r6(at.offset.y)],
+                "bbox_mm": [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)],
+            })
+        })
+        .collect();
+    let sheets: Vec<Value> = layout
+        .sheets
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            json!({
+                "index": i + 1,
+                "width_mm": r6(s.width),
+                "height_mm": r6(s.height),
+                "pieces": s.pieces.iter().map(|&k| layout.pieces[k].id).collect::<Vec<_>>(),
+                "utilisation": r6(layout.utilisation(i)),
+            })
+        })
+        .collect();
+    let surfaces: Vec<Value> = flats
+        .iter()
+        .map(|f| {
+            json!({
+                "name": f.surface.name,
+                "source": f.surface.source.display().to_string(),
+                "faces": f.surface.mesh.faces.len(),
+                "pieces": f.islands.len(),
+                "warnings": f.surface.warnings,
+            })
+        })
+        .collect();
+    let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
+    json!({
+        "name": info.name,
+        "spec": info.spec,
+        "device": info.device,
+        "material": { "kind": info.material, "thickness_mm": info.thickness_mm },
+        "roll": layout.roll,
+        "margin_mm": layout.margin,
+        "spacing_mm": layout.spacing,
+        "surfaces": surfaces,
+        "pieces": pieces,
+        "sheets": sheets,
+        "totals": {
+            "pieces": layout.pieces.len(),
+            "sheets": layout.sheets.len(),
+            "area_mm2": total(&|p| p.area),
+            "cut_length_mm": total(&|p| p.cut_length()),
+            "fold_length_mm": total(&|p| p.fold_length()),
+        },
+        "files": info.files,
+    })
+}
