@@ -10,16 +10,16 @@
 //!
 //! Millimetres and `f64` inside; device units appear only in [`output`].
 
+pub mod cli;
+pub mod device;
+pub mod flatten;
 pub mod geom;
+pub mod nest;
+pub mod output;
+pub mod pattern;
 pub mod spec;
 pub mod surface;
-pub mod flatten;
-pub mod pattern;
-pub mod nest;
 pub mod toolpath;
-pub mod output;
-pub mod device;
-pub mod cli;
 
 /// Any error of a run, by stage. Each message is one line that names the file, piece or line
 /// concerned.

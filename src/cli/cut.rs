@@ -112,7 +112,13 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
             spec.name,
             layout.pieces.len(),
             layout.sheets.len(),
-            if layout.roll { "roll" } else if n == 1 { "sheet" } else { "sheets" },
+            if layout.roll {
+                "roll"
+            } else if n == 1 {
+                "sheet"
+            } else {
+                "sheets"
+            },
             cut,
             fold,
             profile.name

@@ -45,7 +45,8 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         .filter_map(|p| {
             let pts: Vec<_> = p.points().collect();
             let r = glam::DVec2::from_angle(crate::geom::polygon::min_area_rect_angle(&pts));
-            crate::geom::polygon::bounds(pts.iter().map(|q| r.rotate(*q))).map(|(lo, hi)| (hi - lo).x)
+            crate::geom::polygon::bounds(pts.iter().map(|q| r.rotate(*q)))
+                .map(|(lo, hi)| (hi - lo).x)
         })
         .fold(0.0, f64::max);
     let opts = crate::nest::NestOptions {

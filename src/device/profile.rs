@@ -14,7 +14,10 @@ use std::path::{Path, PathBuf};
 /// Profiles shipped with flatcut: (file name, contents).
 pub const BUNDLED: &[(&str, &str)] = &[
     ("sim.toml", include_str!("../../devices/sim.toml")),
-    ("hpgl-pens.toml", include_str!("../../devices/hpgl-pens.toml")),
+    (
+        "hpgl-pens.toml",
+        include_str!("../../devices/hpgl-pens.toml"),
+    ),
 ];
 
 /// Machine language.
@@ -107,7 +110,7 @@ pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
             )));
         }
     }
-    if p.tools.get("cut").is_none() {
+    if !p.tools.contains_key("cut") {
         return Err(invalid("the tool table has no `cut` tool".into()));
     }
     p.source = source_name.to_string();
@@ -194,6 +197,9 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("units_per_mm"), "{e}");
-        assert!(find("no-such-machine").unwrap_err().to_string().contains("hpgl-pens"));
+        assert!(find("no-such-machine")
+            .unwrap_err()
+            .to_string()
+            .contains("hpgl-pens"));
     }
 }

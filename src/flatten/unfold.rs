@@ -20,10 +20,10 @@
 //! material.
 
 use super::{Flat, FlattenError};
+use crate::geom::mesh::Topology;
 use crate::geom::polygon;
 use crate::surface::Surface;
 use glam::{DVec2, DVec3};
-use crate::geom::mesh::Topology;
 use std::collections::HashMap;
 
 /// Options of the unfolder.
@@ -156,7 +156,8 @@ impl Unfolder {
     /// Join the two islands on either side of interior edge `e` by moving the smaller one onto
     /// the larger along the edge, unless that would make them overlap. Returns whether joined.
     fn try_join(&mut self, topology: &Topology, e: usize) -> bool {
-        let [(mut f, mut i), (mut g, mut j)] = [topology.edges[e].uses[0], topology.edges[e].uses[1]];
+        let [(mut f, mut i), (mut g, mut j)] =
+            [topology.edges[e].uses[0], topology.edges[e].uses[1]];
         let (mut a, mut b) = (self.face_island[f], self.face_island[g]);
         if a == b {
             return false;
@@ -229,12 +230,17 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
     let mut dihedral = vec![0.0; ne];
     let mut lengths = vec![0.0; ne];
     for (e, edge) in topology.edges.iter().enumerate() {
-        lengths[e] = surface.mesh.vertices[edge.verts[0]].distance(surface.mesh.vertices[edge.verts[1]]);
+        lengths[e] =
+            surface.mesh.vertices[edge.verts[0]].distance(surface.mesh.vertices[edge.verts[1]]);
         if let [(f, i), (g, _)] = edge.uses[..] {
             dihedral[e] = bend(&surface, f, i, g);
         }
     }
-    let longest = lengths.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let longest = lengths
+        .iter()
+        .copied()
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
     let mean = lengths.iter().sum::<f64>() / ne.max(1) as f64;
     let eps = opts.tolerance.min(0.01 * mean);
 
@@ -277,7 +283,11 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
     let mut joined = vec![false; ne];
     let key = |e: usize| {
         let t = dihedral[e] / std::f64::consts::PI;
-        let w = if t > 0.0 { opts.convex_weight } else { -opts.concave_weight };
+        let w = if t > 0.0 {
+            opts.convex_weight
+        } else {
+            -opts.concave_weight
+        };
         w * t - opts.length_weight * lengths[e] / mean
     };
 
@@ -369,7 +379,11 @@ fn faces_overlap(
 /// over x. For tests and reports.
 pub fn find_overlap(flat: &Flat) -> Option<(usize, usize)> {
     let eps = flat.tolerance;
-    let tris: Vec<Vec<[usize; 3]>> = flat.face_2d.iter().map(|p| polygon::triangulate(p)).collect();
+    let tris: Vec<Vec<[usize; 3]>> = flat
+        .face_2d
+        .iter()
+        .map(|p| polygon::triangulate(p))
+        .collect();
     let mut boxes: Vec<(f64, f64, usize)> = flat
         .face_2d
         .iter()
@@ -523,7 +537,12 @@ pub(crate) mod tests {
         }
         let flat = unfold(surface(Mesh { vertices, faces }), &UnfoldOptions::default()).unwrap();
         assert_eq!(flat.islands.len(), 1);
-        let interior = flat.topology.edges.iter().filter(|e| e.uses.len() == 2).count();
+        let interior = flat
+            .topology
+            .edges
+            .iter()
+            .filter(|e| e.uses.len() == 2)
+            .count();
         assert_eq!(flat.joined.iter().filter(|&&j| j).count(), interior);
     }
 }

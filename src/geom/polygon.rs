@@ -256,7 +256,7 @@ mod tests {
         pts.push(v(1.0, 0.0));
         assert_eq!(convex_hull(&pts).len(), 4);
         // A rectangle 4 x 1 turned by 30 degrees comes back axis aligned, long side along x.
-        let r = DVec2::from_angle(0.5236);
+        let r = DVec2::from_angle(0.5);
         let rect: Vec<_> = [v(0.0, 0.0), v(4.0, 0.0), v(4.0, 1.0), v(0.0, 1.0)]
             .iter()
             .map(|p| r.rotate(*p))
@@ -265,7 +265,10 @@ mod tests {
         let back = DVec2::from_angle(a);
         let (lo, hi) = bounds(rect.iter().map(|p| back.rotate(*p))).unwrap();
         let size = hi - lo;
-        assert!((size.x - 4.0).abs() < 1e-9 && (size.y - 1.0).abs() < 1e-9, "{size}");
+        assert!(
+            (size.x - 4.0).abs() < 1e-9 && (size.y - 1.0).abs() < 1e-9,
+            "{size}"
+        );
     }
 
     #[test]

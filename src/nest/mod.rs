@@ -144,7 +144,11 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
                     piece: piece.name.clone(),
                     w: size.x,
                     h: size.y,
-                    what: if opts.height.is_some() { "sheet" } else { "roll" },
+                    what: if opts.height.is_some() {
+                        "sheet"
+                    } else {
+                        "roll"
+                    },
                     uw,
                     uh: if uh.is_finite() {
                         format!("{uh:.1}")
@@ -287,7 +291,10 @@ mod tests {
     fn too_large_names_both_sizes() {
         let e = nest(vec![square(1, 250.0)], &NestOptions::default()).unwrap_err();
         let s = e.to_string();
-        assert!(s.contains("250.0 × 250.0") && s.contains("200.0 × 287.0"), "{s}");
+        assert!(
+            s.contains("250.0 × 250.0") && s.contains("200.0 × 287.0"),
+            "{s}"
+        );
     }
 
     #[test]

@@ -158,6 +158,9 @@ mod tests {
         let back = parse(&text).unwrap();
         assert_eq!(back.len(), 2);
         assert_eq!(back[1].pen, 1);
-        assert_eq!(back[1].points, vec![(400, 400), (800, 400), (800, 800), (400, 400)]);
+        assert_eq!(
+            back[1].points,
+            vec![(400, 400), (800, 400), (800, 800), (400, 400)]
+        );
     }
 }

@@ -114,7 +114,11 @@ impl Piece {
             .flatten()
             .copied()
             .chain(self.folds.iter().flat_map(|f| [f.a, f.b]))
-            .chain(self.marks.iter().flat_map(|m| m.strokes.iter().flatten().copied()))
+            .chain(
+                self.marks
+                    .iter()
+                    .flat_map(|m| m.strokes.iter().flatten().copied()),
+            )
             .chain(self.label.iter().flatten().copied())
     }
 }
@@ -231,7 +235,9 @@ fn piece(
     }
     // Outer contour first: the loop of largest positive area.
     let outer = (0..loops.len())
-        .max_by(|&a, &b| polygon::signed_area(&loops[a].0).total_cmp(&polygon::signed_area(&loops[b].0)))
+        .max_by(|&a, &b| {
+            polygon::signed_area(&loops[a].0).total_cmp(&polygon::signed_area(&loops[b].0))
+        })
         .unwrap_or(0);
     loops.swap(0, outer);
     let (outline, outline_edges): (Vec<_>, Vec<_>) = loops.into_iter().unzip();
@@ -301,7 +307,7 @@ fn edge_text(text: &str, a: DVec2, b: DVec2, depth: f64, max_h: f64) -> Vec<Vec<
     if w1 * h > 0.8 * len {
         h = 0.8 * len / w1;
     }
-    if !(h > 0.0) {
+    if h.is_nan() || h <= 0.0 {
         return Vec::new();
     }
     let w = w1 * h;
@@ -345,7 +351,7 @@ fn piece_label(flat: &Flat, faces: &[usize], text: &str, max_h: f64) -> Vec<Vec<
     };
     let k = font::text_width(text, 1.0);
     let h = (1.6 * r / (k * k + 1.0).sqrt()).min(max_h);
-    if !(h > 0.0) {
+    if h.is_nan() || h <= 0.0 {
         return Vec::new();
     }
     let (strokes, w) = font::text_strokes(text, h);
@@ -363,8 +369,11 @@ mod tests {
 
     #[test]
     fn cube_piece_has_folds_marks_and_a_simple_outline() {
-        let flat = unfold(crate::flatten::unfold::tests::cube(100.0), &UnfoldOptions::default())
-            .unwrap();
+        let flat = unfold(
+            crate::flatten::unfold::tests::cube(100.0),
+            &UnfoldOptions::default(),
+        )
+        .unwrap();
         let pieces = build(&[flat], &PatternOptions::default()).unwrap();
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];

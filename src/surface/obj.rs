@@ -138,9 +138,9 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
             }
             Some(w) if w.starts_with('#') => {}
             Some(
-                "vt" | "vn" | "vp" | "o" | "g" | "s" | "mtllib" | "usemtl" | "p" | "cstype"
-                | "deg" | "curv" | "curv2" | "surf" | "parm" | "trim" | "hole" | "end" | "mg"
-                | "bevel" | "c_interp" | "d_interp" | "lod" | "shadow_obj" | "trace_obj",
+                "vt" | "vn" | "vp" | "o" | "g" | "s" | "mtllib" | "usemtl" | "p" | "cstype" | "deg"
+                | "curv" | "curv2" | "surf" | "parm" | "trim" | "hole" | "end" | "mg" | "bevel"
+                | "c_interp" | "d_interp" | "lod" | "shadow_obj" | "trace_obj",
             )
             | None => {}
             Some(other) => {
@@ -172,13 +172,11 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::BufReader::new(text.as_bytes());
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &opts, |_| {
-        Ok((Vec::new(), Default::default()))
-    })
-    .map_err(|e| parse_err(path, None, format!("OBJ reader: {e}")))?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
+            .map_err(|e| parse_err(path, None, format!("OBJ reader: {e}")))?;
 
     let mut mesh = Mesh::default();
     let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
@@ -215,7 +213,11 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
         let mut at = 0usize;
         for a in arities {
             let Some(idx) = m.indices.get(at..at + a) else {
-                return Err(parse_err(path, None, "OBJ reader returned a truncated face"));
+                return Err(parse_err(
+                    path,
+                    None,
+                    "OBJ reader returned a truncated face",
+                ));
             };
             let verts = idx
                 .iter()
@@ -275,7 +277,7 @@ pub fn validate(raw: RawMesh, scale: f64) -> Result<(Mesh, Vec<String>), Surface
     }
     let (lo, hi) = mesh.bounds();
     let size = (hi - lo).length();
-    if !(size > 0.0) || !size.is_finite() {
+    if size.is_nan() || size <= 0.0 || !size.is_finite() {
         return Err(SurfaceError::Invalid {
             path,
             message: "all vertices are at the same point (or the scale makes them so)".into(),
@@ -575,7 +577,10 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
         // Bottom face normal points down (outwards).
         assert!((m.face_normal(0) - DVec3::NEG_Z).length() < 1e-12);
         let s = stats(&parse(CUBE, Path::new("t.obj")).unwrap());
-        assert_eq!((s.vertices, s.faces, s.edges, s.boundary_loops), (8, 6, 12, 0));
+        assert_eq!(
+            (s.vertices, s.faces, s.edges, s.boundary_loops),
+            (8, 6, 12, 0)
+        );
         assert!((s.max_angle_defect_deg - 90.0).abs() < 1e-9);
     }
 
@@ -653,10 +658,18 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 
     #[test]
     fn groups_are_welded() {
-        let t = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 4 6 5\n";
+        let t =
+            "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 4 6 5\n";
         let (m, _) = load(t).unwrap();
         assert_eq!(m.vertices.len(), 4);
-        assert_eq!(m.topology().edges.iter().filter(|e| e.uses.len() == 2).count(), 1);
+        assert_eq!(
+            m.topology()
+                .edges
+                .iter()
+                .filter(|e| e.uses.len() == 2)
+                .count(),
+            1
+        );
         assert_eq!(m.faces[1].line, Some(10));
     }
 }

@@ -252,9 +252,8 @@ fn nearest_neighbour(mut strokes: Vec<Stroke>, pen: &mut DVec2) -> Vec<Stroke> {
     for _ in 0..n {
         let c = key(*pen);
         let mut best: Option<(f64, usize, usize)> = None; // (distance, stroke, vertex)
-        let max_r = (c.0.abs().max((c.0 - cells_x).abs()))
-            .max(c.1.abs().max((c.1 - cells_y).abs()))
-            + 1;
+        let max_r =
+            (c.0.abs().max((c.0 - cells_x).abs())).max(c.1.abs().max((c.1 - cells_y).abs())) + 1;
         for r in 0..=max_r {
             if let Some((d, _, _)) = best {
                 // Every point in ring r is at least (r - 1) cells away.
@@ -356,10 +355,16 @@ mod tests {
     fn closed_stroke_starts_at_nearest_vertex() {
         let ring = Stroke {
             role: StrokeRole::Cut,
-            points: [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0), (0.0, 0.0)]
-                .iter()
-                .map(|p| DVec2::new(p.0, p.1))
-                .collect(),
+            points: [
+                (0.0, 0.0),
+                (10.0, 0.0),
+                (10.0, 10.0),
+                (0.0, 10.0),
+                (0.0, 0.0),
+            ]
+            .iter()
+            .map(|p| DVec2::new(p.0, p.1))
+            .collect(),
             closed: true,
             piece: None,
         };
