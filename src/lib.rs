@@ -49,6 +49,12 @@ pub enum Error {
         file: std::path::PathBuf,
         source: Box<Error>,
     },
+    #[error("{}:{line}: {source}", file.display())]
+    At {
+        file: std::path::PathBuf,
+        line: usize,
+        source: Box<Error>,
+    },
     #[error("{0}")]
     Usage(String),
 }
@@ -58,7 +64,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Pattern(_) => 2,
-            Error::In { source, .. } => source.exit_code(),
+            Error::In { source, .. } | Error::At { source, .. } => source.exit_code(),
             _ => 1,
         }
     }

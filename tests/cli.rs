@@ -96,6 +96,17 @@ fn cube_hpgl_cuts_and_folds_every_edge_once() {
     assert_eq!(report["totals"]["pieces"], 1);
     assert_eq!(report["pieces"][0]["folds"]["mountain"], 5);
     assert_eq!(report["pieces"][0]["edge_ids"], 14);
+    let folds = report["pieces"][0]["fold_lines"].as_array().unwrap();
+    assert_eq!(folds.len(), 5);
+    for f in folds {
+        assert_eq!(f["kind"], "mountain");
+        assert!((f["angle_deg"].as_f64().unwrap() - 90.0).abs() < 1e-6);
+        assert!((f["length_mm"].as_f64().unwrap() - 100.0).abs() < 1e-6);
+    }
+    assert!(report["pieces"][0]["source"]
+        .as_str()
+        .unwrap()
+        .ends_with("cube.obj"));
     assert!((report["totals"]["cut_length_mm"].as_f64().unwrap() - 1400.0).abs() < 1e-6);
 }
 
@@ -209,6 +220,17 @@ fn bad_input_is_exit_1_with_one_line() {
     expect_user_error(
         &["cut", &p("nope.toml"), "-o", &out],
         &["nope.toml", "cannot read"],
+    );
+
+    // A spec whose mesh is missing: names the spec line and the mesh.
+    std::fs::write(
+        dir.join("lost.toml"),
+        "name = \"lost\"\n[[surface]]\nkind = \"mesh\"\npath = \"gone.obj\"\n",
+    )
+    .unwrap();
+    expect_user_error(
+        &["cut", &p("lost.toml"), "-o", &out],
+        &["lost.toml:4", "gone.obj"],
     );
 
     // Not an OBJ.

@@ -55,7 +55,17 @@ pub fn run(cli: Cli) -> Result<(), Error> {
 pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
     let mut flats = Vec::new();
     for s in &spec.surfaces {
-        let surface = crate::surface::build(s)?;
+        let surface = crate::surface::build(s).map_err(|e| {
+            if s.line > 0 {
+                Error::At {
+                    file: spec.path.clone(),
+                    line: s.line,
+                    source: Box::new(e.into()),
+                }
+            } else {
+                e.into()
+            }
+        })?;
         if !quiet {
             for w in &surface.warnings {
                 eprintln!("flatcut: warning: {w}");

@@ -1,5 +1,6 @@
-//! `report.json`: what a run made, for people and for scripts. Pieces (id, name, surface,
-//! area, cut and fold lengths, sheet and placement), sheets (size, pieces, utilisation),
+//! `report.json`: what a run made, for people and for scripts. Pieces (id, name, surface and
+//! its source file, area, cut and fold lengths, every fold line with its kind and bend angle,
+//! sheet and placement), sheets (size, pieces, utilisation),
 //! surfaces (source, faces, pieces, repairs made on import) and the files written.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
@@ -27,6 +28,13 @@ fn r6(v: f64) -> f64 {
 
 /// Build the report.
 pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
+    let source = |surface: &str| {
+        flats
+            .iter()
+            .find(|f| f.surface.name == surface)
+            .map(|f| f.surface.source.display().to_string())
+            .unwrap_or_default()
+    };
     let pieces: Vec<Value> = layout
         .pieces
         .iter()
@@ -39,11 +47,17 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "id": p.id,
                 "name": p.name,
                 "surface": p.surface,
+                "source": source(&p.surface),
                 "faces": p.faces.len(),
                 "area_mm2": r6(p.area),
                 "cut_length_mm": r6(p.cut_length()),
                 "fold_length_mm": r6(p.fold_length()),
                 "folds": { "mountain": count(FoldKind::Mountain), "valley": count(FoldKind::Valley) },
+                "fold_lines": p.folds.iter().map(|f| json!({
+                    "kind": f.kind,
+                    "angle_deg": r6(f.angle_deg),
+                    "length_mm": r6(f.a.distance(f.b)),
+                })).collect::<Vec<_>>(),
                 "contours": p.outline.len(),
                 "edge_ids": p.marks.len(),
                 "sheet": at.sheet + 1,
