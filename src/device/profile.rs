@@ -38,12 +38,112 @@ impl Language {
     }
 }
 
-/// How one kind of stroke is made.
+/// How one kind of stroke is made. Which fields matter depends on the language: HP-GL uses
+/// `pen`, `force` (FS) and `speed` (VS); G-code uses `speed` (feed), `z_down`/`z_up` (knife),
+/// `servo_down`/`servo_up` (pen servo, `M3 S`) or `power` (laser, `M4 S`).
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct Tool {
     /// HP-GL pen (tool holder) number.
     pub pen: Option<u32>,
+    /// Knife force in grams (HP-GL `FS`; dialects scale it, see `output::hpgl`).
+    pub force: Option<f64>,
+    /// HP-GL: velocity in cm/s (`VS`). G-code: feed rate in mm/min.
+    pub speed: Option<f64>,
+    /// Times each stroke is repeated (default 1).
+    pub passes: Option<u32>,
+    /// Laser power, spindle `S` units (0 to the profile's `max_power`).
+    pub power: Option<f64>,
+    /// G-code knife: Z height (mm) with the blade in the material, and lifted.
+    pub z_down: Option<f64>,
+    pub z_up: Option<f64>,
+    /// G-code servo pen: `M3 S` value that lowers and lifts the pen.
+    pub servo_down: Option<f64>,
+    pub servo_up: Option<f64>,
+    /// Seconds to wait after a servo move (`G4 P`).
+    pub dwell: Option<f64>,
+}
+
+/// Serial line settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SerialSettings {
+    pub baud: u32,
+    #[serde(default = "default_data_bits")]
+    pub data_bits: u8,
+    #[serde(default)]
+    pub parity: Parity,
+    #[serde(default = "default_stop_bits")]
+    pub stop_bits: u8,
+    #[serde(default)]
+    pub flow_control: FlowControl,
+}
+
+fn default_data_bits() -> u8 {
+    8
+}
+fn default_stop_bits() -> u8 {
+    1
+}
+
+impl Default for SerialSettings {
+    fn default() -> Self {
+        SerialSettings {
+            baud: 9600,
+            data_bits: 8,
+            parity: Parity::None,
+            stop_bits: 1,
+            flow_control: FlowControl::None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Parity {
+    #[default]
+    None,
+    Odd,
+    Even,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum FlowControl {
+    #[default]
+    None,
+    XonXoff,
+    RtsCts,
+}
+
+/// How the host paces the program into the device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Protocol {
+    /// Write as flow control and `buffer` allow (HP-GL devices).
+    #[default]
+    Buffered,
+    /// GRBL: keep at most `buffer` bytes of unacknowledged lines in flight, one `ok` per line.
+    GrblCharacterCounting,
+    /// GRBL: send a line, wait for its `ok`.
+    GrblSendResponse,
+}
+
+/// Axes of the machine relative to the sheet (x right, y up, origin lower-left).
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Axes {
+    /// Exchange x and y (roll-fed cutters whose x axis is the feed direction).
+    #[serde(default)]
+    pub swap_xy: bool,
+    /// Mirror x / y after swapping (origin at the other side).
+    #[serde(default)]
+    pub flip_x: bool,
+    #[serde(default)]
+    pub flip_y: bool,
+    /// Where the machine's origin is, in words (documentation for users).
+    #[serde(default)]
+    pub origin: String,
 }
 
 /// A machine.
@@ -53,13 +153,38 @@ pub struct Profile {
     pub name: String,
     pub description: String,
     pub language: Language,
+    /// `hp-gl`, `camm-gl2` (Roland CAMM-GL mode 2), `grbl`.
     pub dialect: String,
     pub units_per_mm: f64,
+    /// Largest width the machine can cut (mm); 0 when unknown.
+    #[serde(default)]
+    pub media_width: f64,
+    #[serde(default)]
+    pub axes: Axes,
+    #[serde(default)]
+    pub serial: SerialSettings,
+    /// Device input buffer in bytes (what may be in flight unacknowledged).
+    #[serde(default = "default_buffer")]
+    pub buffer: usize,
+    #[serde(default)]
+    pub protocol: Protocol,
+    /// G-code laser: the `S` value of full power (GRBL `$30`).
+    #[serde(default)]
+    pub max_power: Option<f64>,
     #[serde(default)]
     pub tools: BTreeMap<String, Tool>,
+    /// Commands sent before and after the job, verbatim.
+    #[serde(default)]
+    pub init: Vec<String>,
+    #[serde(default)]
+    pub end: Vec<String>,
     /// Where the profile was read from (not in the file).
     #[serde(skip)]
     pub source: String,
+}
+
+fn default_buffer() -> usize {
+    256
 }
 
 impl Profile {
@@ -109,6 +234,15 @@ pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
                 "unknown tool kind `{key}`; expected cut, score, perforate, draw or etch"
             )));
         }
+    }
+    if p.serial.baud == 0 || !(5..=8).contains(&p.serial.data_bits) || !(1..=2).contains(&p.serial.stop_bits) {
+        return Err(invalid(format!(
+            "serial settings: baud must be > 0, data_bits 5–8, stop_bits 1–2 (got {}, {}, {})",
+            p.serial.baud, p.serial.data_bits, p.serial.stop_bits
+        )));
+    }
+    if p.buffer == 0 {
+        return Err(invalid("`buffer` must be at least 1 byte".into()));
     }
     if !p.tools.contains_key("cut") {
         return Err(invalid("the tool table has no `cut` tool".into()));
