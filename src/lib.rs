@@ -39,6 +39,12 @@ pub enum Error {
     Output(#[from] output::OutputError),
     #[error(transparent)]
     Profile(#[from] device::ProfileError),
+    #[error(transparent)]
+    Serial(#[from] device::serial::SerialError),
+    #[error(transparent)]
+    Stream(#[from] device::stream::StreamError),
+    #[error(transparent)]
+    Sim(#[from] device::sim::SimError),
     #[error("{}: cannot write: {source}", path.display())]
     Write {
         path: std::path::PathBuf,

@@ -2,8 +2,10 @@
 //! applies the device profile and the flags (flags win), unfolds, nests, orders the strokes and
 //! writes into `-o DIR`: the program for the device (`<name>.plt`, or `<name>-<k>.plt` per sheet
 //! when there are several), `<name>.svg`, `<name>-<k>.png` per sheet and `report.json`, each
-//! written whole or not at all. `--dry-run` writes everything and sends nothing; until the
-//! serial transport lands every run behaves so, and says it.
+//! written whole or not at all. Then, unless `--dry-run`, the program is streamed to the
+//! device: the simulated cutter for `sim` (the default) or with `--simulate`, else the serial
+//! port given by `--port` (see [`super::link`]). The files are written before anything is
+//! sent, so a failed or interrupted send loses nothing.
 
 use super::{create_dir, write_atomic};
 use crate::output::report::{self, RunInfo};
@@ -29,6 +31,8 @@ pub struct CutArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    #[command(flatten)]
+    pub link: super::link::LinkArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -50,6 +54,12 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
     let profile = crate::device::profile::find(&device)?;
+    if !a.dry_run && !super::link::simulated(&profile, &a.link) && a.link.port.is_none() {
+        return Err(Error::Usage(format!(
+            "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
+            profile.name
+        )));
+    }
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
     let nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
@@ -70,6 +80,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;
     let mut files = Vec::new();
+    let mut programs = Vec::new();
     let ext = profile.language.extension();
     let n = job.sheets.len();
     for (i, sheet) in job.sheets.iter().enumerate() {
@@ -88,7 +99,8 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
             }
         };
         write_atomic(&dir.join(&name), &bytes)?;
-        files.push(name);
+        files.push(name.clone());
+        programs.push((name, bytes));
     }
     files.extend(super::flatten::write_pictures(&dir, &spec.name, &job)?);
     files.push("report.json".into());
@@ -135,12 +147,13 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         println!("wrote {}: {}", dir.display(), files.join(", "));
         if a.dry_run {
             println!("dry run: nothing sent");
-        } else {
-            println!(
-                "nothing sent: streaming to `{}` is not available in this version; the program is in {}",
-                profile.name,
-                dir.display()
-            );
+        }
+    }
+    if !a.dry_run {
+        for line in super::link::deliver(&programs, &profile, &a.link, &dir, a.quiet)? {
+            if !a.quiet {
+                println!("{line}");
+            }
         }
     }
     Ok(())

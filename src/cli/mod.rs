@@ -5,6 +5,10 @@
 pub mod check;
 pub mod cut;
 pub mod flatten;
+pub mod link;
+pub mod ports;
+pub mod send;
+pub mod sim;
 
 use crate::flatten::{Flat, UnfoldOptions};
 use crate::pattern::{PatternOptions, Piece};
@@ -19,7 +23,13 @@ Examples:
   flatcut cut lamp.obj --device hpgl-pens --dry-run   a bare OBJ with defaults (paper, A4, 5 mm margin)
   flatcut cut box.toml --material fabric -o out       flags override the spec file
   flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
-  flatcut check model.obj                             faces, edges, boundary loops, angle defect";
+  flatcut check model.obj                             faces, edges, boundary loops, angle defect
+  flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
+  flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
+  flatcut send out/cube/cube.plt --device hpgl-pens --port /dev/ttyUSB0
+  flatcut sim --device grbl-pen -o out/sim            a simulated cutter for other software
+  flatcut ports                                       serial ports on this machine
+  flatcut devices                                     device profiles";
 
 /// flatcut: developable surfaces to nested flat patterns for cutter plotters.
 #[derive(Debug, Parser)]
@@ -40,6 +50,16 @@ pub enum Command {
     /// Report what a mesh is made of and whether it can be unfolded exactly.
     #[command(after_help = EXAMPLES)]
     Check(check::CheckArgs),
+    /// Stream an existing .plt or .gcode program to a machine (or the simulated cutter).
+    #[command(after_help = EXAMPLES)]
+    Send(send::SendArgs),
+    /// Run the simulated cutter on a pseudo-terminal for other software to talk to.
+    #[command(after_help = EXAMPLES)]
+    Sim(sim::SimArgs),
+    /// List serial ports.
+    Ports,
+    /// List device profiles.
+    Devices,
 }
 
 /// Run a parsed command line.
@@ -48,6 +68,10 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Cut(a) => cut::run(&a),
         Command::Flatten(a) => flatten::run(&a),
         Command::Check(a) => check::run(&a),
+        Command::Send(a) => send::run(&a),
+        Command::Sim(a) => sim::run(&a),
+        Command::Ports => ports::ports(),
+        Command::Devices => ports::devices(),
     }
 }
 

@@ -1,0 +1,171 @@
+//! What the subcommands that talk to a machine share: the link flags (`--port`, `--baud`,
+//! `--simulate`, `--sim-speed`, `--timeout`), Ctrl-C, and streaming one or more programs to a
+//! real port or to a simulated cutter started for the job.
+//!
+//! The default device `sim` is always simulated. Any other device is simulated with
+//! `--simulate`, and otherwise needs `--port`. With the simulator, its picture and report are
+//! written beside the program (`sim.png`, `sim.json`; `sim-<k>.*` per sheet when there are
+//! several) and their paths printed.
+
+use crate::device::profile::Profile;
+use crate::device::sim::{self, SimConfig};
+use crate::device::stream::{self, StreamOptions};
+use crate::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::Duration;
+
+#[derive(Debug, Clone, Args)]
+pub struct LinkArgs {
+    /// Serial port of the machine (e.g. /dev/ttyUSB0); see `flatcut ports`.
+    #[arg(long)]
+    pub port: Option<String>,
+    /// Baud rate (overrides the device profile).
+    #[arg(long)]
+    pub baud: Option<u32>,
+    /// Send to a simulated cutter that behaves like the device instead of a real port.
+    #[arg(long)]
+    pub simulate: bool,
+    /// Simulated cutter: run motion this many times faster than the machine (0: no motion
+    /// time at all).
+    #[arg(long, default_value_t = 10.0)]
+    pub sim_speed: f64,
+    /// Give up when the machine makes no progress for this many seconds.
+    #[arg(long, default_value_t = 60.0)]
+    pub timeout: f64,
+}
+
+/// The process-wide Ctrl-C flag; the handler is installed on first use.
+pub fn cancel_flag() -> Arc<AtomicBool> {
+    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let f = Arc::new(AtomicBool::new(false));
+        let g = f.clone();
+        // If a handler cannot be installed, Ctrl-C ends the process the usual way.
+        let _ = ctrlc::set_handler(move || g.store(true, Ordering::SeqCst));
+        f
+    })
+    .clone()
+}
+
+/// Whether this run goes to a simulated cutter.
+pub fn simulated(profile: &Profile, link: &LinkArgs) -> bool {
+    link.simulate || (profile.name == "sim" && link.port.is_none())
+}
+
+/// Send each program (name, bytes) in turn; returns the lines to print.
+pub fn deliver(
+    programs: &[(String, Vec<u8>)],
+    profile: &Profile,
+    link: &LinkArgs,
+    dir: &Path,
+    quiet: bool,
+) -> Result<Vec<String>, Error> {
+    if !(link.timeout.is_finite() && link.timeout > 0.0) {
+        return Err(Error::Usage(format!(
+            "--timeout must be a positive number of seconds, got {}",
+            link.timeout
+        )));
+    }
+    if !(link.sim_speed.is_finite() && link.sim_speed >= 0.0) {
+        return Err(Error::Usage(format!(
+            "--sim-speed must be 0 or a positive factor, got {}",
+            link.sim_speed
+        )));
+    }
+    let opts = StreamOptions {
+        timeout: Duration::from_secs_f64(link.timeout),
+        progress: !quiet,
+        cancel: cancel_flag(),
+        ..StreamOptions::default()
+    };
+    let mut said = Vec::new();
+    let several = programs.len() > 1;
+    for (k, (name, bytes)) in programs.iter().enumerate() {
+        if simulated(profile, link) {
+            let mut cfg = SimConfig::new(profile.clone());
+            cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
+            let handle = sim::spawn(cfg)?;
+            let mut port = crate::device::serial::open(profile, &handle.path, link.baud)?
+                .with_virtual_cts(handle.cts.clone());
+            let sent = stream::send(&mut port, profile, bytes, &opts);
+            drop(port);
+            // Let the simulated machine finish the motion it has buffered.
+            let report = handle.finish(Duration::from_secs(600))?;
+            let stem = if several {
+                format!("sim-{}", k + 1)
+            } else {
+                "sim".into()
+            };
+            let (png, json) = write_sim(&report, profile, dir, &stem)?;
+            let rep = sent?;
+            said.push(format!(
+                "sent {name} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud); it cut {} paths, {:.0} mm, {} overruns",
+                profile.name,
+                rep.bytes,
+                rep.strokes,
+                rep.seconds,
+                profile.serial.baud,
+                report.paths.len(),
+                report.per_tool.values().map(|t| t.length_mm).sum::<f64>(),
+                report.violations(),
+            ));
+            said.push(format!(
+                "picture of the cut: {} (report {})",
+                png.display(),
+                json.display()
+            ));
+        } else {
+            let Some(path) = link.port.as_deref() else {
+                return Err(Error::Usage(format!(
+                    "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
+                    profile.name
+                )));
+            };
+            if several && k > 0 {
+                wait_for_sheet(k + 1, programs.len(), quiet);
+            }
+            let mut port = crate::device::serial::open(profile, path, link.baud)?;
+            let rep = stream::send(&mut port, profile, bytes, &opts)?;
+            said.push(format!(
+                "sent {name} to {} on {path}: {} bytes, {} strokes in {:.1} s ({:.0} bytes/s)",
+                profile.name, rep.bytes, rep.strokes, rep.seconds, rep.rate
+            ));
+        }
+    }
+    Ok(said)
+}
+
+/// Before sheet k of n on a real machine: ask for the sheet when someone is there to load it.
+fn wait_for_sheet(k: usize, n: usize, quiet: bool) {
+    use std::io::IsTerminal;
+    if quiet || !std::io::stdin().is_terminal() {
+        return;
+    }
+    eprintln!("load sheet {k} of {n} and press Enter");
+    let mut s = String::new();
+    let _ = std::io::stdin().read_line(&mut s);
+}
+
+/// Write the simulator's picture and report as `<stem>.png` / `<stem>.json` in `dir`.
+pub fn write_sim(
+    report: &sim::SimReport,
+    profile: &Profile,
+    dir: &Path,
+    stem: &str,
+) -> Result<(PathBuf, PathBuf), Error> {
+    let (png, json) = sim::write_outputs(report, profile, dir)?;
+    if stem == "sim" {
+        return Ok((png, json));
+    }
+    let (p2, j2) = (dir.join(format!("{stem}.png")), dir.join(format!("{stem}.json")));
+    for (a, b) in [(&png, &p2), (&json, &j2)] {
+        std::fs::rename(a, b).map_err(|source| Error::Write {
+            path: b.clone(),
+            source,
+        })?;
+    }
+    Ok((p2, j2))
+}

@@ -1,0 +1,244 @@
+//! The simulated cutter's HP-GL interpreter: the subset that flatcut's encoders and common
+//! cutter drivers send — `IN`, `DF`, `SP`, `PU`, `PD`, `PA`, `PR`, `VS`, `FS` — executed as a
+//! plotter would; anything else is ignored and counted by name, as HP-GL devices do with
+//! instructions they do not know (HP 7475A Interfacing and Programming Manual, ch. 14: an
+//! unknown instruction sets error 1 and is skipped).
+//!
+//! Instructions end with `;` or a line feed. Parameters are numbers separated by commas or
+//! spaces; `PU`/`PD` take coordinate pairs, absolute after `PA` (the default after `IN`),
+//! relative after `PR`. Roland's `!`-prefixed instructions (`!PZ`, `!ST`, …) are named with
+//! their three characters. A stray odd coordinate is ignored, as a plotter does.
+//!
+//! Motion time: pen-down moves at the `VS` speed (cm/s; the profile's tool speed when the
+//! program sets none), pen-up moves at [`TRAVEL_CM_S`]. This is what paces the simulated
+//! buffer's draining.
+
+use super::record::Recorder;
+use crate::device::Profile;
+use glam::DVec2;
+use std::collections::BTreeMap;
+
+/// Pen-up speed, cm/s.
+pub const TRAVEL_CM_S: f64 = 50.0;
+/// Pen-down speed when neither the program nor the profile says, cm/s.
+pub const DEFAULT_CM_S: f64 = 20.0;
+
+/// Length of the complete instruction at the front of `buf` (terminator included), if the
+/// terminator has arrived.
+pub fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
+    buf.into_iter()
+        .position(|&b| b == b';' || b == b'\n')
+        .map(|i| i + 1)
+}
+
+/// An HP-GL plotter's state.
+#[derive(Debug, Clone)]
+pub struct Hpgl {
+    units_per_mm: f64,
+    /// Pen number → stroke kind name, from the profile's tool table.
+    pens: BTreeMap<u32, String>,
+    /// Pen number → default speed from the profile, cm/s.
+    pen_speed: BTreeMap<u32, f64>,
+    pos: DVec2,
+    down: bool,
+    pen: u32,
+    relative: bool,
+    speed_cm_s: Option<f64>,
+    pub rec: Recorder,
+    /// Instructions executed.
+    pub instructions: usize,
+    /// Instructions not understood, by mnemonic.
+    pub ignored: BTreeMap<String, usize>,
+}
+
+impl Hpgl {
+    pub fn new(profile: &Profile) -> Hpgl {
+        let mut pens = BTreeMap::new();
+        let mut pen_speed = BTreeMap::new();
+        for (kind, tool) in &profile.tools {
+            if let Some(p) = tool.pen {
+                pens.entry(p).or_insert_with(|| kind.clone());
+                if let Some(s) = tool.speed {
+                    pen_speed.entry(p).or_insert(s);
+                }
+            }
+        }
+        Hpgl {
+            units_per_mm: profile.units_per_mm,
+            pens,
+            pen_speed,
+            pos: DVec2::ZERO,
+            down: false,
+            pen: 0,
+            relative: false,
+            speed_cm_s: None,
+            rec: Recorder::default(),
+            instructions: 0,
+            ignored: BTreeMap::new(),
+        }
+    }
+
+    fn tool_name(&self) -> Option<String> {
+        if self.pen == 0 {
+            return None;
+        }
+        Some(
+            self.pens
+                .get(&self.pen)
+                .cloned()
+                .unwrap_or_else(|| format!("pen {}", self.pen)),
+        )
+    }
+
+    fn speed_units_s(&self, down: bool) -> f64 {
+        let cm_s = if down {
+            self.speed_cm_s
+                .or_else(|| self.pen_speed.get(&self.pen).copied())
+                .unwrap_or(DEFAULT_CM_S)
+        } else {
+            TRAVEL_CM_S
+        };
+        cm_s * 10.0 * self.units_per_mm
+    }
+
+    /// Execute one instruction (its bytes, terminator optional). Returns the time its motion
+    /// takes, seconds.
+    pub fn execute(&mut self, raw: &[u8]) -> f64 {
+        let text = String::from_utf8_lossy(raw);
+        let text = text.trim_matches(|c: char| c == ';' || c.is_whitespace() || c == '\0');
+        if text.is_empty() {
+            return 0.0;
+        }
+        let split = if text.starts_with('!') { 3 } else { 2 };
+        let Some(op) = text.get(..split.min(text.len())) else {
+            *self.ignored.entry("?".into()).or_default() += 1;
+            return 0.0;
+        };
+        let op = op.to_ascii_uppercase();
+        let args_text = &text[op.len()..];
+        let nums: Option<Vec<f64>> = args_text
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        let Some(nums) = nums else {
+            *self.ignored.entry(format!("{op} (bad parameters)")).or_default() += 1;
+            return 0.0;
+        };
+        self.instructions += 1;
+        match op.as_str() {
+            "IN" | "DF" => {
+                if op == "IN" {
+                    self.lift();
+                    self.pen = 0;
+                }
+                self.relative = false;
+                self.speed_cm_s = None;
+                0.0
+            }
+            "SP" => {
+                self.lift();
+                self.pen = nums.first().map(|&v| v.max(0.0) as u32).unwrap_or(0);
+                0.0
+            }
+            "PA" | "PR" => {
+                self.relative = op == "PR";
+                self.moves(&nums)
+            }
+            "PU" => {
+                self.lift();
+                self.moves(&nums)
+            }
+            "PD" => {
+                self.down = true;
+                if let Some(t) = self.tool_name() {
+                    self.rec.down(&t, self.pos);
+                }
+                self.moves(&nums)
+            }
+            "VS" => {
+                self.speed_cm_s = nums.first().copied().filter(|v| *v > 0.0);
+                0.0
+            }
+            "FS" => 0.0,
+            _ => {
+                self.instructions -= 1;
+                *self.ignored.entry(op).or_default() += 1;
+                0.0
+            }
+        }
+    }
+
+    fn lift(&mut self) {
+        self.down = false;
+        self.rec.up();
+    }
+
+    fn moves(&mut self, nums: &[f64]) -> f64 {
+        let mut t = 0.0;
+        let tool = if self.down { self.tool_name() } else { None };
+        let speed = self.speed_units_s(self.down && tool.is_some());
+        for xy in nums.chunks_exact(2) {
+            let target = if self.relative {
+                self.pos + DVec2::new(xy[0], xy[1])
+            } else {
+                DVec2::new(xy[0], xy[1])
+            };
+            t += self.pos.distance(target) / speed;
+            self.rec.travel_to(self.pos, target, tool.as_deref());
+            self.pos = target;
+        }
+        t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn profile() -> Profile {
+        crate::device::profile::find("hpgl-pens").unwrap()
+    }
+
+    #[test]
+    fn records_pen_down_paths_per_tool() {
+        let mut m = Hpgl::new(&profile());
+        let prog = "IN;SP3;PU40,40;PD80,40;SP1;PU400,400;PD800,400,800,800;PD400,400;PU;ZZ1;SP0;";
+        let mut rest = prog.as_bytes();
+        while let Some(n) = next_instruction(rest) {
+            m.execute(&rest[..n]);
+            rest = &rest[n..];
+        }
+        assert_eq!(m.rec.paths.len(), 2);
+        assert_eq!(m.rec.paths[0].tool, "draw");
+        assert_eq!(m.rec.paths[0].points, vec![[40.0, 40.0], [80.0, 40.0]]);
+        assert_eq!(m.rec.paths[1].tool, "cut");
+        assert_eq!(
+            m.rec.paths[1].points,
+            vec![[400.0, 400.0], [800.0, 400.0], [800.0, 800.0], [400.0, 400.0]]
+        );
+        assert_eq!(m.ignored.get("ZZ"), Some(&1));
+        // Travel: origin→(40,40), (80,40)→(400,400).
+        let expect = 40.0 * 2f64.sqrt() + (320.0f64.powi(2) + 360.0f64.powi(2)).sqrt();
+        assert!((m.rec.travel - expect).abs() < 1e-9);
+    }
+
+    #[test]
+    fn relative_moves_and_speed() {
+        let mut m = Hpgl::new(&profile());
+        m.execute(b"SP1;");
+        m.execute(b"VS10;");
+        m.execute(b"PR;");
+        m.execute(b"PU100,0;");
+        let t = m.execute(b"PD400,0,0,400;");
+        // 800 units = 20 mm at 10 cm/s.
+        assert!((t - 0.2).abs() < 1e-12, "{t}");
+        assert_eq!(
+            m.rec.paths[0].points,
+            vec![[100.0, 0.0], [500.0, 0.0], [500.0, 400.0]]
+        );
+        // Bad parameters are counted, not executed.
+        m.execute(b"PDx,y;");
+        assert_eq!(m.ignored.get("PD (bad parameters)"), Some(&1));
+    }
+}

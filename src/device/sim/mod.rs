@@ -1,0 +1,724 @@
+//! The simulated cutter: a real peer on the far end of a pseudo-terminal. Software talks to
+//! the slave side (`/dev/pts/N`) exactly as to a USB-serial cutter; the simulator sits on the
+//! master side and behaves like the machine described by a device profile.
+//!
+//! What it models, and the choices made where no device documentation decides:
+//! - **The wire.** A pty has no baud rate, so the simulator takes bytes off the master side
+//!   no faster than the profile's line would carry them (baud / 10 bytes a second, 8N1).
+//!   Bytes still in the pty are bytes the host has not put on the wire yet.
+//! - **The input buffer.** `profile.buffer` bytes (GRBL: its 128-byte receive buffer). A byte
+//!   that arrives when it is full is lost and counted as an *overrun*, as a UART would.
+//! - **Flow control.** XON/XOFF: XOFF (0x13) when the free space falls to a quarter of the
+//!   buffer (at least 16 bytes, at most 256), XON (0x11) when it is back under a quarter full.
+//!   RTS/CTS: the same thresholds drop and raise CTS; a pty has no modem lines, so CTS is a
+//!   shared flag ([`SimHandle::cts`]) that flatcut's transport reads in place of the real
+//!   line. After asking the host to stop, the simulator still takes up to [`SKID`] bytes (a
+//!   UART FIFO's worth) and then leaves the rest in the pty, as a stopped transmitter would
+//!   hold it. A host that ignores the stop is caught: the bytes waiting in the pty must stop
+//!   growing within [`STOP_GRACE`] of the stop, or the growth is counted as
+//!   `flow_violations`. This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
+//!   stream into the simulator.
+//! - **Execution.** HP-GL instructions are executed one at a time, each when the previous
+//!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
+//!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the
+//!   interpreters compute ([`hpgl`], [`grbl`]) divided by the time factor (`None`: no time).
+//!   GRBL real-time bytes (`?`, `!`, `~`, Ctrl-X) act on arrival and are never buffered.
+//! - **Faults** for tests ([`Faults`]): hang up after N bytes, stall (stop reading and
+//!   executing) after N bytes, send garbage after N bytes, lose the first XON, answer a given
+//!   GRBL line with `error:N`.
+//!
+//! Everything it cuts is recorded ([`record`]) and, on [`SimHandle::finish`], summarised in a
+//! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
+
+pub mod grbl;
+pub mod hpgl;
+pub mod record;
+
+use crate::device::grbl as proto;
+use crate::device::profile::{FlowControl, Language, Profile, Protocol};
+use record::SimPath;
+use serde::Serialize;
+use std::collections::{BTreeMap, VecDeque};
+use std::io::{Read, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+pub const XON: u8 = 0x11;
+pub const XOFF: u8 = 0x13;
+
+/// Bytes the simulator still takes after asking the host to stop.
+pub const SKID: usize = 16;
+/// Time a host has to react to XOFF or CTS before growth of its backlog counts as a violation.
+pub const STOP_GRACE: Duration = Duration::from_millis(50);
+/// GRBL planner blocks (`BLOCK_BUFFER_SIZE` 16, one kept free).
+pub const PLANNER_BLOCKS: usize = 15;
+
+/// Faults to inject.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Faults {
+    /// Close the line after this many bytes have been received.
+    pub hang_up_after: Option<usize>,
+    /// Stop reading and executing (but keep the line open) after this many bytes.
+    pub stall_after: Option<usize>,
+    /// Send a burst of garbage to the host after this many bytes.
+    pub garbage_after: Option<usize>,
+    /// Never send the first XON that is due.
+    pub lose_xon: bool,
+    /// GRBL: answer line N (1-based, counting every line received) with `error:code`.
+    pub grbl_error: Option<(usize, u32)>,
+}
+
+/// How the simulator is set up.
+#[derive(Debug, Clone)]
+pub struct SimConfig {
+    /// The machine to behave like.
+    pub profile: Profile,
+    /// Motion runs this many times faster than the real machine; `None`: motion takes no time.
+    pub time_factor: Option<f64>,
+    pub faults: Faults,
+}
+
+impl SimConfig {
+    pub fn new(profile: Profile) -> SimConfig {
+        SimConfig {
+            profile,
+            time_factor: None,
+            faults: Faults::default(),
+        }
+    }
+}
+
+/// Stroke count and length for one tool.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ToolTotals {
+    pub strokes: usize,
+    pub length_mm: f64,
+}
+
+/// What the simulated cutter saw and did (`sim.json`).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SimReport {
+    pub device: String,
+    pub language: String,
+    pub baud: u32,
+    pub flow_control: String,
+    pub buffer: usize,
+    pub bytes_received: usize,
+    /// HP-GL instructions or GRBL lines executed.
+    pub executed: usize,
+    /// HP-GL instructions ignored, by mnemonic.
+    pub ignored: BTreeMap<String, usize>,
+    /// GRBL: `[line, code]` of every `error:N` sent.
+    pub errors_sent: Vec<(usize, u32)>,
+    /// GRBL alarms raised.
+    pub alarms: Vec<u32>,
+    /// Bytes lost because the buffer was full.
+    pub overruns: usize,
+    /// Bytes the host queued after being told to stop (past the grace time).
+    pub flow_violations: usize,
+    /// Bytes left in the buffer at the end that never made a whole instruction or line.
+    pub unexecuted_bytes: usize,
+    /// Fullest the input buffer ever was.
+    pub max_buffer_fill: usize,
+    pub xoff_sent: usize,
+    pub xon_sent: usize,
+    pub per_tool: BTreeMap<String, ToolTotals>,
+    pub travel_mm: f64,
+    /// Time the real machine would have taken for the motion, seconds.
+    pub simulated_time_s: f64,
+    pub faults: Faults,
+    /// Why the simulator stopped: `finished`, `stopped`, `hung up (fault)`, `host closed`.
+    pub ended: String,
+    /// Every tool-down path, device units, machine axes.
+    pub paths: Vec<SimPath>,
+}
+
+impl SimReport {
+    /// Sum of the two protocol-violation counters.
+    pub fn violations(&self) -> usize {
+        self.overruns + self.flow_violations
+    }
+}
+
+/// Errors of the simulator.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    #[error("cannot open a pseudo-terminal for the simulated cutter: {0}")]
+    Pty(String),
+    #[error("the simulated cutter's thread failed")]
+    Thread,
+}
+
+const RUN: u8 = 0;
+const FINISH: u8 = 1;
+const STOP: u8 = 2;
+
+/// A running simulator.
+pub struct SimHandle {
+    /// The slave side's path, e.g. `/dev/pts/7`.
+    pub path: String,
+    /// The CTS line as the simulated device drives it (true: clear to send).
+    pub cts: Arc<AtomicBool>,
+    ctl: Arc<AtomicU8>,
+    thread: Option<JoinHandle<SimReport>>,
+}
+
+impl SimHandle {
+    /// Let the device work off what it has received, then stop: waits until the input is
+    /// executed and no byte has arrived for a moment, or `timeout` passes.
+    pub fn finish(mut self, timeout: Duration) -> Result<SimReport, SimError> {
+        self.ctl.store(FINISH, Ordering::SeqCst);
+        let t = self.thread.take().ok_or(SimError::Thread)?;
+        let deadline = Instant::now() + timeout;
+        while !t.is_finished() && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        self.ctl.store(STOP, Ordering::SeqCst);
+        t.join().map_err(|_| SimError::Thread)
+    }
+
+    /// Stop at once.
+    pub fn stop(mut self) -> Result<SimReport, SimError> {
+        self.ctl.store(STOP, Ordering::SeqCst);
+        self.thread
+            .take()
+            .ok_or(SimError::Thread)?
+            .join()
+            .map_err(|_| SimError::Thread)
+    }
+}
+
+impl Drop for SimHandle {
+    fn drop(&mut self) {
+        self.ctl.store(STOP, Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Open a pseudo-terminal and start the simulator on its master side.
+pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
+    let (master, slave) = serialport::TTYPort::pair().map_err(|e| SimError::Pty(e.to_string()))?;
+    let path = slave
+        .name()
+        .ok_or_else(|| SimError::Pty("the pty has no name".into()))?;
+    let cts = Arc::new(AtomicBool::new(true));
+    let ctl = Arc::new(AtomicU8::new(RUN));
+    let (c2, k2) = (cts.clone(), ctl.clone());
+    let thread = std::thread::Builder::new()
+        .name("flatcut-sim".into())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2).run())
+        .map_err(|e| SimError::Pty(e.to_string()))?;
+    Ok(SimHandle {
+        path,
+        cts,
+        ctl,
+        thread: Some(thread),
+    })
+}
+
+use serialport::SerialPort;
+
+enum Interp {
+    Hpgl(hpgl::Hpgl),
+    Grbl(grbl::Grbl),
+}
+
+struct Device {
+    cfg: SimConfig,
+    master: Option<serialport::TTYPort>,
+    /// Kept open so that the master side does not see a hang-up between clients.
+    slave: Option<serialport::TTYPort>,
+    cts: Arc<AtomicBool>,
+    ctl: Arc<AtomicU8>,
+    interp: Interp,
+    rx: VecDeque<u8>,
+    cap: usize,
+    high: usize,
+    low: usize,
+    flow: FlowControl,
+    /// The host has been told to stop (XOFF sent or CTS dropped).
+    stopped: bool,
+    stopped_at: Option<Instant>,
+    taken_since_stop: usize,
+    backlog_at_grace: Option<usize>,
+    xon_lost: bool,
+    /// Remaining seconds (real time) of each queued motion.
+    motion: VecDeque<f64>,
+    held: bool,
+    grbl_lines: usize,
+    garbage_sent: bool,
+    stalled: bool,
+    rep: SimReport,
+    out: Vec<u8>,
+}
+
+impl Device {
+    fn new(
+        cfg: SimConfig,
+        master: serialport::TTYPort,
+        slave: serialport::TTYPort,
+        cts: Arc<AtomicBool>,
+        ctl: Arc<AtomicU8>,
+    ) -> Device {
+        let p = &cfg.profile;
+        let grbl = p.language == Language::Gcode;
+        let cap = p.buffer.max(1);
+        let headroom = (cap / 4).clamp(16.min(cap / 2).max(1), 256);
+        let flow = if grbl {
+            FlowControl::None
+        } else {
+            p.serial.flow_control
+        };
+        let interp = if grbl {
+            Interp::Grbl(grbl::Grbl::new(p))
+        } else {
+            Interp::Hpgl(hpgl::Hpgl::new(p))
+        };
+        let rep = SimReport {
+            device: p.name.clone(),
+            language: format!("{:?}", p.language).to_lowercase(),
+            baud: p.serial.baud,
+            flow_control: format!("{:?}", flow),
+            buffer: cap,
+            faults: cfg.faults.clone(),
+            ..SimReport::default()
+        };
+        Device {
+            master: Some(master),
+            slave: Some(slave),
+            cts,
+            ctl,
+            interp,
+            rx: VecDeque::with_capacity(cap),
+            cap,
+            high: cap.saturating_sub(headroom).max(1),
+            low: cap / 4,
+            flow,
+            stopped: false,
+            stopped_at: None,
+            taken_since_stop: 0,
+            backlog_at_grace: None,
+            xon_lost: false,
+            motion: VecDeque::new(),
+            held: false,
+            grbl_lines: 0,
+            garbage_sent: false,
+            stalled: false,
+            rep,
+            out: Vec::new(),
+            cfg,
+        }
+    }
+
+    fn run(mut self) -> SimReport {
+        let rate = self.cfg.profile.serial.baud.max(1) as f64 / 10.0;
+        // The wire may carry a small burst after an idle moment (the host's UART FIFO).
+        let burst = (rate * 0.002).max(SKID as f64);
+        let mut credit = 0.0f64;
+        let mut last = Instant::now();
+        let mut quiet_since = Instant::now();
+        let mut buf = vec![0u8; 4096];
+        self.rep.ended = "stopped".into();
+        loop {
+            let ctl = self.ctl.load(Ordering::SeqCst);
+            if ctl == STOP {
+                break;
+            }
+            let now = Instant::now();
+            let dt = now.duration_since(last).as_secs_f64();
+            last = now;
+            credit = (credit + dt * rate).min(burst);
+
+            // Receive.
+            let Some(waiting) = self.master.as_mut().map(|m| m.bytes_to_read().unwrap_or(0) as usize) else {
+                break;
+            };
+            let mut allowance = credit.floor() as usize;
+            if self.stopped {
+                allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
+                self.watch_backlog(waiting);
+            }
+            if self.stalled {
+                allowance = 0;
+            }
+            let n = allowance.min(waiting).min(buf.len());
+            if n > 0 {
+                let Some(master) = self.master.as_mut() else {
+                    break;
+                };
+                match master.read(&mut buf[..n]) {
+                    Ok(k) => {
+                        credit -= k as f64;
+                        quiet_since = now;
+                        for &b in &buf[..k] {
+                            self.receive(b);
+                        }
+                        if self.stopped {
+                            self.taken_since_stop += k;
+                        }
+                    }
+                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                    Err(_) => {
+                        self.rep.ended = "host closed".into();
+                        break;
+                    }
+                }
+            }
+            if self.faults_due() {
+                break;
+            }
+
+            // Execute.
+            if !self.stalled {
+                self.advance(dt);
+                self.execute();
+            }
+            self.flow_control();
+            if !self.out.is_empty() {
+                let out = std::mem::take(&mut self.out);
+                if let Some(m) = self.master.as_mut() {
+                    if m.write_all(&out).is_err() {
+                        self.rep.ended = "host closed".into();
+                        break;
+                    }
+                }
+            }
+
+            if ctl == FINISH
+                && waiting == n
+                && (self.stalled || (!self.has_complete_input() && self.motion.is_empty()))
+                && now.duration_since(quiet_since) > Duration::from_millis(30)
+            {
+                self.rep.unexecuted_bytes = self.rx.len();
+                self.rep.ended = "finished".into();
+                break;
+            }
+            let busy = n > 0 || (!self.rx.is_empty() && !self.stalled);
+            std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
+        }
+        self.close()
+    }
+
+    /// Whether the buffer holds a whole instruction or line (what is left is a fragment that
+    /// no further byte will complete once the host is done).
+    fn has_complete_input(&self) -> bool {
+        match self.interp {
+            Interp::Hpgl(_) => hpgl::next_instruction(self.rx.iter()).is_some(),
+            Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
+        }
+    }
+
+    /// After a stop, check that the host stops adding bytes to the pty.
+    fn watch_backlog(&mut self, waiting: usize) {
+        let Some(at) = self.stopped_at else { return };
+        if at.elapsed() < STOP_GRACE {
+            return;
+        }
+        match self.backlog_at_grace {
+            None => self.backlog_at_grace = Some(waiting),
+            Some(b) if waiting > b => {
+                self.rep.flow_violations += waiting - b;
+                self.backlog_at_grace = Some(waiting);
+            }
+            _ => {}
+        }
+    }
+
+    fn receive(&mut self, b: u8) {
+        self.rep.bytes_received += 1;
+        if let Interp::Grbl(g) = &mut self.interp {
+            match b {
+                proto::STATUS_QUERY => {
+                    let state = if g.alarm {
+                        "Alarm"
+                    } else if self.held {
+                        "Hold:0"
+                    } else if self.motion.is_empty() && self.rx.is_empty() {
+                        "Idle"
+                    } else {
+                        "Run"
+                    };
+                    let s = g.status(state);
+                    self.out.extend_from_slice(s.as_bytes());
+                    self.out.extend_from_slice(b"\r\n");
+                    return;
+                }
+                proto::FEED_HOLD => {
+                    self.held = true;
+                    return;
+                }
+                proto::CYCLE_START => {
+                    self.held = false;
+                    return;
+                }
+                proto::SOFT_RESET => {
+                    let in_motion = !self.motion.is_empty() && !self.held;
+                    self.rx.clear();
+                    self.motion.clear();
+                    self.held = false;
+                    g.reset();
+                    if in_motion {
+                        g.alarm = true;
+                        self.rep.alarms.push(3);
+                        self.out.extend_from_slice(b"ALARM:3\r\n");
+                    }
+                    self.out.extend_from_slice(b"\r\n");
+                    self.out.extend_from_slice(proto::WELCOME.as_bytes());
+                    self.out.extend_from_slice(b"\r\n");
+                    if g.alarm {
+                        self.out.extend_from_slice(b"[MSG:'$H'|'$X' to unlock]\r\n");
+                    }
+                    return;
+                }
+                _ => {}
+            }
+        }
+        if self.rx.len() >= self.cap {
+            self.rep.overruns += 1;
+            return;
+        }
+        self.rx.push_back(b);
+        self.rep.max_buffer_fill = self.rep.max_buffer_fill.max(self.rx.len());
+    }
+
+    /// Run down queued motion by `dt` real seconds.
+    fn advance(&mut self, dt: f64) {
+        if self.held {
+            return;
+        }
+        let mut left = dt;
+        while let Some(front) = self.motion.front_mut() {
+            if *front > left {
+                *front -= left;
+                break;
+            }
+            left -= *front;
+            self.motion.pop_front();
+        }
+    }
+
+    fn scaled(&self, seconds: f64) -> Option<f64> {
+        match self.cfg.time_factor {
+            Some(f) if f > 0.0 && seconds > 0.0 => Some(seconds / f),
+            _ => None,
+        }
+    }
+
+    fn execute(&mut self) {
+        loop {
+            match &mut self.interp {
+                Interp::Hpgl(m) => {
+                    if !self.motion.is_empty() {
+                        return;
+                    }
+                    let Some(n) = hpgl::next_instruction(self.rx.iter()) else {
+                        return;
+                    };
+                    let instr: Vec<u8> = self.rx.drain(..n).collect();
+                    let t = m.execute(&instr);
+                    self.rep.simulated_time_s += t;
+                    if let Some(s) = self.scaled(t) {
+                        self.motion.push_back(s);
+                    }
+                }
+                Interp::Grbl(g) => {
+                    if self.held || self.motion.len() >= PLANNER_BLOCKS {
+                        return;
+                    }
+                    let Some(end) = self.rx.iter().position(|&b| b == b'\n' || b == b'\r') else {
+                        return;
+                    };
+                    let raw: Vec<u8> = self.rx.drain(..=end).collect();
+                    let line = String::from_utf8_lossy(&raw[..end]).to_string();
+                    // `$` commands wait for the planner to empty.
+                    if line.trim_start().starts_with('$') && !self.motion.is_empty() {
+                        let mut back = raw;
+                        while let Some(b) = back.pop() {
+                            self.rx.push_front(b);
+                        }
+                        return;
+                    }
+                    self.grbl_lines += 1;
+                    let injected = self
+                        .cfg
+                        .faults
+                        .grbl_error
+                        .filter(|(k, _)| *k == self.grbl_lines)
+                        .map(|(_, c)| c);
+                    let result = match injected {
+                        Some(c) => Err(c),
+                        None => g.execute(&line),
+                    };
+                    match result {
+                        Ok(grbl::Effect::Motion(t)) => {
+                            self.rep.simulated_time_s += t;
+                            if let Some(s) = self.scaled(t) {
+                                self.motion.push_back(s);
+                            }
+                            self.out.extend_from_slice(b"ok\r\n");
+                        }
+                        Ok(grbl::Effect::Text(lines)) => {
+                            for l in lines {
+                                self.out.extend_from_slice(l.as_bytes());
+                                self.out.extend_from_slice(b"\r\n");
+                            }
+                            self.out.extend_from_slice(b"ok\r\n");
+                        }
+                        Err(code) => {
+                            self.rep.errors_sent.push((self.grbl_lines, code));
+                            self.out
+                                .extend_from_slice(format!("error:{code}\r\n").as_bytes());
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn flow_control(&mut self) {
+        let fill = self.rx.len();
+        match self.flow {
+            FlowControl::None => {}
+            FlowControl::XonXoff | FlowControl::RtsCts => {
+                if !self.stopped && fill >= self.high {
+                    self.stopped = true;
+                    self.stopped_at = Some(Instant::now());
+                    self.taken_since_stop = 0;
+                    self.backlog_at_grace = None;
+                    if self.flow == FlowControl::XonXoff {
+                        self.out.push(XOFF);
+                        self.rep.xoff_sent += 1;
+                    } else {
+                        self.cts.store(false, Ordering::SeqCst);
+                    }
+                } else if self.stopped && fill <= self.low && !self.stalled {
+                    if self.flow == FlowControl::XonXoff {
+                        if self.cfg.faults.lose_xon && !self.xon_lost {
+                            // The XON is lost on the line: the device believes it sent it.
+                            self.xon_lost = true;
+                        } else {
+                            self.out.push(XON);
+                            self.rep.xon_sent += 1;
+                        }
+                    } else {
+                        self.cts.store(true, Ordering::SeqCst);
+                    }
+                    self.stopped = false;
+                    self.stopped_at = None;
+                }
+            }
+        }
+    }
+
+    /// Inject due faults; true when the line was hung up.
+    fn faults_due(&mut self) -> bool {
+        let got = self.rep.bytes_received;
+        let f = self.cfg.faults.clone();
+        if f.hang_up_after.is_some_and(|n| got >= n) {
+            self.master = None;
+            self.slave = None;
+            self.rep.ended = "hung up (fault)".into();
+            return true;
+        }
+        if f.stall_after.is_some_and(|n| got >= n) {
+            self.stalled = true;
+        }
+        if !self.garbage_sent && f.garbage_after.is_some_and(|n| got >= n) {
+            self.garbage_sent = true;
+            self.out
+                .extend_from_slice(b"\xfe\xff#%&garbage\x07\x00\xc3\r\n~~\xa5\r\n");
+        }
+        false
+    }
+
+    fn close(mut self) -> SimReport {
+        let (rec, upm) = match &self.interp {
+            Interp::Hpgl(m) => {
+                self.rep.executed = m.instructions;
+                self.rep.ignored = m.ignored.clone();
+                (m.rec.clone(), self.cfg.profile.units_per_mm)
+            }
+            Interp::Grbl(g) => {
+                self.rep.executed = g.lines_ok;
+                (g.rec.clone(), self.cfg.profile.units_per_mm)
+            }
+        };
+        for p in &rec.paths {
+            let t = self.rep.per_tool.entry(p.tool.clone()).or_default();
+            t.strokes += 1;
+            t.length_mm += p.length() / upm;
+        }
+        self.rep.travel_mm = rec.travel / upm;
+        self.rep.paths = rec.paths;
+        if self.rep.ended == "stopped" && self.master.is_none() {
+            self.rep.ended = "hung up (fault)".into();
+        }
+        let _ = self.slave.take();
+        self.rep
+    }
+}
+
+/// Draw what the simulator cut, in the machine's axes (mm), and write `sim.png` and
+/// `sim.json` into `dir`. Returns the two paths.
+pub fn write_outputs(
+    rep: &SimReport,
+    profile: &Profile,
+    dir: &Path,
+) -> Result<(std::path::PathBuf, std::path::PathBuf), crate::Error> {
+    use crate::toolpath::{SheetJob, Stroke, StrokeRole};
+    use glam::DVec2;
+    let upm = profile.units_per_mm;
+    let mut strokes = Vec::new();
+    let (mut w, mut h) = (10.0f64, 10.0f64);
+    for p in &rep.paths {
+        let role = match p.tool.as_str() {
+            "cut" => StrokeRole::Cut,
+            "score" | "perforate" => StrokeRole::FoldValley,
+            "draw" => StrokeRole::Mark,
+            _ => StrokeRole::Label,
+        };
+        let points: Vec<DVec2> = p
+            .points
+            .iter()
+            .map(|q| DVec2::new(q[0] / upm, q[1] / upm))
+            .collect();
+        for q in &points {
+            w = w.max(q.x);
+            h = h.max(q.y);
+        }
+        strokes.push(Stroke {
+            role,
+            points,
+            closed: false,
+            piece: None,
+        });
+    }
+    let sheet = SheetJob {
+        width: w.ceil() + 5.0,
+        height: h.ceil() + 5.0,
+        strokes,
+    };
+    let px = crate::output::png::DEFAULT_PX_PER_MM;
+    let png = crate::output::png::render(&sheet, 0, px)?;
+    let png_path = dir.join("sim.png");
+    let json_path = dir.join("sim.json");
+    crate::cli::write_atomic(&png_path, &png)?;
+    let text = serde_json::to_string_pretty(rep).unwrap_or_default() + "\n";
+    crate::cli::write_atomic(&json_path, text.as_bytes())?;
+    Ok((png_path, json_path))
+}
+
+/// `Protocol` the simulator expects for a profile (GRBL profiles always count characters on
+/// the device side: the device does not know how the host paces).
+pub fn is_grbl(p: &Profile) -> bool {
+    p.language == Language::Gcode
+        || matches!(
+            p.protocol,
+            Protocol::GrblCharacterCounting | Protocol::GrblSendResponse
+        )
+}

@@ -1,0 +1,828 @@
+//! Streaming a program into a device without ever overrunning it.
+//!
+//! - **Buffered** (HP-GL cutters): the program goes out in chunks of at most [`CHUNK`] bytes,
+//!   paced at the line rate (baud / 10 bytes a second) so that no more than a chunk is in the
+//!   kernel's queue when the device asks to stop. XON/XOFF: after every chunk the input is
+//!   read; XOFF stops sending until XON. RTS/CTS: CTS is checked before every chunk. Without
+//!   flow control the pacing is all there is, and a device with a small buffer may overrun:
+//!   the profile should say `xon-xoff` or `rts-cts` wherever the machine can.
+//! - **GRBL character counting** (GRBL wiki, "Interface", streaming protocols): lines are sent
+//!   while the bytes of the lines not yet answered (`ok` or `error:N`) fit in the device's
+//!   128-byte receive buffer. `$` commands are sent alone, after every earlier line is
+//!   answered (send-response), because GRBL executes them only when idle.
+//! - **GRBL send-response**: one line, wait for its answer, the next.
+//!
+//! Before a GRBL job the controller is reset (Ctrl-X) and its welcome awaited, which also
+//! proves it is there. `error:N` or `ALARM:N` stops the job with the line, GRBL's meaning and
+//! the tool lifted. On Ctrl-C (the `cancel` flag), a hang-up or a timeout the stream stops,
+//! lifts the tool when the line still works (HP-GL: `;PU;SP0;`; GRBL: feed hold, wait for
+//! the hold, soft reset, then the cut tool's "up" command) and reports how far it got: the
+//! stroke (counted from the program's pen-up moves) and the byte or line.
+//!
+//! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
+//! GRBL status is polled with `?` at most five times a second while the bar is shown.
+
+use super::grbl::{self as proto, Response};
+use super::profile::{FlowControl, Language, Profile, Protocol};
+use super::serial::Link;
+use super::sim::{XOFF, XON};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Largest write of the buffered protocol, bytes.
+pub const CHUNK: usize = 16;
+
+/// How the stream behaves.
+#[derive(Debug, Clone)]
+pub struct StreamOptions {
+    /// Give up when the device makes no progress (no XON, no CTS, no answer) for this long.
+    pub timeout: Duration,
+    /// How long to wait for GRBL's welcome after the reset.
+    pub wake_timeout: Duration,
+    /// Show a progress bar (only when stderr is a terminal).
+    pub progress: bool,
+    /// Set (by Ctrl-C) to stop the job.
+    pub cancel: Arc<AtomicBool>,
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        StreamOptions {
+            timeout: Duration::from_secs(60),
+            wake_timeout: Duration::from_secs(5),
+            progress: true,
+            cancel: Arc::new(AtomicBool::new(false)),
+        }
+    }
+}
+
+/// How far a job got.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Position {
+    /// Bytes the device has taken (buffered) or that were answered (GRBL).
+    pub bytes: usize,
+    pub bytes_total: usize,
+    /// Strokes begun, of all.
+    pub stroke: usize,
+    pub strokes_total: usize,
+    /// GRBL: the last line answered `ok` (1-based in the program), and how many lines.
+    pub line: Option<usize>,
+    pub lines_total: usize,
+}
+
+impl std::fmt::Display for Position {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "stroke {} of {}, byte {} of {}",
+            self.stroke, self.strokes_total, self.bytes, self.bytes_total
+        )?;
+        if let Some(l) = self.line {
+            write!(f, ", last acknowledged line {l} of {}", self.lines_total)?;
+        }
+        Ok(())
+    }
+}
+
+/// What became of the tool after a stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolState {
+    Lifted,
+    /// The line failed before the tool-up command could be sent.
+    Unknown,
+}
+
+impl std::fmt::Display for ToolState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ToolState::Lifted => write!(f, "tool lifted"),
+            ToolState::Unknown => write!(
+                f,
+                "the line is gone, so the tool could not be lifted: check the machine"
+            ),
+        }
+    }
+}
+
+/// Why a stream stopped early. Every message says how far the job got.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    #[error("{port}: timed out after {secs:.0} s {op} ({at}; {tool})")]
+    Timeout {
+        port: String,
+        op: &'static str,
+        secs: f64,
+        at: Position,
+        tool: ToolState,
+    },
+    #[error("{port}: the line closed {op} ({at}; {tool})")]
+    HungUp {
+        port: String,
+        op: &'static str,
+        at: Position,
+        tool: ToolState,
+    },
+    #[error("{port}: GRBL answered error:{code} ({meaning}) to line {line} `{text}` ({at}; {tool})")]
+    Grbl {
+        port: String,
+        code: u32,
+        meaning: &'static str,
+        line: usize,
+        text: String,
+        at: Position,
+        tool: ToolState,
+    },
+    #[error("{port}: GRBL raised ALARM:{code} ({meaning}) ({at}; {tool})")]
+    Alarm {
+        port: String,
+        code: u32,
+        meaning: &'static str,
+        at: Position,
+        tool: ToolState,
+    },
+    #[error("{port}: GRBL did not answer the reset within {secs:.0} s: is it a GRBL controller at this baud rate?")]
+    NoWelcome { port: String, secs: f64 },
+    #[error("{port}: line {line} is {len} characters, more than GRBL's {max}")]
+    LineTooLong {
+        port: String,
+        line: usize,
+        len: usize,
+        max: usize,
+    },
+    #[error("{port}: stopped by Ctrl-C ({at}; {tool})")]
+    Cancelled {
+        port: String,
+        at: Position,
+        tool: ToolState,
+    },
+}
+
+impl StreamError {
+    pub fn position(&self) -> Option<&Position> {
+        match self {
+            StreamError::Timeout { at, .. }
+            | StreamError::HungUp { at, .. }
+            | StreamError::Grbl { at, .. }
+            | StreamError::Alarm { at, .. }
+            | StreamError::Cancelled { at, .. } => Some(at),
+            _ => None,
+        }
+    }
+}
+
+/// What a finished stream did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StreamReport {
+    pub bytes: usize,
+    pub strokes: usize,
+    pub lines: usize,
+    pub seconds: f64,
+    /// Bytes a second over the whole job.
+    pub rate: f64,
+    pub xoff_received: usize,
+    /// Input that was neither flow control nor a GRBL answer (noise on the line).
+    pub garbage_bytes: usize,
+}
+
+/// Byte offsets where strokes start: HP-GL `PU` with coordinates, G-code `G0` with X or Y.
+pub fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
+    let mut out = Vec::new();
+    match language {
+        Language::Hpgl => {
+            for i in 0..program.len().saturating_sub(2) {
+                if &program[i..i + 2] == b"PU"
+                    && (program[i + 2].is_ascii_digit() || program[i + 2] == b'-')
+                {
+                    out.push(i);
+                }
+            }
+        }
+        Language::Gcode => {
+            let mut at = 0;
+            for line in program.split(|&b| b == b'\n') {
+                let l = String::from_utf8_lossy(line);
+                let t = l.trim_start();
+                if (t.starts_with("G0 ") || t.starts_with("G00 "))
+                    && (t.contains('X') || t.contains('Y'))
+                {
+                    out.push(at);
+                }
+                at += line.len() + 1;
+            }
+        }
+    }
+    out
+}
+
+struct Bar {
+    bar: Option<indicatif::ProgressBar>,
+    starts: Vec<usize>,
+}
+
+impl Bar {
+    fn new(total: usize, starts: Vec<usize>, show: bool) -> Bar {
+        use std::io::IsTerminal;
+        let bar = (show && std::io::stderr().is_terminal()).then(|| {
+            let b = indicatif::ProgressBar::new(total as u64);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{spinner} [{bar:32}] {bytes}/{total_bytes} {msg} ETA {eta}",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            b
+        });
+        Bar { bar, starts }
+    }
+
+    fn stroke_at(&self, byte: usize) -> usize {
+        self.starts.partition_point(|&s| s < byte)
+    }
+
+    fn set(&self, byte: usize, extra: &str) {
+        if let Some(b) = &self.bar {
+            b.set_position(byte as u64);
+            b.set_message(format!(
+                "stroke {}/{}{extra}",
+                self.stroke_at(byte),
+                self.starts.len()
+            ));
+        }
+    }
+
+    fn done(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// Send `program` to the device on `link` as the profile says.
+pub fn send(
+    link: &mut Link,
+    profile: &Profile,
+    program: &[u8],
+    opts: &StreamOptions,
+) -> Result<StreamReport, StreamError> {
+    let start = Instant::now();
+    let starts = stroke_starts(program, profile.language);
+    let bar = Bar::new(program.len(), starts, opts.progress);
+    let grbl = profile.language == Language::Gcode
+        || matches!(
+            profile.protocol,
+            Protocol::GrblCharacterCounting | Protocol::GrblSendResponse
+        );
+    let result = if grbl {
+        Grbl::new(link, profile, program, opts, &bar).run()
+    } else {
+        buffered(link, profile, program, opts, &bar)
+    };
+    bar.done();
+    let mut rep = result?;
+    rep.seconds = start.elapsed().as_secs_f64();
+    rep.rate = rep.bytes as f64 / rep.seconds.max(1e-9);
+    rep.strokes = bar.starts.len();
+    Ok(rep)
+}
+
+fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
+    Position {
+        bytes,
+        bytes_total: total,
+        stroke: bar.stroke_at(bytes),
+        strokes_total: bar.starts.len(),
+        line: None,
+        lines_total: 0,
+    }
+}
+
+fn buffered(
+    link: &mut Link,
+    profile: &Profile,
+    program: &[u8],
+    opts: &StreamOptions,
+    bar: &Bar,
+) -> Result<StreamReport, StreamError> {
+    let rate = link.baud.max(1) as f64 / 10.0;
+    let flow = profile.serial.flow_control;
+    let mut rep = StreamReport::default();
+    let mut sent = 0usize;
+    let mut stopped = false;
+    let t0 = Instant::now();
+    let mut last_progress = Instant::now();
+    let mut input = [0u8; 256];
+    let total = program.len();
+    let port = link.name.clone();
+    let mut last_bar = Instant::now();
+
+    let fail = |link: &mut Link, kind: Failure, sent: usize| -> StreamError {
+        let at = position(bar, sent, total);
+        let tool = if matches!(kind, Failure::HungUp(_)) {
+            ToolState::Unknown
+        } else {
+            lift_hpgl(link, opts)
+        };
+        kind.into_error(port.clone(), at, tool, opts.timeout)
+    };
+
+    while sent < total {
+        if opts.cancel.load(Ordering::SeqCst) {
+            return Err(fail(link, Failure::Cancelled, sent));
+        }
+        // Listen: XON/XOFF and anything else the device says.
+        match link.read_ready(&mut input) {
+            Ok(n) => {
+                for &b in &input[..n] {
+                    match b {
+                        XOFF if flow == FlowControl::XonXoff => {
+                            if !stopped {
+                                rep.xoff_received += 1;
+                            }
+                            stopped = true;
+                        }
+                        XON if flow == FlowControl::XonXoff => {
+                            stopped = false;
+                            last_progress = Instant::now();
+                        }
+                        _ => rep.garbage_bytes += 1,
+                    }
+                }
+            }
+            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent)),
+        }
+        let cts = link.clear_to_send();
+        if stopped || !cts {
+            if last_progress.elapsed() > opts.timeout {
+                let op = if stopped {
+                    "waiting for XON from the device (it sent XOFF and never resumed)"
+                } else {
+                    "waiting for the device to raise CTS"
+                };
+                return Err(fail(link, Failure::Timeout(op), sent));
+            }
+            // Wait for the next byte (XON) or the CTS line.
+            if flow == FlowControl::XonXoff {
+                match link.read_some(&mut input[..1]) {
+                    Ok(1) => match input[0] {
+                        XON => {
+                            stopped = false;
+                            last_progress = Instant::now();
+                        }
+                        XOFF => {}
+                        _ => rep.garbage_bytes += 1,
+                    },
+                    Ok(_) => {}
+                    Err(_) => {
+                        return Err(fail(link, Failure::HungUp("while waiting for XON"), sent))
+                    }
+                }
+            } else {
+                std::thread::sleep(Duration::from_micros(500));
+            }
+            continue;
+        }
+        // Pace at the line rate: the bytes allowed so far, plus one chunk of slack.
+        let allowed = (t0.elapsed().as_secs_f64() * rate) as usize + CHUNK;
+        if allowed <= sent {
+            let wait = (sent + 1 - (allowed - CHUNK).min(sent + 1)) as f64 / rate;
+            std::thread::sleep(Duration::from_secs_f64(wait.clamp(50e-6, 0.01)));
+            continue;
+        }
+        let n = (allowed - sent).min(CHUNK).min(total - sent);
+        match link.write_some(&program[sent..sent + n]) {
+            Ok(0) => {
+                if last_progress.elapsed() > opts.timeout {
+                    return Err(fail(
+                        link,
+                        Failure::Timeout("writing to the device (it stopped reading)"),
+                        sent,
+                    ));
+                }
+            }
+            Ok(k) => {
+                sent += k;
+                last_progress = Instant::now();
+                if last_bar.elapsed() > Duration::from_millis(100) {
+                    bar.set(sent, "");
+                    last_bar = Instant::now();
+                }
+            }
+            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent)),
+        }
+    }
+    let _ = link.flush();
+    bar.set(sent, "");
+    rep.bytes = sent;
+    Ok(rep)
+}
+
+enum Failure {
+    Timeout(&'static str),
+    HungUp(&'static str),
+    Cancelled,
+}
+
+impl Failure {
+    fn into_error(self, port: String, at: Position, tool: ToolState, t: Duration) -> StreamError {
+        match self {
+            Failure::Timeout(op) => StreamError::Timeout {
+                port,
+                op,
+                secs: t.as_secs_f64(),
+                at,
+                tool,
+            },
+            Failure::HungUp(op) => StreamError::HungUp { port, op, at, tool },
+            Failure::Cancelled => StreamError::Cancelled { port, at, tool },
+        }
+    }
+}
+
+/// Lift the tool of an HP-GL device: end any partial instruction, pen up, put the pen away.
+/// Honours XOFF/CTS for a short while; the device lifts after working off its buffer.
+fn lift_hpgl(link: &mut Link, opts: &StreamOptions) -> ToolState {
+    let _ = opts;
+    let cmd = b";PU;SP0;\n";
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut stopped = false;
+    let mut sent = 0;
+    let mut input = [0u8; 64];
+    while sent < cmd.len() && Instant::now() < deadline {
+        if let Ok(n) = link.read_ready(&mut input) {
+            for &b in &input[..n] {
+                if b == XOFF {
+                    stopped = true;
+                } else if b == XON {
+                    stopped = false;
+                }
+            }
+        }
+        if (stopped && link.flow == FlowControl::XonXoff) || !link.clear_to_send() {
+            std::thread::sleep(Duration::from_millis(2));
+            continue;
+        }
+        match link.write_some(&cmd[sent..]) {
+            Ok(k) => sent += k,
+            Err(_) => return ToolState::Unknown,
+        }
+    }
+    if sent == cmd.len() && link.flush().is_ok() {
+        ToolState::Lifted
+    } else {
+        ToolState::Unknown
+    }
+}
+
+struct Grbl<'a> {
+    link: &'a mut Link,
+    profile: &'a Profile,
+    program: &'a [u8],
+    opts: &'a StreamOptions,
+    bar: &'a Bar,
+    port: String,
+    /// Lines of the program: (byte offset, text without newline, 1-based number).
+    lines: Vec<(usize, String)>,
+    /// Lines sent and not yet answered: (index into `lines`, bytes incl. newline).
+    pending: std::collections::VecDeque<(usize, usize)>,
+    in_flight: usize,
+    acked: usize,
+    acked_bytes: usize,
+    partial: Vec<u8>,
+    rep: StreamReport,
+    last_answer: Instant,
+    last_poll: Instant,
+    state: String,
+}
+
+enum Event {
+    Answer(Response),
+    Nothing,
+}
+
+impl<'a> Grbl<'a> {
+    fn new(
+        link: &'a mut Link,
+        profile: &'a Profile,
+        program: &'a [u8],
+        opts: &'a StreamOptions,
+        bar: &'a Bar,
+    ) -> Grbl<'a> {
+        let mut lines = Vec::new();
+        let mut at = 0;
+        for l in program.split(|&b| b == b'\n') {
+            let text = String::from_utf8_lossy(l).trim_end_matches('\r').to_string();
+            if !text.trim().is_empty() {
+                lines.push((at, text));
+            }
+            at += l.len() + 1;
+        }
+        let port = link.name.clone();
+        Grbl {
+            link,
+            profile,
+            program,
+            opts,
+            bar,
+            port,
+            lines,
+            pending: Default::default(),
+            in_flight: 0,
+            acked: 0,
+            acked_bytes: 0,
+            partial: Vec::new(),
+            rep: StreamReport::default(),
+            last_answer: Instant::now(),
+            last_poll: Instant::now(),
+            state: String::new(),
+        }
+    }
+
+    fn position(&self) -> Position {
+        let bytes = self.acked_bytes;
+        let mut p = position(self.bar, bytes, self.program.len());
+        p.line = Some(self.acked);
+        p.lines_total = self.lines.len();
+        p
+    }
+
+    /// Read one answer line if there is one (waits at most the poll interval).
+    fn poll(&mut self) -> Result<Event, StreamError> {
+        if let Some(i) = self.partial.iter().position(|&b| b == b'\n') {
+            let line: Vec<u8> = self.partial.drain(..=i).collect();
+            let text = String::from_utf8_lossy(&line).trim().to_string();
+            if text.is_empty() {
+                return Ok(Event::Nothing);
+            }
+            let r = proto::parse_response(&text);
+            if let Response::Other(_) = &r {
+                self.rep.garbage_bytes += line.len();
+            }
+            return Ok(Event::Answer(r));
+        }
+        let mut buf = [0u8; 512];
+        match self.link.read_some(&mut buf) {
+            Ok(n) => {
+                self.partial.extend_from_slice(&buf[..n]);
+                if n > 0 && self.partial.contains(&b'\n') {
+                    return self.poll();
+                }
+                Ok(Event::Nothing)
+            }
+            Err(_) => Err(StreamError::HungUp {
+                port: self.port.clone(),
+                op: "while streaming G-code",
+                at: self.position(),
+                tool: ToolState::Unknown,
+            }),
+        }
+    }
+
+    fn write_all(&mut self, bytes: &[u8], op: &'static str) -> Result<(), StreamError> {
+        let mut sent = 0;
+        let t = Instant::now();
+        while sent < bytes.len() {
+            match self.link.write_some(&bytes[sent..]) {
+                Ok(k) => sent += k,
+                Err(_) => {
+                    return Err(StreamError::HungUp {
+                        port: self.port.clone(),
+                        op,
+                        at: self.position(),
+                        tool: ToolState::Unknown,
+                    })
+                }
+            }
+            if t.elapsed() > self.opts.timeout {
+                return Err(self.stop(Failure::Timeout(op)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Reset the controller and wait for its welcome.
+    fn wake(&mut self) -> Result<(), StreamError> {
+        self.write_all(&[proto::SOFT_RESET], "resetting GRBL")?;
+        let deadline = Instant::now() + self.opts.wake_timeout;
+        while Instant::now() < deadline {
+            if let Event::Answer(Response::Welcome) = self.poll()? {
+                // Drop whatever follows the welcome (messages, alarm notes).
+                std::thread::sleep(Duration::from_millis(20));
+                while let Event::Answer(r) = self.poll()? {
+                    if let Response::Alarm(_) = r {
+                        // An alarm from before: unlock it.
+                        self.write_all(b"$X\n", "unlocking GRBL")?;
+                    }
+                }
+                self.partial.clear();
+                return Ok(());
+            }
+        }
+        Err(StreamError::NoWelcome {
+            port: self.port.clone(),
+            secs: self.opts.wake_timeout.as_secs_f64(),
+        })
+    }
+
+    fn handle(&mut self, r: Response) -> Result<(), StreamError> {
+        self.last_answer = Instant::now();
+        match r {
+            Response::Ok => {
+                if let Some((i, len)) = self.pending.pop_front() {
+                    self.in_flight -= len;
+                    self.acked = i + 1;
+                    self.acked_bytes = self.lines[i].0 + len;
+                    self.rep.lines += 1;
+                }
+                Ok(())
+            }
+            Response::Error(code) => {
+                let (i, len) = self.pending.pop_front().unwrap_or((self.acked, 0));
+                self.in_flight = self.in_flight.saturating_sub(len);
+                let text = self.lines.get(i).map(|l| l.1.clone()).unwrap_or_default();
+                let tool = self.lift();
+                Err(StreamError::Grbl {
+                    port: self.port.clone(),
+                    code,
+                    meaning: proto::error_meaning(code),
+                    line: i + 1,
+                    text,
+                    at: self.position(),
+                    tool,
+                })
+            }
+            Response::Alarm(code) => {
+                let tool = self.lift();
+                Err(StreamError::Alarm {
+                    port: self.port.clone(),
+                    code,
+                    meaning: proto::alarm_meaning(code),
+                    at: self.position(),
+                    tool,
+                })
+            }
+            Response::Status(s) => {
+                self.state = s;
+                Ok(())
+            }
+            Response::Welcome => {
+                // The controller reset under us: everything in flight is lost.
+                Err(StreamError::HungUp {
+                    port: self.port.clone(),
+                    op: "while streaming G-code (GRBL reset itself)",
+                    at: self.position(),
+                    tool: ToolState::Unknown,
+                })
+            }
+            Response::Other(_) => Ok(()),
+        }
+    }
+
+    /// Stop the job: the tool goes up, and the error says where the job was.
+    fn stop(&mut self, f: Failure) -> StreamError {
+        let tool = self.lift();
+        f.into_error(self.port.clone(), self.position(), tool, self.opts.timeout)
+    }
+
+    /// Feed hold, wait for the hold, soft reset, wait for the welcome, then the tool-up
+    /// command of the profile's cut tool.
+    fn lift(&mut self) -> ToolState {
+        if self.link.write_some(&[proto::FEED_HOLD]).is_err() {
+            return ToolState::Unknown;
+        }
+        let deadline = Instant::now() + Duration::from_secs(2);
+        let mut last_q = Instant::now() - Duration::from_secs(1);
+        while Instant::now() < deadline {
+            if last_q.elapsed() > Duration::from_millis(200) {
+                if self.link.write_some(&[proto::STATUS_QUERY]).is_err() {
+                    return ToolState::Unknown;
+                }
+                last_q = Instant::now();
+            }
+            match self.poll() {
+                Ok(Event::Answer(Response::Status(s))) if s == "Hold:0" || s == "Idle" => break,
+                Ok(_) => {}
+                Err(_) => return ToolState::Unknown,
+            }
+        }
+        if self.link.write_some(&[proto::SOFT_RESET]).is_err() {
+            return ToolState::Unknown;
+        }
+        let deadline = Instant::now() + Duration::from_secs(3);
+        let mut awake = false;
+        let mut alarm = false;
+        while Instant::now() < deadline {
+            match self.poll() {
+                Ok(Event::Answer(Response::Welcome)) => awake = true,
+                Ok(Event::Answer(Response::Alarm(_))) => alarm = true,
+                Ok(Event::Nothing) if awake => break,
+                Ok(_) => {}
+                Err(_) => return ToolState::Unknown,
+            }
+        }
+        if !awake {
+            return ToolState::Unknown;
+        }
+        let mut up = String::new();
+        if alarm {
+            up.push_str("$X\n");
+        }
+        if let Some(t) = self.profile.tool(crate::toolpath::StrokeKind::Cut) {
+            if let Some(z) = t.z_up {
+                up.push_str(&format!("G0 Z{}\n", crate::output::fmt_mm(z)));
+            } else if let Some(s) = t.servo_up {
+                up.push_str(&format!("M3 S{}\n", crate::output::fmt_mm(s)));
+            }
+        }
+        up.push_str("M5\n");
+        if self.link.write_some(up.as_bytes()).is_err() {
+            return ToolState::Unknown;
+        }
+        let _ = self.link.flush();
+        // Wait for the answers so the command is known to be taken.
+        let want = up.lines().count();
+        let mut got = 0;
+        let deadline = Instant::now() + Duration::from_secs(3);
+        while got < want && Instant::now() < deadline {
+            match self.poll() {
+                Ok(Event::Answer(Response::Ok)) | Ok(Event::Answer(Response::Error(_))) => got += 1,
+                Ok(_) => {}
+                Err(_) => return ToolState::Unknown,
+            }
+        }
+        if got == want {
+            ToolState::Lifted
+        } else {
+            ToolState::Unknown
+        }
+    }
+
+    fn run(mut self) -> Result<StreamReport, StreamError> {
+        self.wake()?;
+        let limit = match self.profile.protocol {
+            Protocol::GrblSendResponse => 1,
+            _ => self.profile.buffer.clamp(1, 1 << 20),
+        };
+        let send_response = self.profile.protocol == Protocol::GrblSendResponse;
+        let mut next = 0;
+        self.last_answer = Instant::now();
+        while next < self.lines.len() || !self.pending.is_empty() {
+            if self.opts.cancel.load(Ordering::SeqCst) {
+                return Err(self.stop(Failure::Cancelled));
+            }
+            // Send what fits.
+            if next < self.lines.len() {
+                let text = self.lines[next].1.clone();
+                if text.len() > proto::LINE_MAX {
+                    return Err(StreamError::LineTooLong {
+                        port: self.port.clone(),
+                        line: next + 1,
+                        len: text.len(),
+                        max: proto::LINE_MAX,
+                    });
+                }
+                let len = text.len() + 1;
+                let system = text.trim_start().starts_with('$');
+                let fits = if send_response || system {
+                    self.pending.is_empty()
+                } else {
+                    self.in_flight + len <= limit
+                        && !self
+                            .pending
+                            .front()
+                            .is_some_and(|&(i, _)| self.lines[i].1.trim_start().starts_with('$'))
+                };
+                if fits {
+                    let mut bytes = text.into_bytes();
+                    bytes.push(b'\n');
+                    self.write_all(&bytes, "sending G-code")?;
+                    self.pending.push_back((next, len));
+                    self.in_flight += len;
+                    next += 1;
+                    continue;
+                }
+            }
+            // Wait for an answer.
+            match self.poll()? {
+                Event::Answer(r) => self.handle(r)?,
+                Event::Nothing => {
+                    if self.last_answer.elapsed() > self.opts.timeout {
+                        return Err(self.stop(Failure::Timeout(
+                            "waiting for GRBL to answer `ok` (the controller went silent)",
+                        )));
+                    }
+                }
+            }
+            if self.bar.bar.is_some() && self.last_poll.elapsed() > Duration::from_millis(200) {
+                self.last_poll = Instant::now();
+                self.write_all(&[proto::STATUS_QUERY], "asking GRBL for its status")?;
+                let state = format!(" {}", self.state);
+                self.bar.set(self.acked_bytes, &state);
+            }
+        }
+        let _ = self.link.flush();
+        self.rep.bytes = self.program.len();
+        Ok(self.rep)
+    }
+}
