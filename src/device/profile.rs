@@ -5,20 +5,55 @@
 //! A profile says which language the machine speaks, how many device units make a millimetre,
 //! and which tool makes each kind of stroke (cut, score, perforate, draw, etch). A kind the
 //! profile has no tool for is left out of the program, with a note to the user.
+//!
+//! Profiles are data: each value in a bundled file carries a comment saying where it comes from
+//! (a document and section, or "typical value, not documented"). [`parse`] checks what the
+//! output and device stages rely on: G-code profiles speak millimetres (`units_per_mm = 1`) over
+//! a GRBL streaming protocol; every HP-GL tool has a pen; every G-code tool has exactly one way
+//! down (Z knife, servo pen or laser power within `max_power`); speeds and forces are positive
+//! and finite, passes at least 1, the buffer at least 1 byte. Errors name the file and the key.
 
 use crate::toolpath::StrokeKind;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Profiles shipped with flatcut: (file name, contents).
+/// Profiles shipped with flatcut: (file name, contents). `sim` first: it is the default.
 pub const BUNDLED: &[(&str, &str)] = &[
     ("sim.toml", include_str!("../../devices/sim.toml")),
     (
         "hpgl-pens.toml",
         include_str!("../../devices/hpgl-pens.toml"),
     ),
+    (
+        "roland-gx24.toml",
+        include_str!("../../devices/roland-gx24.toml"),
+    ),
+    (
+        "graphtec-ce6000.toml",
+        include_str!("../../devices/graphtec-ce6000.toml"),
+    ),
+    (
+        "uscutter-mh.toml",
+        include_str!("../../devices/uscutter-mh.toml"),
+    ),
+    (
+        "grbl-dragknife.toml",
+        include_str!("../../devices/grbl-dragknife.toml"),
+    ),
+    ("grbl-pen.toml", include_str!("../../devices/grbl-pen.toml")),
+    (
+        "grbl-laser.toml",
+        include_str!("../../devices/grbl-laser.toml"),
+    ),
 ];
+
+/// Dialects the output stage knows, per language.
+pub const HPGL_DIALECTS: &[&str] = &["hp-gl", "camm-gl2"];
+pub const GCODE_DIALECTS: &[&str] = &["grbl"];
+
+/// Stroke kinds a tool table may name (see [`StrokeKind::name`]).
+pub const TOOL_KINDS: &[&str] = &["cut", "score", "perforate", "draw", "etch"];
 
 /// Machine language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -38,9 +73,15 @@ impl Language {
     }
 }
 
-/// How one kind of stroke is made. Which fields matter depends on the language: HP-GL uses
-/// `pen`, `force` (FS) and `speed` (VS); G-code uses `speed` (feed), `z_down`/`z_up` (knife),
-/// `servo_down`/`servo_up` (pen servo, `M3 S`) or `power` (laser, `M4 S`).
+/// How one kind of stroke is made. Which fields matter depends on the language:
+///
+/// - HP-GL: `pen` (required), `force` (`FS`, grams) and `speed` (`VS`, cm/s).
+/// - G-code: `speed` (feed, mm/min) and exactly one way of putting the tool down: a knife on Z
+///   (`z_down` and `z_up`), a servo pen (`servo_down` and `servo_up`, `M3 S`, with `dwell`), or
+///   a laser (`power`, `M4 S`, more than 0 and at most the profile's `max_power`).
+///
+/// Both: `passes`. [`parse`] refuses fields of the other language, so that a value a user wrote
+/// is never silently ignored.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct Tool {
@@ -52,9 +93,9 @@ pub struct Tool {
     pub speed: Option<f64>,
     /// Times each stroke is repeated (default 1).
     pub passes: Option<u32>,
-    /// Laser power, spindle `S` units (0 to the profile's `max_power`).
+    /// Laser power, spindle `S` units (more than 0, at most the profile's `max_power`).
     pub power: Option<f64>,
-    /// G-code knife: Z height (mm) with the blade in the material, and lifted.
+    /// G-code knife: Z height (mm) with the blade in the material, and lifted (`z_down < z_up`).
     pub z_down: Option<f64>,
     pub z_up: Option<f64>,
     /// G-code servo pen: `M3 S` value that lowers and lifts the pen.
@@ -62,6 +103,13 @@ pub struct Tool {
     pub servo_up: Option<f64>,
     /// Seconds to wait after a servo move (`G4 P`).
     pub dwell: Option<f64>,
+}
+
+impl Tool {
+    /// Times each stroke is made.
+    pub fn passes(&self) -> u32 {
+        self.passes.unwrap_or(1)
+    }
 }
 
 /// Serial line settings.
@@ -153,7 +201,8 @@ pub struct Profile {
     pub name: String,
     pub description: String,
     pub language: Language,
-    /// `hp-gl`, `camm-gl2` (Roland CAMM-GL mode 2), `grbl`.
+    /// HP-GL: `hp-gl` or `camm-gl2` (Roland CAMM-GL, mode 2: the HP-GL-like instruction set of
+    /// Roland's cutters; see [`HPGL_DIALECTS`]). G-code: `grbl`.
     pub dialect: String,
     pub units_per_mm: f64,
     /// Largest width the machine can cut (mm); 0 when unknown.
@@ -163,7 +212,8 @@ pub struct Profile {
     pub axes: Axes,
     #[serde(default)]
     pub serial: SerialSettings,
-    /// Device input buffer in bytes (what may be in flight unacknowledged).
+    /// Device input buffer in bytes (what may be in flight unacknowledged). GRBL: its serial
+    /// receive buffer, 128.
     #[serde(default = "default_buffer")]
     pub buffer: usize,
     #[serde(default)]
@@ -206,7 +256,8 @@ pub enum ProfileError {
     Unknown { name: String, known: String },
 }
 
-/// Parse one profile.
+/// Parse one profile and check it. Errors name `source_name` and the key at fault, with its
+/// line when the key is written as `key = value` under its table header.
 pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
     let invalid = |message: String| ProfileError::Invalid {
         source_name: source_name.to_string(),
@@ -222,33 +273,339 @@ pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
             e.message()
         ))
     })?;
-    if !(p.units_per_mm.is_finite() && p.units_per_mm > 0.0) {
-        return Err(invalid(format!(
-            "`units_per_mm` must be a positive number, got {}",
-            p.units_per_mm
-        )));
-    }
-    for key in p.tools.keys() {
-        if !["cut", "score", "perforate", "draw", "etch"].contains(&key.as_str()) {
-            return Err(invalid(format!(
-                "unknown tool kind `{key}`; expected cut, score, perforate, draw or etch"
-            )));
-        }
-    }
-    if p.serial.baud == 0 || !(5..=8).contains(&p.serial.data_bits) || !(1..=2).contains(&p.serial.stop_bits) {
-        return Err(invalid(format!(
-            "serial settings: baud must be > 0, data_bits 5–8, stop_bits 1–2 (got {}, {}, {})",
-            p.serial.baud, p.serial.data_bits, p.serial.stop_bits
-        )));
-    }
-    if p.buffer == 0 {
-        return Err(invalid("`buffer` must be at least 1 byte".into()));
-    }
-    if !p.tools.contains_key("cut") {
-        return Err(invalid("the tool table has no `cut` tool".into()));
-    }
+    check(&p).map_err(|pr| {
+        // A missing key points at its table.
+        let line = line_of(text, &pr.table, &pr.key)
+            .or_else(|| line_of(text, &pr.table, ""))
+            .map(|l| format!("line {l}: "))
+            .unwrap_or_default();
+        let name = match (pr.table.is_empty(), pr.key.is_empty()) {
+            (true, _) => pr.key,
+            (false, true) => pr.table,
+            (false, false) => format!("{}.{}", pr.table, pr.key),
+        };
+        invalid(format!("{line}`{name}` {}", pr.message))
+    })?;
     p.source = source_name.to_string();
     Ok(p)
+}
+
+/// What is wrong with a profile, and where: `table` is `""` for top-level keys, `key` is `""`
+/// when the whole table is at fault.
+struct Problem {
+    table: String,
+    key: String,
+    message: String,
+}
+
+fn problem(table: &str, key: &str, message: impl Into<String>) -> Problem {
+    Problem {
+        table: table.to_string(),
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+/// The checks of [`parse`] on a profile that deserialised.
+fn check(p: &Profile) -> Result<(), Problem> {
+    if !positive(p.units_per_mm) {
+        return Err(problem(
+            "",
+            "units_per_mm",
+            format!("must be a positive number, got {}", p.units_per_mm),
+        ));
+    }
+    let (dialects, gcode) = match p.language {
+        Language::Hpgl => (HPGL_DIALECTS, false),
+        Language::Gcode => (GCODE_DIALECTS, true),
+    };
+    if !dialects.contains(&p.dialect.as_str()) {
+        return Err(problem(
+            "",
+            "dialect",
+            format!(
+                "`{}` is not a dialect of this language; expected {}",
+                p.dialect,
+                dialects.join(" or ")
+            ),
+        ));
+    }
+    let grbl = matches!(
+        p.protocol,
+        Protocol::GrblCharacterCounting | Protocol::GrblSendResponse
+    );
+    if gcode && !grbl {
+        return Err(problem(
+            "",
+            "protocol",
+            "must be grbl-character-counting or grbl-send-response for a G-code profile",
+        ));
+    }
+    if !gcode && grbl {
+        return Err(problem(
+            "",
+            "protocol",
+            "must be buffered for an HP-GL profile (the grbl-* protocols are for G-code)",
+        ));
+    }
+    if gcode && p.units_per_mm != 1.0 {
+        return Err(problem(
+            "",
+            "units_per_mm",
+            format!(
+                "must be 1 for G-code (programs are in millimetres, G21), got {}",
+                p.units_per_mm
+            ),
+        ));
+    }
+    if !(p.media_width.is_finite() && p.media_width >= 0.0) {
+        return Err(problem(
+            "",
+            "media_width",
+            format!(
+                "must be 0 (unknown) or a width in mm, got {}",
+                p.media_width
+            ),
+        ));
+    }
+    if p.buffer == 0 {
+        return Err(problem("", "buffer", "must be at least 1 byte"));
+    }
+    let s = &p.serial;
+    if s.baud == 0 {
+        return Err(problem("serial", "baud", "must be more than 0"));
+    }
+    if !(5..=8).contains(&s.data_bits) {
+        return Err(problem(
+            "serial",
+            "data_bits",
+            format!("must be 5 to 8, got {}", s.data_bits),
+        ));
+    }
+    if !(1..=2).contains(&s.stop_bits) {
+        return Err(problem(
+            "serial",
+            "stop_bits",
+            format!("must be 1 or 2, got {}", s.stop_bits),
+        ));
+    }
+    if let Some(m) = p.max_power {
+        if !gcode {
+            return Err(problem("", "max_power", "is for G-code lasers only"));
+        }
+        if !positive(m) {
+            return Err(problem(
+                "",
+                "max_power",
+                format!("must be a positive number, got {m}"),
+            ));
+        }
+    }
+    for (kind, t) in &p.tools {
+        let table = format!("tools.{kind}");
+        if !TOOL_KINDS.contains(&kind.as_str()) {
+            return Err(problem(
+                &table,
+                "",
+                "is not a tool kind; expected cut, score, perforate, draw or etch",
+            ));
+        }
+        check_tool(&table, t, p.max_power, gcode)?;
+    }
+    if !p.tools.contains_key("cut") {
+        return Err(problem(
+            "tools",
+            "cut",
+            "is missing: every profile needs a `[tools.cut]`",
+        ));
+    }
+    Ok(())
+}
+
+/// The checks of one tool, `[table]`.
+fn check_tool(table: &str, t: &Tool, max_power: Option<f64>, gcode: bool) -> Result<(), Problem> {
+    let err = |key: &str, message: String| Err(problem(table, key, message));
+    let numbers = [
+        ("force", t.force),
+        ("speed", t.speed),
+        ("power", t.power),
+        ("z_down", t.z_down),
+        ("z_up", t.z_up),
+        ("servo_down", t.servo_down),
+        ("servo_up", t.servo_up),
+        ("dwell", t.dwell),
+    ];
+    for (key, v) in numbers {
+        if let Some(v) = v.filter(|v| !v.is_finite()) {
+            return err(key, format!("must be a finite number, got {v}"));
+        }
+    }
+    for (key, v) in [("force", t.force), ("speed", t.speed)] {
+        if let Some(v) = v.filter(|&v| v <= 0.0) {
+            return err(key, format!("must be a positive number, got {v}"));
+        }
+    }
+    if t.passes == Some(0) {
+        return err("passes", "must be at least 1".into());
+    }
+    if let Some(d) = t.dwell.filter(|&d| d < 0.0) {
+        return err("dwell", format!("must be 0 or more seconds, got {d}"));
+    }
+    if !gcode {
+        let gcode_only = [
+            ("z_down", t.z_down.is_some()),
+            ("z_up", t.z_up.is_some()),
+            ("servo_down", t.servo_down.is_some()),
+            ("servo_up", t.servo_up.is_some()),
+            ("dwell", t.dwell.is_some()),
+            ("power", t.power.is_some()),
+        ];
+        if let Some((key, _)) = gcode_only.into_iter().find(|(_, set)| *set) {
+            return err(
+                key,
+                "is for G-code tools; an HP-GL tool has pen, force, speed and passes".into(),
+            );
+        }
+        if t.pen.is_none() {
+            return err(
+                "pen",
+                "is missing: an HP-GL tool needs a pen (tool holder) number".into(),
+            );
+        }
+        return Ok(());
+    }
+    if let Some((key, _)) = [("pen", t.pen.is_some()), ("force", t.force.is_some())]
+        .into_iter()
+        .find(|(_, set)| *set)
+    {
+        return err(
+            key,
+            "is for HP-GL tools; a G-code tool goes down by z_down/z_up, servo_down/servo_up or power"
+                .into(),
+        );
+    }
+    // Exactly one way down; a half-given pair names its missing half.
+    let mut ways = Vec::new();
+    match (t.z_down, t.z_up) {
+        (Some(down), Some(up)) if down >= up => {
+            return err(
+                "z_down",
+                format!("must be below z_up ({down} is not below {up})"),
+            )
+        }
+        (Some(_), Some(_)) => ways.push("z_down/z_up"),
+        (Some(_), None) => {
+            return err(
+                "z_up",
+                "is missing: a knife on Z needs z_down and z_up".into(),
+            )
+        }
+        (None, Some(_)) => {
+            return err(
+                "z_down",
+                "is missing: a knife on Z needs z_down and z_up".into(),
+            )
+        }
+        (None, None) => {}
+    }
+    match (t.servo_down, t.servo_up) {
+        (Some(down), Some(up)) if down < 0.0 || up < 0.0 => {
+            return err(
+                "servo_down",
+                format!("and servo_up are `M3 S` values, 0 or more; got {down} and {up}"),
+            )
+        }
+        (Some(down), Some(up)) if down == up => {
+            return err(
+                "servo_down",
+                format!("must differ from servo_up (both are {down})"),
+            )
+        }
+        (Some(_), Some(_)) => ways.push("servo_down/servo_up"),
+        (Some(_), None) => {
+            return err(
+                "servo_up",
+                "is missing: a servo pen needs servo_down and servo_up".into(),
+            )
+        }
+        (None, Some(_)) => {
+            return err(
+                "servo_down",
+                "is missing: a servo pen needs servo_down and servo_up".into(),
+            )
+        }
+        (None, None) => {}
+    }
+    if let Some(power) = t.power {
+        let Some(max) = max_power else {
+            return err(
+                "power",
+                "needs the profile's `max_power` (GRBL `$30`, the S value of full power)".into(),
+            );
+        };
+        if !(power > 0.0 && power <= max) {
+            return err(
+                "power",
+                format!("must be more than 0 and at most max_power ({max}), got {power}"),
+            );
+        }
+        ways.push("power");
+    }
+    match ways.len() {
+        1 => {}
+        0 => {
+            return err(
+                "",
+                "has no way down: a G-code tool needs z_down and z_up (knife), servo_down and \
+                 servo_up (pen) or power (laser)"
+                    .into(),
+            )
+        }
+        _ => {
+            return err(
+                "",
+                format!(
+                    "has more than one way down ({}); give exactly one",
+                    ways.join(", ")
+                ),
+            )
+        }
+    }
+    if t.dwell.is_some() && t.servo_down.is_none() {
+        return err(
+            "dwell",
+            "is the wait after a servo move; only a servo pen has one".into(),
+        );
+    }
+    Ok(())
+}
+
+/// Line (1-based) where `key` is set under `[table]` (`""`: top level), or where `[table]`
+/// starts when `key` is `""`. Best effort: it knows `[table]` headers and `key = …` lines; a key
+/// written inline or dotted is not found, and the message goes without a line.
+fn line_of(text: &str, table: &str, key: &str) -> Option<usize> {
+    let mut current = "";
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if let Some(header) = line.strip_prefix('[').and_then(|r| r.split(']').next()) {
+            current = header.trim();
+            if key.is_empty() && current == table {
+                return Some(i + 1);
+            }
+            continue;
+        }
+        if current == table && !key.is_empty() {
+            let rest = line.strip_prefix(key).map(str::trim_start);
+            if rest.is_some_and(|r| r.starts_with('=')) {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
 }
 
 /// The user's profile directory, if one can be named.
@@ -307,33 +664,256 @@ pub fn find(name: &str) -> Result<Profile, ProfileError> {
 mod tests {
     use super::*;
 
+    const KINDS: [StrokeKind; 5] = [
+        StrokeKind::Cut,
+        StrokeKind::Score,
+        StrokeKind::Perforate,
+        StrokeKind::Draw,
+        StrokeKind::Etch,
+    ];
+
+    fn bundled(name: &str) -> Profile {
+        let file = format!("{name}.toml");
+        let (_, text) = BUNDLED.iter().find(|(f, _)| *f == file).unwrap();
+        parse(text, &file).unwrap()
+    }
+
     #[test]
     fn every_bundled_profile_loads() {
+        assert_eq!(BUNDLED[0].0, "sim.toml");
         for (file, text) in BUNDLED {
-            let p = parse(text, file).unwrap();
+            let p = parse(text, file).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(format!("{}.toml", p.name), *file);
-            assert!(p.tool(StrokeKind::Cut).is_some());
+            assert!(p.tool(StrokeKind::Cut).is_some(), "{file}: no cut tool");
+            assert!(!p.description.is_empty(), "{file}");
+            assert!(p.buffer >= 1 && p.serial.baud > 0, "{file}");
+            for kind in KINDS {
+                let Some(t) = p.tool(kind) else { continue };
+                assert!(t.passes() >= 1, "{file}");
+                assert!(
+                    t.speed.is_some_and(|v| v > 0.0),
+                    "{file}: {kind:?} has no speed"
+                );
+                match p.language {
+                    Language::Hpgl => {
+                        assert!(t.pen.is_some(), "{file}: HP-GL {kind:?} has no pen");
+                        assert_eq!(p.units_per_mm, 40.0, "{file}");
+                        assert_eq!(p.protocol, Protocol::Buffered, "{file}");
+                    }
+                    Language::Gcode => {
+                        let knife = t.z_down.is_some() && t.z_up.is_some();
+                        let servo = t.servo_down.is_some() && t.servo_up.is_some();
+                        let laser = t.power.is_some();
+                        assert_eq!(
+                            [knife, servo, laser].iter().filter(|w| **w).count(),
+                            1,
+                            "{file}: G-code {kind:?} needs exactly one way down"
+                        );
+                        assert_eq!(p.units_per_mm, 1.0, "{file}");
+                        assert_eq!(p.protocol, Protocol::GrblCharacterCounting, "{file}");
+                        assert_eq!(p.buffer, 128, "{file}: GRBL's receive buffer");
+                    }
+                }
+            }
         }
-        let p = parse(BUNDLED[1].1, "x").unwrap();
-        assert_eq!(p.tool(StrokeKind::Cut).and_then(|t| t.pen), Some(1));
-        assert_eq!(p.tool(StrokeKind::Score).and_then(|t| t.pen), Some(2));
-        assert_eq!(p.tool(StrokeKind::Draw).and_then(|t| t.pen), Some(3));
-        assert_eq!(p.units_per_mm, 40.0);
+        let names: Vec<String> = all().unwrap().into_iter().map(|p| p.name).collect();
+        for name in [
+            "sim",
+            "hpgl-pens",
+            "roland-gx24",
+            "graphtec-ce6000",
+            "uscutter-mh",
+            "grbl-dragknife",
+            "grbl-pen",
+            "grbl-laser",
+        ] {
+            assert!(names.iter().any(|n| n == name), "{name} missing");
+        }
+    }
+
+    #[test]
+    fn the_pens_users_rely_on() {
+        // DESIGN.md: hpgl-pens maps cut = SP1, score/fold = SP2, draw = SP3.
+        for name in ["hpgl-pens", "sim"] {
+            let p = bundled(name);
+            assert_eq!(p.tool(StrokeKind::Cut).and_then(|t| t.pen), Some(1));
+            assert_eq!(p.tool(StrokeKind::Score).and_then(|t| t.pen), Some(2));
+            assert_eq!(p.tool(StrokeKind::Draw).and_then(|t| t.pen), Some(3));
+            assert_eq!(p.units_per_mm, 40.0);
+        }
+        let sim = bundled("sim");
+        assert_eq!(sim.serial.baud, 115200);
+        assert_eq!(sim.serial.flow_control, FlowControl::XonXoff);
+        assert_eq!(sim.buffer, 1024);
+
+        let gx = bundled("roland-gx24");
+        assert_eq!(
+            (gx.language, gx.dialect.as_str()),
+            (Language::Hpgl, "camm-gl2")
+        );
+        assert!(gx.axes.swap_xy, "roll-fed: the machine's x is the feed");
+        let laser = bundled("grbl-laser");
+        assert_eq!(laser.max_power, Some(1000.0));
+        assert!(laser.tools.values().all(|t| t.power.is_some()));
+        let pen = bundled("grbl-pen");
+        assert!(pen
+            .tools
+            .values()
+            .all(|t| t.servo_down.is_some() && t.dwell.is_some()));
+        let knife = bundled("grbl-dragknife");
+        assert!(knife.tools.values().all(|t| t.z_down < t.z_up));
+    }
+
+    const HPGL: &str =
+        "name='x'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n";
+    const GCODE: &str =
+        "name='x'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\n\
+                         protocol='grbl-character-counting'\nbuffer=128\n";
+
+    fn error(text: &str) -> String {
+        parse(text, "x.toml").unwrap_err().to_string()
     }
 
     #[test]
     fn bad_profiles_say_why() {
-        let e = parse("name = \"x\"\ncolour = 1\n", "x.toml").unwrap_err();
-        assert!(e.to_string().contains("x.toml: line 2"), "{e}");
-        let e = parse(
-            "name='x'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=0\n[tools.cut]\npen=1\n",
-            "x.toml",
-        )
-        .unwrap_err();
-        assert!(e.to_string().contains("units_per_mm"), "{e}");
+        let e = error("name = \"x\"\ncolour = 1\n");
+        assert!(e.contains("x.toml: line 2"), "{e}");
+        let e = error(&format!(
+            "{}\n[tools.cut]\npen=1\n",
+            HPGL.replace("=40", "=0")
+        ));
+        assert!(e.contains("x.toml: line 5: `units_per_mm`"), "{e}");
         assert!(find("no-such-machine")
             .unwrap_err()
             .to_string()
             .contains("hpgl-pens"));
+    }
+
+    #[test]
+    fn bad_tools_name_file_and_key() {
+        // A G-code tool with no way down.
+        let e = error(&format!("{GCODE}[tools.cut]\nspeed=600\n"));
+        assert!(
+            e.starts_with("x.toml: line 8: `tools.cut` has no way down"),
+            "{e}"
+        );
+        // Half a pair names the missing half.
+        let e = error(&format!("{GCODE}[tools.cut]\nz_down=-1\nspeed=600\n"));
+        assert!(e.contains("`tools.cut.z_up` is missing"), "{e}");
+        // Two ways down.
+        let e = error(&format!(
+            "{GCODE}max_power=1000\n[tools.cut]\nz_down=-1\nz_up=2\npower=10\n"
+        ));
+        assert!(e.contains("`tools.cut` has more than one way down"), "{e}");
+        // An HP-GL tool without a pen.
+        let e = error(&format!(
+            "{HPGL}[tools.cut]\npen=1\n[tools.score]\nforce=50\n"
+        ));
+        assert!(
+            e.starts_with("x.toml: line 8: `tools.score.pen` is missing"),
+            "{e}"
+        );
+        // A negative speed, with its line.
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nspeed=-3\n"));
+        assert!(
+            e.starts_with("x.toml: line 8: `tools.cut.speed` must be a positive"),
+            "{e}"
+        );
+        // Not finite, zero force, no passes.
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nspeed=nan\n"));
+        assert!(
+            e.contains("`tools.cut.speed` must be a finite number"),
+            "{e}"
+        );
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nforce=0\n"));
+        assert!(e.contains("`tools.cut.force` must be a positive"), "{e}");
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\npasses=0\n"));
+        assert!(
+            e.contains("line 8: `tools.cut.passes` must be at least 1"),
+            "{e}"
+        );
+        // Laser power beyond $30, or without it.
+        let e = error(&format!("{GCODE}max_power=1000\n[tools.cut]\npower=1200\n"));
+        assert!(
+            e.contains("line 10: `tools.cut.power` must be more than 0 and at most"),
+            "{e}"
+        );
+        let e = error(&format!("{GCODE}[tools.cut]\npower=100\n"));
+        assert!(
+            e.contains("`tools.cut.power` needs the profile's `max_power`"),
+            "{e}"
+        );
+        // The other language's fields.
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nz_down=-1\n"));
+        assert!(e.contains("`tools.cut.z_down` is for G-code tools"), "{e}");
+        let e = error(&format!("{GCODE}[tools.cut]\npen=1\nz_down=-1\nz_up=1\n"));
+        assert!(e.contains("`tools.cut.pen` is for HP-GL tools"), "{e}");
+        // Knife upside down, servo that does not move, dwell without a servo.
+        let e = error(&format!("{GCODE}[tools.cut]\nz_down=2\nz_up=-1\n"));
+        assert!(e.contains("`tools.cut.z_down` must be below z_up"), "{e}");
+        let e = error(&format!("{GCODE}[tools.cut]\nservo_down=30\nservo_up=30\n"));
+        assert!(e.contains("`tools.cut.servo_down` must differ"), "{e}");
+        let e = error(&format!(
+            "{GCODE}[tools.cut]\nz_down=-1\nz_up=1\ndwell=0.2\n"
+        ));
+        assert!(e.contains("`tools.cut.dwell`"), "{e}");
+        // Unknown kind, missing cut.
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\n[tools.glue]\npen=2\n"));
+        assert!(e.contains("line 8: `tools.glue` is not a tool kind"), "{e}");
+        let e = error(&format!("{HPGL}[tools.draw]\npen=3\n"));
+        assert!(e.contains("`tools.cut` is missing"), "{e}");
+    }
+
+    #[test]
+    fn language_protocol_and_units_agree() {
+        let knife = "[tools.cut]\nz_down=-1\nz_up=2\n";
+        let e = error(&format!(
+            "{}{knife}",
+            GCODE.replace("grbl-character-counting", "buffered")
+        ));
+        assert!(
+            e.contains("line 6: `protocol` must be grbl-character-counting"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{}{knife}",
+            GCODE.replace("units_per_mm=1", "units_per_mm=40")
+        ));
+        assert!(
+            e.contains("line 5: `units_per_mm` must be 1 for G-code"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{HPGL}protocol='grbl-send-response'\n[tools.cut]\npen=1\n"
+        ));
+        assert!(e.contains("`protocol` must be buffered"), "{e}");
+        let e = error(&format!(
+            "{}[tools.cut]\npen=1\n",
+            HPGL.replace("hp-gl", "camm-gl3")
+        ));
+        assert!(
+            e.contains("line 4: `dialect` `camm-gl3` is not a dialect"),
+            "{e}"
+        );
+        let e = error(&format!("{HPGL}buffer=0\n[tools.cut]\npen=1\n"));
+        assert!(
+            e.contains("line 6: `buffer` must be at least 1 byte"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{HPGL}[serial]\nbaud=9600\nstop_bits=3\n[tools.cut]\npen=1\n"
+        ));
+        assert!(
+            e.contains("line 8: `serial.stop_bits` must be 1 or 2"),
+            "{e}"
+        );
+        let e = error(&format!("{HPGL}max_power=1000\n[tools.cut]\npen=1\n"));
+        assert!(e.contains("`max_power` is for G-code lasers only"), "{e}");
+        // GRBL with a bigger buffer than its 128 bytes is accepted (no check, no warning).
+        assert!(parse(
+            &format!("{}{knife}", GCODE.replace("=128", "=256")),
+            "x.toml"
+        )
+        .is_ok());
     }
 }
