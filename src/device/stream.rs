@@ -310,7 +310,8 @@ fn buffered(
     let mut rep = StreamReport::default();
     let mut sent = 0usize;
     let mut stopped = false;
-    let t0 = Instant::now();
+    let mut wire_free = Instant::now();
+    let chunk_time = Duration::from_secs_f64(CHUNK as f64 / rate);
     let mut last_progress = Instant::now();
     let mut input = [0u8; 256];
     let total = program.len();
@@ -383,14 +384,16 @@ fn buffered(
             }
             continue;
         }
-        // Pace at the line rate: the bytes allowed so far, plus one chunk of slack.
-        let allowed = (t0.elapsed().as_secs_f64() * rate) as usize + CHUNK;
-        if allowed <= sent {
-            let wait = (sent + 1 - (allowed - CHUNK).min(sent + 1)) as f64 / rate;
-            std::thread::sleep(Duration::from_secs_f64(wait.clamp(50e-6, 0.01)));
+        // Pace at the line rate: `wire_free` is when the line will have carried everything
+        // written; write when at most one chunk is still queued, so no more than two chunks
+        // are ever ahead of the wire (and a long stop never turns into a burst).
+        let now = Instant::now();
+        let queued = wire_free.saturating_duration_since(now);
+        if queued > chunk_time {
+            std::thread::sleep((queued - chunk_time).min(Duration::from_millis(10)));
             continue;
         }
-        let n = (allowed - sent).min(CHUNK).min(total - sent);
+        let n = CHUNK.min(total - sent);
         match link.write_some(&program[sent..sent + n]) {
             Ok(0) => {
                 if last_progress.elapsed() > opts.timeout {
@@ -403,6 +406,7 @@ fn buffered(
             }
             Ok(k) => {
                 sent += k;
+                wire_free = wire_free.max(now) + Duration::from_secs_f64(k as f64 / rate);
                 last_progress = Instant::now();
                 if last_bar.elapsed() > Duration::from_millis(100) {
                     bar.set(sent, "");

@@ -123,6 +123,11 @@ impl Grbl {
         best.map(|(_, n)| n.clone())
     }
 
+    /// The tool that is down now (a laser counts while it is on).
+    pub fn tool_down_now(&self) -> Option<String> {
+        self.tool_down(true)
+    }
+
     /// Soft reset: spindle off, modes to defaults, position kept.
     pub fn reset(&mut self) {
         self.spindle_on = false;

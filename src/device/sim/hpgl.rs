@@ -31,6 +31,40 @@ pub fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usi
         .map(|i| i + 1)
 }
 
+/// For an instruction still arriving: the bytes at the front of `buf` that a plotter can
+/// already execute, and the mnemonic to put back in front of the rest. A plotter moves as
+/// coordinate pairs arrive; without this a host stopped by XOFF in the middle of a long `PD`
+/// would wait for XON while the device waited for the `;`.
+pub fn executable_prefix<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<(usize, [u8; 2])> {
+    let bytes: Vec<u8> = buf.into_iter().copied().take(4096).collect();
+    let start = bytes.iter().position(|b| !b.is_ascii_whitespace())?;
+    let op = bytes.get(start..start + 2)?;
+    let op = [op[0].to_ascii_uppercase(), op[1].to_ascii_uppercase()];
+    if !matches!(&op, b"PU" | b"PD" | b"PA" | b"PR") {
+        return None;
+    }
+    // Count separators after numbers; cut after the separator that ends a y coordinate.
+    let mut numbers = 0;
+    let mut in_number = false;
+    let mut cut = None;
+    for (i, &b) in bytes.iter().enumerate().skip(start + 2) {
+        match b {
+            b'0'..=b'9' | b'.' | b'-' | b'+' => in_number = true,
+            b',' | b' ' => {
+                if in_number {
+                    numbers += 1;
+                    in_number = false;
+                    if numbers % 2 == 0 {
+                        cut = Some(i + 1);
+                    }
+                }
+            }
+            _ => return None,
+        }
+    }
+    cut.map(|c| (c, op))
+}
+
 /// An HP-GL plotter's state.
 #[derive(Debug, Clone)]
 pub struct Hpgl {
@@ -169,6 +203,15 @@ impl Hpgl {
         }
     }
 
+    /// The tool that is down now, if any.
+    pub fn tool_down(&self) -> Option<String> {
+        if self.down {
+            self.tool_name()
+        } else {
+            None
+        }
+    }
+
     fn lift(&mut self) {
         self.down = false;
         self.rec.up();
@@ -221,6 +264,15 @@ mod tests {
         // Travel: origin→(40,40), (80,40)→(400,400).
         let expect = 40.0 * 2f64.sqrt() + (320.0f64.powi(2) + 360.0f64.powi(2)).sqrt();
         assert!((m.rec.travel - expect).abs() < 1e-9);
+    }
+
+    #[test]
+    fn partial_instructions_execute_whole_pairs() {
+        assert_eq!(executable_prefix(b"PD10,20,30,40,5".iter()), Some((14, *b"PD")));
+        assert_eq!(executable_prefix(b" pu1,2,".iter()), Some((7, *b"PU")));
+        assert_eq!(executable_prefix(b"PD10,20".iter()), None);
+        assert_eq!(executable_prefix(b"SP1".iter()), None);
+        assert_eq!(executable_prefix(b"PDx".iter()), None);
     }
 
     #[test]

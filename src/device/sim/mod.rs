@@ -119,6 +119,8 @@ pub struct SimReport {
     pub overruns: usize,
     /// Bytes the host queued after being told to stop (past the grace time).
     pub flow_violations: usize,
+    /// The tool that was down when the simulator stopped (`None`: all tools up).
+    pub tool_down_at_end: Option<String>,
     /// Bytes left in the buffer at the end that never made a whole instruction or line.
     pub unexecuted_bytes: usize,
     /// Fullest the input buffer ever was.
@@ -516,10 +518,16 @@ impl Device {
                     if !self.motion.is_empty() {
                         return;
                     }
-                    let Some(n) = hpgl::next_instruction(self.rx.iter()) else {
+                    let instr: Vec<u8> = if let Some(n) = hpgl::next_instruction(self.rx.iter()) {
+                        self.rx.drain(..n).collect()
+                    } else if let Some((n, op)) = hpgl::executable_prefix(self.rx.iter()) {
+                        let part = self.rx.drain(..n).collect();
+                        self.rx.push_front(op[1]);
+                        self.rx.push_front(op[0]);
+                        part
+                    } else {
                         return;
                     };
-                    let instr: Vec<u8> = self.rx.drain(..n).collect();
                     let t = m.execute(&instr);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
@@ -640,11 +648,13 @@ impl Device {
         let (rec, upm) = match &self.interp {
             Interp::Hpgl(m) => {
                 self.rep.executed = m.instructions;
+                self.rep.tool_down_at_end = m.tool_down();
                 self.rep.ignored = m.ignored.clone();
                 (m.rec.clone(), self.cfg.profile.units_per_mm)
             }
             Interp::Grbl(g) => {
                 self.rep.executed = g.lines_ok;
+                self.rep.tool_down_at_end = g.tool_down_now();
                 (g.rec.clone(), self.cfg.profile.units_per_mm)
             }
         };
