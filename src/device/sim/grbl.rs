@@ -83,9 +83,18 @@ impl Grbl {
                 });
             }
         }
+        // The machine starts with its tool up: a knife at its highest `z_up` (the user zeroes
+        // Z on the material and the controller is told where the tool is by the first `G0 Z`).
+        let z0 = rules
+            .iter()
+            .filter_map(|r| match r {
+                ToolRule::Knife { z_up, .. } => Some(*z_up),
+                _ => None,
+            })
+            .fold(0.0f64, f64::max);
         Grbl {
             rules,
-            pos: DVec3::ZERO,
+            pos: DVec3::new(0.0, 0.0, z0),
             g1: false,
             relative: false,
             inches: false,

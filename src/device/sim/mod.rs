@@ -345,8 +345,10 @@ impl Device {
                 allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
                 self.watch_backlog(waiting);
             }
-            if self.stalled {
-                allowance = 0;
+            // With flow control the device asks to stop the moment the high-water mark is
+            // reached: take no more than that in one read, so the request goes out in time.
+            if !self.stopped && self.flow != FlowControl::None {
+                allowance = allowance.min(self.high.saturating_sub(self.rx.len()).max(1));
             }
             let n = allowance.min(waiting).min(buf.len());
             if n > 0 {
@@ -392,8 +394,8 @@ impl Device {
             }
 
             if ctl == FINISH
-                && waiting == n
-                && (self.stalled || (!self.has_complete_input() && self.motion.is_empty()))
+                && (self.stalled
+                    || (waiting == n && !self.has_complete_input() && self.motion.is_empty()))
                 && now.duration_since(quiet_since) > Duration::from_millis(30)
             {
                 self.rep.unexecuted_bytes = self.rx.len();
@@ -433,6 +435,11 @@ impl Device {
 
     fn receive(&mut self, b: u8) {
         self.rep.bytes_received += 1;
+        // A stalled device still fills its buffer (and asks to stop) but answers nothing.
+        if self.stalled {
+            self.buffer(b);
+            return;
+        }
         if let Interp::Grbl(g) = &mut self.interp {
             match b {
                 proto::STATUS_QUERY => {
@@ -480,6 +487,10 @@ impl Device {
                 _ => {}
             }
         }
+        self.buffer(b);
+    }
+
+    fn buffer(&mut self, b: u8) {
         if self.rx.len() >= self.cap {
             self.rep.overruns += 1;
             return;
@@ -635,6 +646,7 @@ impl Device {
         }
         if f.stall_after.is_some_and(|n| got >= n) {
             self.stalled = true;
+            self.motion.clear();
         }
         if !self.garbage_sent && f.garbage_after.is_some_and(|n| got >= n) {
             self.garbage_sent = true;

@@ -1,0 +1,404 @@
+//! Devices end to end through real pseudo-terminals: flatcut's serial transport on the slave
+//! side, the simulated cutter on the master side. Flow control under load (XON/XOFF and
+//! RTS/CTS into a 256-byte buffer), GRBL character counting against its 128-byte buffer,
+//! `error:N` mid-job, faults (hang-up, silent device, stall, lost XON, garbage, missing port),
+//! and a plain program using the kernel's XON/XOFF streaming into `flatcut sim`.
+
+mod common;
+use common::*;
+use flatcut::device::profile::{self, Profile};
+use flatcut::device::serial;
+use flatcut::device::sim::{self, Faults, SimConfig, SimReport};
+use flatcut::device::stream::{self, StreamError, StreamOptions};
+use std::time::Duration;
+
+fn hpgl_profile(baud: u32, flow: &str, buffer: usize) -> Profile {
+    profile::parse(
+        &format!(
+            "name='t'\ndescription='test cutter'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n\
+             buffer={buffer}\n[serial]\nbaud={baud}\nflow_control='{flow}'\n\
+             [tools.cut]\npen=1\nspeed=20\n"
+        ),
+        "test.toml",
+    )
+    .unwrap()
+}
+
+fn opts(timeout_s: f64) -> StreamOptions {
+    StreamOptions {
+        timeout: Duration::from_secs_f64(timeout_s),
+        wake_timeout: Duration::from_secs(2),
+        progress: false,
+        ..StreamOptions::default()
+    }
+}
+
+/// Stream `program` into a simulator of `profile`; returns what the host and the device saw.
+fn run(
+    profile: &Profile,
+    program: &[u8],
+    time_factor: Option<f64>,
+    faults: Faults,
+    o: &StreamOptions,
+) -> (Result<stream::StreamReport, StreamError>, SimReport) {
+    let mut cfg = SimConfig::new(profile.clone());
+    cfg.time_factor = time_factor;
+    cfg.faults = faults;
+    let h = sim::spawn(cfg).unwrap();
+    let mut link = serial::open(profile, &h.path, None)
+        .unwrap()
+        .with_virtual_cts(h.cts.clone());
+    let r = stream::send(&mut link, profile, program, o);
+    drop(link);
+    let rep = h.finish(Duration::from_secs(120)).unwrap();
+    (r, rep)
+}
+
+/// About `size` bytes of HP-GL: 1 mm pen-down steps zig-zagging over a 100 mm square.
+fn big_hpgl(size: usize) -> (Vec<u8>, usize) {
+    let mut s = String::from("IN;SP1;PU0,0;\n");
+    let mut k = 0usize;
+    while s.len() < size {
+        let x = (k % 100) * 40;
+        let y = ((k / 100) % 100) * 40;
+        s.push_str(&format!("PD{x},{y};\n"));
+        k += 1;
+    }
+    s.push_str("PU;SP0;\n");
+    (s.into_bytes(), k)
+}
+
+fn check_flow(flow: &str) {
+    // A fast line (pty) and a device that draws slower than the line delivers, so the
+    // buffer fills and flow control must act again and again.
+    let p = hpgl_profile(2_000_000, flow, 256);
+    let (prog, moves) = big_hpgl(1 << 20);
+    // 1 mm at 20 cm/s is 5 ms; at ×40 it is 0.125 ms a ~12-byte instruction (~100 kB/s).
+    let (r, rep) = run(&p, &prog, Some(40.0), Faults::default(), &opts(20.0));
+    let r = r.unwrap();
+    assert_eq!(r.bytes, prog.len());
+    assert_eq!(rep.bytes_received, prog.len(), "no byte lost");
+    assert_eq!(rep.overruns, 0, "{flow}: overruns");
+    assert_eq!(rep.flow_violations, 0, "{flow}: host ignored a stop");
+    assert!(rep.max_buffer_fill <= 256);
+    if flow == "xon-xoff" {
+        assert!(rep.xoff_sent > 10, "flow control never acted: {}", rep.xoff_sent);
+        assert!(r.xoff_received > 10);
+    }
+    // Every move was drawn: one path, one step per PD after the first (which is at 0,0).
+    assert_eq!(rep.paths.len(), 1);
+    assert_eq!(rep.paths[0].points.len() - 1, moves - 1);
+    assert_eq!(rep.tool_down_at_end, None);
+}
+
+#[test]
+fn one_megabyte_over_xon_xoff_into_256_bytes() {
+    check_flow("xon-xoff");
+}
+
+#[test]
+fn one_megabyte_over_rts_cts_into_256_bytes() {
+    check_flow("rts-cts");
+}
+
+#[test]
+fn a_host_that_ignores_xoff_is_caught() {
+    // Write straight into the pty, ignoring XOFF: the simulator must see the violation.
+    use std::io::Write;
+    let p = hpgl_profile(115_200, "xon-xoff", 256);
+    let mut cfg = SimConfig::new(p.clone());
+    cfg.time_factor = Some(1.0);
+    let h = sim::spawn(cfg).unwrap();
+    let mut port = serial::open(&p, &h.path, None).unwrap();
+    let (prog, _) = big_hpgl(6000);
+    for c in prog.chunks(64) {
+        let _ = port.write_some(c);
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    std::thread::sleep(Duration::from_millis(200));
+    let rep = h.stop().unwrap();
+    assert!(rep.xoff_sent >= 1);
+    assert!(rep.violations() > 0, "{rep:?}");
+    let _ = port.flush();
+}
+
+fn grbl_profile(protocol: &str) -> Profile {
+    profile::parse(
+        &format!(
+            "name='g'\ndescription='grbl knife'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\n\
+             buffer=128\nprotocol='{protocol}'\n[serial]\nbaud=115200\n\
+             [tools.cut]\nz_down=-1\nz_up=2\nspeed=3000\n"
+        ),
+        "grbl.toml",
+    )
+    .unwrap()
+}
+
+/// A G-code job of `n` cut strokes (squares of 10 mm).
+fn gcode_job(n: usize) -> String {
+    let mut s = String::from("G21\nG90\nG94\n");
+    for k in 0..n {
+        let (x, y) = ((k % 10) as f64 * 12.0, (k / 10) as f64 * 12.0);
+        s.push_str(&format!("G0 Z2\nG0 X{x} Y{y}\nG1 Z-1 F3000\n"));
+        for (dx, dy) in [(10.0, 0.0), (10.0, 10.0), (0.0, 10.0), (0.0, 0.0)] {
+            s.push_str(&format!("G1 X{} Y{}\n", x + dx, y + dy));
+        }
+        s.push_str("G0 Z2\n");
+    }
+    s.push_str("M5\nM2\n");
+    s
+}
+
+#[test]
+fn grbl_character_counting_never_exceeds_128_bytes() {
+    let p = grbl_profile("grbl-character-counting");
+    let job = gcode_job(60);
+    // ×20: a 10 mm side takes 10 ms, so the planner fills and lines wait in the buffer.
+    let (r, rep) = run(&p, job.as_bytes(), Some(20.0), Faults::default(), &opts(10.0));
+    let r = r.unwrap();
+    assert_eq!(rep.overruns, 0, "more than 128 bytes outstanding");
+    assert!(rep.max_buffer_fill <= 128);
+    assert!(
+        rep.max_buffer_fill > 64,
+        "character counting should keep the buffer full: {}",
+        rep.max_buffer_fill
+    );
+    assert!(rep.errors_sent.is_empty(), "{:?}", rep.errors_sent);
+    assert_eq!(r.lines, job.lines().count());
+    assert_eq!(rep.paths.len(), 60);
+    for (k, path) in rep.paths.iter().enumerate() {
+        assert_eq!(path.tool, "cut");
+        let (x, y) = ((k % 10) as f64 * 12.0, (k / 10) as f64 * 12.0);
+        assert_eq!(path.points[0], [x, y]);
+        assert_eq!(path.points.len(), 5);
+    }
+    assert_eq!(rep.tool_down_at_end, None);
+}
+
+#[test]
+fn a_naive_grbl_host_overruns_the_simulated_buffer() {
+    // The check must be able to fail: pour a job in without counting.
+    use std::io::Write;
+    let p = grbl_profile("grbl-character-counting");
+    let mut cfg = SimConfig::new(p.clone());
+    cfg.time_factor = Some(1.0);
+    let h = sim::spawn(cfg).unwrap();
+    let mut port = serial::open(&p, &h.path, None).unwrap();
+    let job = gcode_job(30);
+    for c in job.as_bytes().chunks(256) {
+        let _ = port.write_some(c);
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let rep = h.stop().unwrap();
+    assert!(rep.overruns > 0, "{rep:?}");
+    let _ = port.flush();
+}
+
+#[test]
+fn grbl_send_response_streams_too() {
+    let p = grbl_profile("grbl-send-response");
+    let job = gcode_job(5);
+    let (r, rep) = run(&p, job.as_bytes(), None, Faults::default(), &opts(10.0));
+    r.unwrap();
+    assert_eq!(rep.overruns, 0);
+    assert!(rep.max_buffer_fill <= 30, "one line at a time");
+    assert_eq!(rep.paths.len(), 5);
+}
+
+#[test]
+fn grbl_error_stops_the_job_with_line_meaning_and_tool_up() {
+    let p = grbl_profile("grbl-character-counting");
+    let job = gcode_job(20);
+    // Line 30 of the job (the reset line does not count: it is a real-time byte).
+    let faults = Faults {
+        grbl_error: Some((30, 20)),
+        ..Faults::default()
+    };
+    let (r, rep) = run(&p, job.as_bytes(), Some(50.0), faults, &opts(10.0));
+    let e = r.unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, StreamError::Grbl { code: 20, line: 30, .. }), "{msg}");
+    assert!(msg.contains("error:20") && msg.contains("unsupported"), "{msg}");
+    let text = job.lines().nth(29).unwrap();
+    assert!(msg.contains(text), "{msg}");
+    assert!(msg.contains("tool lifted"), "{msg}");
+    assert!(msg.contains("last acknowledged line 29"), "{msg}");
+    assert_eq!(rep.tool_down_at_end, None, "{rep:?}");
+    assert!(rep.paths.len() < 20);
+}
+
+#[test]
+fn hang_up_mid_job_says_how_far_it_got() {
+    let p = hpgl_profile(115_200, "xon-xoff", 1024);
+    let (prog, _) = big_hpgl(20_000);
+    let faults = Faults {
+        hang_up_after: Some(5000),
+        ..Faults::default()
+    };
+    let (r, rep) = run(&p, &prog, None, faults, &opts(5.0));
+    let e = r.unwrap_err();
+    assert!(matches!(e, StreamError::HungUp { .. }), "{e}");
+    let at = e.position().unwrap();
+    assert!(at.bytes >= 5000 && at.bytes < 20_000, "{at:?}");
+    assert!(e.to_string().contains("byte"), "{e}");
+    assert_eq!(rep.ended, "hung up (fault)");
+
+    let g = grbl_profile("grbl-character-counting");
+    let faults = Faults {
+        hang_up_after: Some(700),
+        ..Faults::default()
+    };
+    let (r, _) = run(&g, gcode_job(30).as_bytes(), None, faults, &opts(5.0));
+    let e = r.unwrap_err();
+    assert!(matches!(e, StreamError::HungUp { .. }), "{e}");
+    assert!(e.position().unwrap().line.unwrap() > 0, "{e}");
+}
+
+#[test]
+fn silent_and_stalled_devices_time_out_naming_the_operation() {
+    // GRBL that never answers: no welcome.
+    let g = grbl_profile("grbl-character-counting");
+    let faults = Faults {
+        stall_after: Some(0),
+        ..Faults::default()
+    };
+    let (r, _) = run(&g, gcode_job(3).as_bytes(), None, faults, &opts(1.0));
+    let e = r.unwrap_err();
+    assert!(matches!(e, StreamError::NoWelcome { .. }), "{e}");
+
+    // GRBL that stops answering mid-job.
+    let faults = Faults {
+        stall_after: Some(400),
+        ..Faults::default()
+    };
+    let (r, _) = run(&g, gcode_job(30).as_bytes(), None, faults, &opts(1.0));
+    let e = r.unwrap_err();
+    assert!(e.to_string().contains("waiting for GRBL to answer"), "{e}");
+
+    // HP-GL device that jams: buffer fills, XOFF, no XON ever.
+    let p = hpgl_profile(115_200, "xon-xoff", 256);
+    let faults = Faults {
+        stall_after: Some(100),
+        ..Faults::default()
+    };
+    let (prog, _) = big_hpgl(5000);
+    let (r, _) = run(&p, &prog, None, faults, &opts(1.0));
+    let e = r.unwrap_err();
+    assert!(e.to_string().contains("waiting for XON"), "{e}");
+    assert!(e.position().unwrap().bytes < 5000);
+
+    // A lost XON is the same to the host: it says so after the timeout.
+    let faults = Faults {
+        lose_xon: true,
+        ..Faults::default()
+    };
+    let (r, rep) = run(&p, &prog, Some(5.0), faults, &opts(1.0));
+    let e = r.unwrap_err();
+    assert!(e.to_string().contains("waiting for XON"), "{e}");
+    assert_eq!(rep.xon_sent, 0);
+}
+
+#[test]
+fn garbage_on_the_line_does_not_stop_a_job() {
+    let p = hpgl_profile(115_200, "xon-xoff", 1024);
+    let (prog, _) = big_hpgl(8000);
+    let faults = Faults {
+        garbage_after: Some(2000),
+        ..Faults::default()
+    };
+    let (r, rep) = run(&p, &prog, None, faults.clone(), &opts(5.0));
+    let r = r.unwrap();
+    assert!(r.garbage_bytes > 0);
+    assert_eq!(rep.bytes_received, prog.len());
+
+    let g = grbl_profile("grbl-character-counting");
+    let job = gcode_job(10);
+    let (r, rep) = run(&g, job.as_bytes(), None, faults, &opts(5.0));
+    r.unwrap();
+    assert_eq!(rep.paths.len(), 10);
+}
+
+#[test]
+fn missing_port_is_exit_1_with_one_line() {
+    let dir = scratch("missing-port");
+    let plt = dir.join("x.plt");
+    std::fs::write(&plt, "IN;SP1;PU0,0;PD100,0;PU;SP0;\n").unwrap();
+    let o = flatcut(&[
+        "send",
+        plt.to_str().unwrap(),
+        "--device",
+        "hpgl-pens",
+        "--port",
+        "/dev/ttyNOPE0",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("/dev/ttyNOPE0"), "{err}");
+    // A real device with no port given.
+    let o = flatcut(&["send", plt.to_str().unwrap(), "--device", "hpgl-pens"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--port"), "{}", stderr(&o));
+    // G-code file to an HP-GL device.
+    let nc = dir.join("x.gcode");
+    std::fs::write(&nc, "G0 X1\n").unwrap();
+    let o = flatcut(&["send", nc.to_str().unwrap(), "--device", "sim"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("x.gcode"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_plain_program_with_kernel_xon_xoff_streams_into_flatcut_sim() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let dir = scratch("external-client");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flatcut"))
+        .args(["sim", "--device", "sim", "--speed", "2", "--for", "8", "-o"])
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut first = String::new();
+    out.read_line(&mut first).unwrap();
+    let path = first
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap_or_else(|| panic!("first line: {first}"))
+        .to_string();
+    // 12 kB of HP-GL into a 1024-byte buffer, by `stty ixon` and `cat`: the kernel honours
+    // the simulator's XOFF, no flatcut code on this side.
+    let (prog, moves) = big_hpgl(12_000);
+    let file = dir.join("job.plt");
+    std::fs::write(&file, &prog).unwrap();
+    let st = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "stty -F {path} raw -echo ixon 115200 && cat {} > {path}",
+            file.display()
+        ))
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let mut rest = String::new();
+    for l in out.lines() {
+        rest.push_str(&l.unwrap());
+        rest.push('\n');
+    }
+    assert!(child.wait().unwrap().success(), "{rest}");
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("sim.json")).unwrap()).unwrap();
+    assert_eq!(rep["bytes_received"], prog.len());
+    assert_eq!(rep["overruns"], 0);
+    assert_eq!(rep["flow_violations"], 0);
+    assert!(rep["xoff_sent"].as_u64().unwrap() >= 1, "{rest}");
+    let steps: usize = rep["paths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["points"].as_array().unwrap().len() - 1)
+        .sum();
+    assert_eq!(steps, moves - 1);
+    assert!(dir.join("sim.png").is_file());
+}
