@@ -89,15 +89,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         } else {
             format!("{}-{}.{ext}", spec.name, i + 1)
         };
-        let bytes = match profile.language {
-            crate::device::Language::Hpgl => crate::output::hpgl::emit(sheet, &profile),
-            crate::device::Language::Gcode => {
-                return Err(Error::Usage(format!(
-                    "device `{}` speaks G-code, which this flatcut cannot write yet; use an HP-GL device such as hpgl-pens",
-                    profile.name
-                )))
-            }
-        };
+        let bytes = crate::output::program(sheet, &profile).map_err(|e| e.on_sheet(i + 1))?;
         write_atomic(&dir.join(&name), &bytes)?;
         files.push(name.clone());
         programs.push((name, bytes));

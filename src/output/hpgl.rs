@@ -1,105 +1,355 @@
-//! HP-GL programs: `IN;`, then for each stroke a pen select when the tool changes (`SPn;`), a
-//! pen-up move to its start (`PU x,y;`) and pen-down moves along it (`PD x,y,…;`), in absolute
-//! plotter units; `PU;SP0;` at the end puts the pen away with the tool up.
+//! HP-GL programs, plain (dialect `hp-gl`) and Roland CAMM-GL mode 2 (dialect `camm-gl2`), one
+//! instruction per line:
 //!
-//! Coordinates are converted from millimetres with the profile's units per mm (40 for HP-GL)
-//! and rounded once, from the absolute position, so rounding never accumulates. Long strokes
-//! are split into `PD` commands of at most 32 points, one command per line, because some
-//! cutters limit the length of an instruction. Strokes whose kind the profile has no pen for
-//! are left out; a point repeated after rounding is sent once.
+//! ```text
+//! IN;                      initialise (absolute coordinates, pen up)
+//! <profile init lines>     verbatim, `;` added where missing
+//! SP1;                     pen select, when the pen changes
+//! VS20;                    velocity, cm/s, when the tool's speed differs from the one in effect
+//! FS120;                   force (camm-gl2: `!FS120;`), when it differs from the one in effect
+//! PU400,400;               pen-up move to the start of a stroke
+//! PD800,400,800,800;       pen-down moves along it, at most 32 points per instruction
+//! PU;                      } only when the profile has `end` lines: pen up first,
+//! <profile end lines>      } then the user's lines
+//! PU;SP0;                  always last: pen up, pen put away
+//! ```
+//!
+//! Coordinates are absolute, in plotter units: each point goes through
+//! [`to_device`] (the profile's axes and units per mm, 40 for HP-GL's
+//! 0.025 mm plotter unit) and is rounded once, from the absolute position, so rounding never
+//! accumulates. A point repeated after rounding is sent once. A stroke of one point is a dot:
+//! `PU x,y;` then `PD x,y;`.
+//!
+//! Documentation followed:
+//! - HP-GL: HP 7475A Interfacing and Programming Manual (`IN`, `SP`, `PU`/`PD` with coordinate
+//!   pairs, `VS` in cm/s, the plotter unit of 0.025 mm).
+//! - Roland CAMM-GL mode 2: Roland's CAMM-GL II Programmer's Guide as summarised in
+//!   Ti-Ion/EGX-300-USB-Drive `CAMM-GL2_REFERENCE.md` (mode 2 instructions are two letters
+//!   ended by `;`; `!`-prefixed instructions work in either mode; `IN` restores the defaults,
+//!   absolute coordinates and the tool up); the GX-24 programs written by MIT's fab modules
+//!   (`fab_write_camm` in fab.c, and mods' `mod_Roland_GX_24_path`: `PA;PA;!ST1;!FS<gf>;VS<cm/s>;`
+//!   then `PU`/`PD` at 40 units per mm), which is where `!FS` for the force in grams comes from;
+//!   Inkcut's Roland driver (inkcut/device/protocols/camm.py) also starts with `IN;` and sets
+//!   `VS` and `SP`. The coordinate range, ±(2^26 − 1), is the one of CAMM-GL III's instruction
+//!   list (Roland PNC-900 CAMM-1 User's Manual, "List of CAMM-GL III instructions", note *1).
+//!
+//! Choices where the documents are silent or disagree:
+//! - `FS` (plain HP-GL): its unit is the device's (HP pen plotters take a level, most HP-GL
+//!   vinyl cutters grams); the profile's `force` is sent as is, rounded to a whole number.
+//!   camm-gl2 sends `!FS` instead, in grams (fab modules), and not the `!ST1` that fab modules
+//!   also send, whose meaning is not documented in the sources above (a profile can put it in
+//!   `init`). `VS` is sent with up to 3 decimals, trailing zeros trimmed.
+//! - VS and FS are stateful on the device, so they are sent when a stroke's tool asks for a
+//!   value other than the one in effect (the first time after `IN;`, and when the tool
+//!   changes to one with other settings). A tool without `speed` or `force` leaves the value
+//!   in effect (the previous tool's, or the machine panel's).
+//! - `passes`: a closed stroke (its last point, after rounding, is its first) goes round again
+//!   without lifting; an open one is lifted, moved back to its start and cut again.
+//! - `end` lines come after a `PU;` so that a user's page feed or move home happens with the
+//!   tool up, and the program still ends with `PU;SP0;` whatever those lines did.
+//! - `PD` instructions carry at most 32 points, because some cutters limit the length of an
+//!   instruction. A stroke kind the profile has no tool for is left out; a tool without `pen`
+//!   is an error, as is a coordinate beyond ±(2^23 − 1) plotter units in plain HP-GL (a
+//!   conservative bound: HP-GL devices differ, 2^23 units is 209 m at 40 per mm).
 
-use crate::device::Profile;
+use super::{line_error, to_device, tool_error, OutputError};
+use crate::device::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
 
 /// Points per `PD` instruction.
 const PD_POINTS: usize = 32;
 
-/// Encode one sheet's strokes.
-pub fn emit(sheet: &SheetJob, profile: &Profile) -> Vec<u8> {
-    let k = profile.units_per_mm;
-    let to_units = |v: f64| (v * k).round() as i64;
+/// Largest coordinate magnitude, plotter units, of plain HP-GL.
+pub const HPGL_LIMIT: i64 = (1 << 23) - 1;
+/// Largest coordinate magnitude, plotter units, of Roland CAMM-GL (mode 2).
+pub const CAMM_LIMIT: i64 = (1 << 26) - 1;
+
+/// The HP-GL dialects flatcut writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dialect {
+    /// Plain HP-GL (`hp-gl`).
+    Hpgl,
+    /// Roland CAMM-GL mode 2 (`camm-gl2`).
+    CammGl2,
+}
+
+impl Dialect {
+    /// The dialect a profile names.
+    pub fn of(profile: &Profile) -> Result<Dialect, OutputError> {
+        match profile.dialect.as_str() {
+            "hp-gl" => Ok(Dialect::Hpgl),
+            "camm-gl2" => Ok(Dialect::CammGl2),
+            other => Err(OutputError::Dialect {
+                profile: profile.name.clone(),
+                source_name: profile.source.clone(),
+                language: "HP-GL",
+                dialect: other.to_string(),
+                known: "hp-gl, camm-gl2",
+            }),
+        }
+    }
+
+    /// Largest coordinate magnitude in plotter units.
+    pub fn limit(self) -> i64 {
+        match self {
+            Dialect::Hpgl => HPGL_LIMIT,
+            Dialect::CammGl2 => CAMM_LIMIT,
+        }
+    }
+
+    /// The force instruction's mnemonic.
+    fn force_op(self) -> &'static str {
+        match self {
+            Dialect::Hpgl => "FS",
+            Dialect::CammGl2 => "!FS",
+        }
+    }
+}
+
+/// What an HP-GL program uses of a tool, checked.
+struct HpglTool {
+    pen: u32,
+    speed: Option<String>,
+    force: Option<String>,
+    passes: u32,
+}
+
+fn check_tool(profile: &Profile, kind: &str, tool: &Tool) -> Result<HpglTool, OutputError> {
+    let err = |m: String| tool_error(profile, kind, m);
+    let pen = tool
+        .pen
+        .ok_or_else(|| err("no `pen`: HP-GL selects the tool with `SP<pen>`".into()))?;
+    let speed = match tool.speed {
+        Some(v) if !(v.is_finite() && v > 0.0) => {
+            return Err(err(format!(
+                "`speed` must be a positive number of cm/s, got {v}"
+            )))
+        }
+        Some(v) => Some(super::fmt_mm(v)),
+        None => None,
+    };
+    let force = match tool.force {
+        Some(v) if !(0.0..1e6).contains(&v) => {
+            return Err(err(format!(
+                "`force` must be a number of grams ≥ 0, got {v}"
+            )))
+        }
+        Some(v) => Some(format!("{}", v.round() as i64)),
+        None => None,
+    };
+    let passes = tool.passes.unwrap_or(1);
+    if passes == 0 {
+        return Err(err("`passes` must be at least 1".into()));
+    }
+    Ok(HpglTool {
+        pen,
+        speed,
+        force,
+        passes,
+    })
+}
+
+/// An `init`/`end` line as one terminated instruction line.
+fn profile_line(profile: &Profile, which: &'static str, line: &str) -> Result<String, OutputError> {
+    let t = line.trim();
+    if t.contains(['\n', '\r']) {
+        return Err(line_error(
+            profile,
+            which,
+            line,
+            "one instruction per line: split it into several lines".into(),
+        ));
+    }
+    Ok(if t.ends_with(';') {
+        t.to_string()
+    } else {
+        format!("{t};")
+    })
+}
+
+/// Encode one sheet's strokes (see the module documentation for the exact text).
+pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+    let dialect = Dialect::of(profile)?;
+    let limit = dialect.limit();
     let mut out = String::from("IN;\n");
+    for line in &profile.init {
+        if !line.trim().is_empty() {
+            out.push_str(&profile_line(profile, "init", line)?);
+            out.push('\n');
+        }
+    }
     let mut pen: Option<u32> = None;
-    for stroke in &sheet.strokes {
-        let Some(p) = profile.tool(stroke.role.kind()).and_then(|t| t.pen) else {
+    let mut speed: Option<String> = None;
+    let mut force: Option<String> = None;
+    for (index, stroke) in sheet.strokes.iter().enumerate() {
+        let kind = stroke.role.kind();
+        let Some(tool) = profile.tool(kind) else {
             continue;
         };
-        let mut pts: Vec<(i64, i64)> = stroke
-            .points
-            .iter()
-            .map(|q| (to_units(q.x), to_units(q.y)))
-            .collect();
+        let tool = check_tool(profile, kind.name(), tool)?;
+        let mut pts: Vec<(i64, i64)> = Vec::with_capacity(stroke.points.len());
+        for q in &stroke.points {
+            let d = to_device(profile, sheet.width, sheet.height, *q);
+            let mut unit = [0i64; 2];
+            for (u, v) in unit.iter_mut().zip([d.x, d.y]) {
+                let r = v.round();
+                if !(r.is_finite() && r.abs() <= limit as f64) {
+                    return Err(OutputError::OutOfRange {
+                        sheet: None,
+                        stroke: index + 1,
+                        role: stroke.role.name(),
+                        value: v,
+                        limit: limit as f64,
+                        units: "plotter units",
+                        profile: profile.name.clone(),
+                    });
+                }
+                *u = r as i64;
+            }
+            pts.push((unit[0], unit[1]));
+        }
         pts.dedup();
         let Some(&(x0, y0)) = pts.first() else {
             continue;
         };
-        if pen != Some(p) {
-            let _ = writeln!(out, "SP{p};");
-            pen = Some(p);
+        if pen != Some(tool.pen) {
+            let _ = writeln!(out, "SP{};", tool.pen);
+            pen = Some(tool.pen);
         }
-        let _ = writeln!(out, "PU{x0},{y0};");
-        if pts.len() == 1 {
-            // A dot: put the tool down where it is.
-            let _ = writeln!(out, "PD{x0},{y0};");
-            continue;
+        if tool.speed.is_some() && tool.speed != speed {
+            let _ = writeln!(out, "VS{};", tool.speed.as_deref().unwrap_or_default());
+            speed = tool.speed.clone();
         }
-        for chunk in pts[1..].chunks(PD_POINTS) {
-            out.push_str("PD");
-            for (i, (x, y)) in chunk.iter().enumerate() {
-                if i > 0 {
-                    out.push(',');
-                }
-                let _ = write!(out, "{x},{y}");
+        if tool.force.is_some() && tool.force != force {
+            let f = tool.force.as_deref().unwrap_or_default();
+            let _ = writeln!(out, "{}{f};", dialect.force_op());
+            force = tool.force.clone();
+        }
+        let closed = pts.len() > 2 && pts.first() == pts.last();
+        for pass in 0..tool.passes {
+            if pass == 0 || !closed {
+                let _ = writeln!(out, "PU{x0},{y0};");
             }
-            out.push_str(";\n");
+            if pts.len() == 1 {
+                // A dot: put the tool down where it is.
+                let _ = writeln!(out, "PD{x0},{y0};");
+                continue;
+            }
+            for chunk in pts[1..].chunks(PD_POINTS) {
+                out.push_str("PD");
+                for (i, (x, y)) in chunk.iter().enumerate() {
+                    if i > 0 {
+                        out.push(',');
+                    }
+                    let _ = write!(out, "{x},{y}");
+                }
+                out.push_str(";\n");
+            }
+        }
+    }
+    let end: Vec<&String> = profile
+        .end
+        .iter()
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    if !end.is_empty() {
+        out.push_str("PU;\n");
+        for line in end {
+            out.push_str(&profile_line(profile, "end", line)?);
+            out.push('\n');
         }
     }
     out.push_str("PU;SP0;\n");
-    out.into_bytes()
+    Ok(out.into_bytes())
 }
 
-/// A stroke read back from an HP-GL program: pen number and points in plotter units.
+/// A stroke read back from an HP-GL program: pen number, the velocity and force in effect
+/// (as written after `VS` and `FS`/`!FS`; `None` when none was set since `IN`) and the points
+/// in plotter units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParsedStroke {
     pub pen: u32,
+    pub speed: Option<f64>,
+    pub force: Option<f64>,
     pub points: Vec<(i64, i64)>,
 }
 
-/// Read back the pen-down paths of a program made by [`emit`] (absolute `PU`/`PD`/`SP` only).
-/// For tests and reports; the full interpreter is the simulated cutter's.
+/// Read back the pen-down paths of a program made by [`emit`]: absolute `PU`/`PD`/`PA`, `SP`,
+/// `VS`, `FS` and Roland's `!FS`; `IN` resets pen, velocity and force. Other instructions
+/// (a profile's `init` and `end` lines) are skipped, except `PR`, whose relative moves this
+/// reader does not follow. For tests and reports; the full interpreter is the simulated
+/// cutter's.
 pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
     let mut strokes: Vec<ParsedStroke> = Vec::new();
     let mut pen = 0u32;
+    let mut speed: Option<f64> = None;
+    let mut force: Option<f64> = None;
     let mut at = (0i64, 0i64);
     let mut down = false;
     for (n, cmd) in program.split(';').enumerate() {
         let cmd = cmd.trim();
-        if cmd.len() < 2 {
+        let roland = cmd.starts_with('!');
+        let cmd_body = if roland { &cmd[1..] } else { cmd };
+        if cmd_body.len() < 2 || !cmd_body.is_char_boundary(2) {
             continue;
         }
-        let (op, args) = cmd.split_at(2);
-        let nums: Vec<i64> = if args.is_empty() {
+        let (op, args) = cmd_body.split_at(2);
+        let op = op.to_ascii_uppercase();
+        let understood = if roland {
+            op == "FS"
+        } else {
+            matches!(
+                op.as_str(),
+                "IN" | "SP" | "PU" | "PD" | "PA" | "PR" | "VS" | "FS"
+            )
+        };
+        if !understood {
+            continue;
+        }
+        let nums: Vec<f64> = if args.trim().is_empty() {
             Vec::new()
         } else {
             args.split(',')
-                .map(|v| v.trim().parse::<i64>())
+                .map(|v| v.trim().parse::<f64>())
                 .collect::<Result<_, _>>()
                 .map_err(|e| format!("instruction {} `{cmd}`: {e}", n + 1))?
         };
-        match op {
-            "IN" => {}
-            "SP" => pen = nums.first().copied().unwrap_or(0) as u32,
-            "PU" | "PD" => {
-                let pd = op == "PD";
+        match op.as_str() {
+            "IN" => {
+                pen = 0;
+                speed = None;
+                force = None;
+                down = false;
+            }
+            "SP" => pen = nums.first().copied().unwrap_or(0.0) as u32,
+            "VS" => speed = nums.first().copied(),
+            "FS" => force = nums.first().copied(),
+            "PR" if !nums.is_empty() => {
+                return Err(format!(
+                    "instruction {} `{cmd}`: relative moves are not read",
+                    n + 1
+                ))
+            }
+            "PR" => {}
+            _ => {
+                // PU, PD, PA: pen state (PA keeps it), then absolute moves.
+                let pd = match op.as_str() {
+                    "PU" => false,
+                    "PD" => true,
+                    _ => down,
+                };
+                if nums.len() % 2 != 0 {
+                    return Err(format!("instruction {} `{cmd}`: odd coordinates", n + 1));
+                }
                 for xy in nums.chunks(2) {
-                    let &[x, y] = xy else {
-                        return Err(format!("instruction {} `{cmd}`: odd coordinates", n + 1));
-                    };
+                    let (x, y) = (xy[0].round() as i64, xy[1].round() as i64);
                     if pd {
                         if !down {
                             strokes.push(ParsedStroke {
                                 pen,
+                                speed,
+                                force,
                                 points: vec![at],
                             });
                         }
@@ -112,7 +362,6 @@ pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
                 }
                 down = pd;
             }
-            other => return Err(format!("instruction {} `{other}` not understood", n + 1)),
         }
     }
     Ok(strokes)
@@ -121,36 +370,50 @@ pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::device::profile::parse as parse_profile;
     use crate::toolpath::{Stroke, StrokeRole};
     use glam::DVec2;
 
-    #[test]
-    fn pens_units_and_end() {
-        let profile = crate::device::profile::find("hpgl-pens").unwrap();
-        let job = SheetJob {
+    /// The bundled `hpgl-pens` profile as it was when the exact text below was pinned: pens
+    /// only, no axes, no init or end.
+    const PENS: &str = "name='hpgl-pens'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\n\
+        units_per_mm=40.0\n[tools.cut]\npen=1\n[tools.score]\npen=2\n[tools.draw]\npen=3\n";
+
+    fn stroke(role: StrokeRole, pts: &[(f64, f64)]) -> Stroke {
+        Stroke {
+            role,
+            points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
+            closed: pts.len() > 2 && pts.first() == pts.last(),
+            piece: None,
+        }
+    }
+
+    fn job(strokes: Vec<Stroke>) -> SheetJob {
+        SheetJob {
             width: 100.0,
             height: 100.0,
-            strokes: vec![
-                Stroke {
-                    role: StrokeRole::Label,
-                    points: vec![DVec2::new(1.0, 1.0), DVec2::new(2.0, 1.0)],
-                    closed: false,
-                    piece: None,
-                },
-                Stroke {
-                    role: StrokeRole::Cut,
-                    points: vec![
-                        DVec2::new(10.0, 10.0),
-                        DVec2::new(20.012, 10.0),
-                        DVec2::new(20.0, 20.0),
-                        DVec2::new(10.0, 10.0),
-                    ],
-                    closed: true,
-                    piece: None,
-                },
-            ],
-        };
-        let text = String::from_utf8(emit(&job, &profile)).unwrap();
+            strokes,
+        }
+    }
+
+    fn text(sheet: &SheetJob, profile_text: &str) -> String {
+        let profile = parse_profile(profile_text, "test.toml").unwrap();
+        String::from_utf8(emit(sheet, &profile).unwrap()).unwrap()
+    }
+
+    fn small_job() -> SheetJob {
+        job(vec![
+            stroke(StrokeRole::Label, &[(1.0, 1.0), (2.0, 1.0)]),
+            stroke(
+                StrokeRole::Cut,
+                &[(10.0, 10.0), (20.012, 10.0), (20.0, 20.0), (10.0, 10.0)],
+            ),
+        ])
+    }
+
+    #[test]
+    fn pens_units_and_end() {
+        let text = text(&small_job(), PENS);
         assert_eq!(
             text,
             "IN;\nSP3;\nPU40,40;\nPD80,40;\nSP1;\nPU400,400;\nPD800,400,800,800,400,400;\nPU;SP0;\n"
@@ -162,5 +425,171 @@ mod tests {
             back[1].points,
             vec![(400, 400), (800, 400), (800, 800), (400, 400)]
         );
+    }
+
+    #[test]
+    fn bundled_hpgl_pens_keeps_its_frame() {
+        let profile = crate::device::profile::find("hpgl-pens").unwrap();
+        let text = String::from_utf8(emit(&small_job(), &profile).unwrap()).unwrap();
+        assert!(text.starts_with("IN;\n"), "{text}");
+        assert!(text.ends_with("PU;SP0;\n"), "{text}");
+        let back = parse(&text).unwrap();
+        assert_eq!(back.iter().map(|s| s.pen).collect::<Vec<_>>(), vec![3, 1]);
+    }
+
+    const CUTTER: &str = "name='c'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\n\
+        units_per_mm=40.0\ninit=['!ST1', 'VS5;']\nend=['PU0,0']\n\
+        [tools.cut]\npen=1\nforce=120\nspeed=20\n\
+        [tools.score]\npen=1\nforce=50.4\nspeed=20\npasses=2\n\
+        [tools.draw]\npen=2\nspeed=12.5\n";
+
+    #[test]
+    fn plain_hpgl_force_speed_passes_init_end() {
+        let sheet = job(vec![
+            stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)]),
+            stroke(StrokeRole::Cut, &[(3.0, 1.0), (4.0, 1.0)]),
+            stroke(StrokeRole::FoldValley, &[(1.0, 2.0), (2.0, 2.0)]),
+            stroke(
+                StrokeRole::FoldMountain,
+                &[(1.0, 3.0), (2.0, 3.0), (2.0, 4.0), (1.0, 3.0)],
+            ),
+            stroke(StrokeRole::Mark, &[(5.0, 5.0)]),
+            stroke(StrokeRole::Cut, &[(6.0, 6.0), (7.0, 6.0)]),
+        ]);
+        let t = text(&sheet, CUTTER);
+        assert_eq!(
+            t,
+            "IN;\n!ST1;\nVS5;\n\
+             SP1;\nVS20;\nFS120;\nPU40,40;\nPD80,40;\n\
+             PU120,40;\nPD160,40;\n\
+             FS50;\nPU40,80;\nPD80,80;\nPU40,80;\nPD80,80;\n\
+             PU40,120;\nPD80,120,80,160,40,120;\nPD80,120,80,160,40,120;\n\
+             SP2;\nVS12.5;\nPU200,200;\nPD200,200;\n\
+             SP1;\nVS20;\nFS120;\nPU240,240;\nPD280,240;\n\
+             PU;\nPU0,0;\nPU;SP0;\n"
+        );
+        let back = parse(&t).unwrap();
+        assert_eq!(back.len(), 7);
+        assert_eq!((back[0].speed, back[0].force), (Some(20.0), Some(120.0)));
+        assert_eq!((back[2].speed, back[2].force), (Some(20.0), Some(50.0)));
+        assert_eq!(back[2], back[3]);
+        assert_eq!(back[4].points.len(), 7);
+        assert_eq!((back[5].pen, back[5].speed), (2, Some(12.5)));
+        assert_eq!(back[5].points, vec![(200, 200), (200, 200)]);
+        assert_eq!(back[6].force, Some(120.0));
+    }
+
+    #[test]
+    fn camm_gl2_uses_roland_force() {
+        let profile = CUTTER
+            .replace("dialect='hp-gl'", "dialect='camm-gl2'")
+            .replace("init=['!ST1', 'VS5;']\nend=['PU0,0']\n", "");
+        let t = text(
+            &job(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]),
+            &profile,
+        );
+        assert_eq!(
+            t,
+            "IN;\nSP1;\nVS20;\n!FS120;\nPU40,40;\nPD80,40;\nPU;SP0;\n"
+        );
+        let back = parse(&t).unwrap();
+        assert_eq!(back[0].force, Some(120.0));
+    }
+
+    #[test]
+    fn unknown_dialect_and_unusable_tools_are_errors() {
+        let sheet = job(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]);
+        let p = parse_profile(&PENS.replace("'hp-gl'", "'dmpl'"), "test.toml").unwrap();
+        let e = emit(&sheet, &p).unwrap_err().to_string();
+        assert!(
+            e.contains("hpgl-pens") && e.contains("`dmpl`") && e.contains("camm-gl2"),
+            "{e}"
+        );
+        let p = parse_profile(&PENS.replace("pen=1", "speed=3"), "test.toml").unwrap();
+        let e = emit(&sheet, &p).unwrap_err().to_string();
+        assert!(e.contains("tool `cut`") && e.contains("`pen`"), "{e}");
+        let p = parse_profile(&PENS.replace("pen=1", "pen=1\npasses=0"), "t.toml").unwrap();
+        assert!(emit(&sheet, &p).unwrap_err().to_string().contains("passes"));
+    }
+
+    #[test]
+    fn out_of_range_names_sheet_and_stroke() {
+        let p = parse_profile(PENS, "test.toml").unwrap();
+        let sheet = job(vec![
+            stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)]),
+            stroke(StrokeRole::Cut, &[(1.0, 1.0), (300_000.0, 1.0)]),
+        ]);
+        let e = emit(&sheet, &p).unwrap_err().on_sheet(3).to_string();
+        assert!(
+            e.contains("sheet 3, stroke 2 (cut)") && e.contains("8388607"),
+            "{e}"
+        );
+        // Roland addresses further.
+        let p = parse_profile(&PENS.replace("'hp-gl'", "'camm-gl2'"), "t.toml").unwrap();
+        assert!(emit(&sheet, &p).is_ok());
+        let nan = job(vec![stroke(StrokeRole::Cut, &[(1.0, f64::NAN)])]);
+        assert!(emit(&nan, &p).is_err());
+    }
+
+    #[test]
+    fn axes_swap_and_flip() {
+        // A 100 × 50 mm sheet on a roll cutter: x along the feed is the sheet's y, and Y is
+        // mirrored across the media.
+        let profile = format!("{PENS}[axes]\nswap_xy=true\nflip_y=true\n");
+        let sheet = SheetJob {
+            width: 100.0,
+            height: 50.0,
+            strokes: vec![stroke(
+                StrokeRole::Cut,
+                &[(0.0, 0.0), (100.0, 0.0), (100.0, 50.0), (0.0, 50.0)],
+            )],
+        };
+        let back = parse(&text(&sheet, &profile)).unwrap();
+        assert_eq!(
+            back[0].points,
+            vec![(0, 4000), (0, 0), (2000, 0), (2000, 4000)]
+        );
+    }
+
+    #[test]
+    fn absolute_rounding_does_not_drift() {
+        // 8000 steps of 0.0125 mm (half a plotter unit): rounded increments would lose or
+        // gain up to half a unit per step.
+        let mut pts = Vec::new();
+        let mut x = 0.0;
+        for _ in 0..=8000 {
+            pts.push((x, 0.0));
+            x += 0.0125;
+        }
+        let sheet = SheetJob {
+            width: 200.0,
+            height: 10.0,
+            strokes: vec![stroke(StrokeRole::Cut, &pts)],
+        };
+        let t = text(&sheet, PENS);
+        let back = parse(&t).unwrap();
+        let got = &back[0].points;
+        assert_eq!(got.first(), Some(&(0, 0)));
+        assert_eq!(got.last(), Some(&(4000, 0)));
+        // Every point sent is the rounding of an absolute input position.
+        let exact: Vec<i64> = pts.iter().map(|p| (p.0 * 40.0).round() as i64).collect();
+        for p in got {
+            assert!(exact.contains(&p.0), "{p:?}");
+        }
+        assert!(got.windows(2).all(|w| w[1].0 > w[0].0));
+        // One instruction per line, at most 32 points each.
+        for line in t.lines().filter(|l| l.starts_with("PD")) {
+            assert!(line.matches(',').count() < 64, "{line}");
+            assert_eq!(line.matches(';').count(), 1);
+        }
+    }
+
+    #[test]
+    fn parse_tolerates_extras() {
+        let back = parse("IN;!ST1;VS10;FS3;SP1;PA;PU0,0;PD10,0;PA20,0;PU;DF;!PG;").unwrap();
+        assert_eq!(back.len(), 1);
+        assert_eq!(back[0].points, vec![(0, 0), (10, 0), (20, 0)]);
+        assert_eq!((back[0].speed, back[0].force), (Some(10.0), Some(3.0)));
+        assert!(parse("PR10,0;").is_err());
     }
 }

@@ -1,21 +1,32 @@
-//! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — HPGL/G-code programs for
-//! the cutter (`hpgl.rs`), an SVG document of all sheets ([`svg`]) and a PNG preview per sheet
-//! ([`png`]).
+//! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
+//! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
+//! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
-//! Choices shared by the encoders and kept in this module so that SVG and PNG agree:
-//! the colour and dash pattern of each [`StrokeRole`], and the drawing order
-//! ([`DRAW_ORDER`]: labels, marks, valley folds, mountain folds, cuts — cuts end up on top).
+//! Choices shared by the encoders and kept in this module so that they agree:
+//! - SVG and PNG: the colour and dash pattern of each [`StrokeRole`], and the drawing order
+//!   ([`DRAW_ORDER`]: labels, marks, valley folds, mountain folds, cuts — cuts end up on top).
+//! - HP-GL and G-code: the sheet-to-machine transform [`to_device`] (DESIGN.md "Devices": the
+//!   profile's axes and units), applied to every absolute position, which each encoder then
+//!   rounds once (plotter units, or 3 decimals of a mm with [`fmt_mm`]) — rounding never
+//!   accumulates along a stroke. A stroke kind that the profile has no tool for is left out; a
+//!   tool that lacks what the language needs is an error ([`OutputError::Tool`]), as is a
+//!   position beyond what the language can address ([`OutputError::OutOfRange`]).
 
-use crate::toolpath::StrokeRole;
+use crate::device::{Language, Profile};
+use crate::toolpath::{SheetJob, StrokeRole};
+use glam::DVec2;
 
+pub mod gcode;
 pub mod hpgl;
 pub mod png;
 pub mod report;
 pub mod svg;
 
-/// Errors of the output stage; each names the sheet (index in the job) it happened on.
+/// Errors of the output stage. Those about a sheet name it by its number as the user sees it
+/// (1-based) when known: [`program`] does not know which sheet of the job it encodes, so the
+/// caller adds it with [`OutputError::on_sheet`].
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// The picture has a zero or non-finite size, or its pixels cannot be allocated.
@@ -28,6 +39,123 @@ pub enum OutputError {
     /// The PNG encoder refused the picture.
     #[error("sheet {sheet}: PNG encoding failed: {message}")]
     Encode { sheet: usize, message: String },
+    /// The profile's dialect is not one the encoder of its language knows.
+    #[error("device `{profile}` ({source_name}): unknown {language} dialect `{dialect}`; known: {known}")]
+    Dialect {
+        profile: String,
+        source_name: String,
+        language: &'static str,
+        dialect: String,
+        known: &'static str,
+    },
+    /// A tool of the profile lacks a setting the language needs, or has one out of range.
+    #[error("device `{profile}` ({source_name}), tool `{kind}`: {message}")]
+    Tool {
+        profile: String,
+        source_name: String,
+        kind: String,
+        message: String,
+    },
+    /// An `init` or `end` line of the profile that the language cannot carry.
+    #[error("device `{profile}` ({source_name}), {which} line `{line}`: {message}")]
+    ProfileLine {
+        profile: String,
+        source_name: String,
+        which: &'static str,
+        line: String,
+        message: String,
+    },
+    /// A position of a stroke that the device cannot address: beyond its coordinate range, or
+    /// not a number. `stroke` is 1-based in the sheet's cutting order; `value` is in device
+    /// units (plotter units, or mm for G-code).
+    #[error(
+        "{}stroke {stroke} ({role}): coordinate {value} is beyond the ±{limit} {units} that device `{profile}` can address; is a piece placed far from the sheet?",
+        sheet_prefix(.sheet)
+    )]
+    OutOfRange {
+        sheet: Option<usize>,
+        stroke: usize,
+        role: &'static str,
+        value: f64,
+        limit: f64,
+        units: &'static str,
+        profile: String,
+    },
+}
+
+fn sheet_prefix(sheet: &Option<usize>) -> String {
+    sheet.map(|s| format!("sheet {s}, ")).unwrap_or_default()
+}
+
+impl OutputError {
+    /// The same error, naming the sheet (1-based) where it has no sheet yet.
+    pub fn on_sheet(mut self, number: usize) -> Self {
+        if let OutputError::OutOfRange { sheet, .. } = &mut self {
+            sheet.get_or_insert(number);
+        }
+        self
+    }
+}
+
+/// A [`OutputError::Tool`] for the tool of `kind` in `profile`.
+pub(crate) fn tool_error(profile: &Profile, kind: &str, message: String) -> OutputError {
+    OutputError::Tool {
+        profile: profile.name.clone(),
+        source_name: profile.source.clone(),
+        kind: kind.to_string(),
+        message,
+    }
+}
+
+/// A [`OutputError::ProfileLine`] for an `init` or `end` line of `profile`.
+pub(crate) fn line_error(
+    profile: &Profile,
+    which: &'static str,
+    line: &str,
+    message: String,
+) -> OutputError {
+    OutputError::ProfileLine {
+        profile: profile.name.clone(),
+        source_name: profile.source.clone(),
+        which,
+        line: line.to_string(),
+        message,
+    }
+}
+
+/// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
+/// ([`hpgl::emit`]), or GRBL G-code ([`gcode::emit`]), by `profile.language` and
+/// `profile.dialect`.
+pub fn program(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+    match profile.language {
+        Language::Hpgl => hpgl::emit(sheet, profile),
+        Language::Gcode => gcode::emit(sheet, profile),
+    }
+}
+
+/// A point of a sheet (mm; x right, y up, origin at the lower-left corner; the sheet is
+/// `sheet_w` × `sheet_h`, for a roll `sheet_h` is the length used) in the machine's
+/// coordinates, unrounded, in device units:
+/// 1. if `axes.swap_xy`, x and y are exchanged, and so are the extents (`sheet_h` becomes the
+///    extent along X);
+/// 2. if `axes.flip_x`, X becomes extent_x − X; if `axes.flip_y`, Y becomes extent_y − Y;
+/// 3. both are multiplied by `units_per_mm`.
+///
+/// The encoders round the result once per absolute position.
+pub fn to_device(profile: &Profile, sheet_w: f64, sheet_h: f64, p: DVec2) -> DVec2 {
+    let axes = &profile.axes;
+    let (mut x, mut y, ext_x, ext_y) = if axes.swap_xy {
+        (p.y, p.x, sheet_h, sheet_w)
+    } else {
+        (p.x, p.y, sheet_w, sheet_h)
+    };
+    if axes.flip_x {
+        x = ext_x - x;
+    }
+    if axes.flip_y {
+        y = ext_y - y;
+    }
+    DVec2::new(x, y) * profile.units_per_mm
 }
 
 /// Roles in drawing order, back to front: what is drawn later lies on top.
@@ -117,6 +245,77 @@ mod tests {
         assert_eq!(fmt_mm(1.9996), "2");
         assert_eq!(fmt_mm(f64::NAN), "0");
         assert_eq!(fmt_mm(f64::INFINITY), "0");
+    }
+
+    #[test]
+    fn to_device_maps_the_corners() {
+        let base = "name='t'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\n\
+            units_per_mm=40.0\n[tools.cut]\npen=1\n[axes]\n";
+        let corners = [(0.0, 0.0), (300.0, 0.0), (300.0, 200.0), (0.0, 200.0)];
+        let map = |axes: &str| -> Vec<(f64, f64)> {
+            let p = crate::device::profile::parse(&format!("{base}{axes}"), "test.toml").unwrap();
+            corners
+                .iter()
+                .map(|&(x, y)| {
+                    let d = to_device(&p, 300.0, 200.0, DVec2::new(x, y));
+                    (d.x, d.y)
+                })
+                .collect()
+        };
+        // As is, times 40.
+        assert_eq!(
+            map(""),
+            vec![(0.0, 0.0), (12000.0, 0.0), (12000.0, 8000.0), (0.0, 8000.0)]
+        );
+        // Swapped: X from the sheet's y, Y from its x.
+        assert_eq!(
+            map("swap_xy=true\n"),
+            vec![(0.0, 0.0), (0.0, 12000.0), (8000.0, 12000.0), (8000.0, 0.0)]
+        );
+        // Mirrored within the sheet.
+        assert_eq!(
+            map("flip_x=true\n"),
+            vec![(12000.0, 0.0), (0.0, 0.0), (0.0, 8000.0), (12000.0, 8000.0)]
+        );
+        assert_eq!(
+            map("flip_y=true\n"),
+            vec![(0.0, 8000.0), (12000.0, 8000.0), (12000.0, 0.0), (0.0, 0.0)]
+        );
+        // Roll cutter: swap, then Y mirrored across the swapped extent (the sheet's width).
+        assert_eq!(
+            map("swap_xy=true\nflip_y=true\n"),
+            vec![(0.0, 12000.0), (0.0, 0.0), (8000.0, 0.0), (8000.0, 12000.0)]
+        );
+        // Swap then mirror X uses the sheet's height as X's extent; unrounded.
+        let p = crate::device::profile::parse(
+            &format!("{base}swap_xy=true\nflip_x=true\n"),
+            "test.toml",
+        )
+        .unwrap();
+        let d = to_device(&p, 300.0, 200.0, DVec2::new(0.01, 0.0125));
+        assert!((d.x - (200.0 - 0.0125) * 40.0).abs() < 1e-9);
+        assert!((d.y - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn program_dispatches_on_language() {
+        let sheet = SheetJob {
+            width: 10.0,
+            height: 10.0,
+            strokes: vec![],
+        };
+        let hpgl = crate::device::profile::parse(
+            "name='h'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n[tools.cut]\npen=1\n",
+            "test.toml",
+        )
+        .unwrap();
+        assert_eq!(program(&sheet, &hpgl).unwrap(), b"IN;\nPU;SP0;\n");
+        let gcode = crate::device::profile::parse(
+            "name='g'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\n[tools.cut]\npower=1\nspeed=1\n",
+            "test.toml",
+        )
+        .unwrap();
+        assert_eq!(program(&sheet, &gcode).unwrap(), b"G21\nG90\nG94\nM5\nM2\n");
     }
 
     #[test]
