@@ -402,3 +402,105 @@ fn a_plain_program_with_kernel_xon_xoff_streams_into_flatcut_sim() {
     assert_eq!(steps, moves - 1);
     assert!(dir.join("sim.png").is_file());
 }
+
+/// The name the simulator gives the tool of `kind`: the first tool (in the profile's order)
+/// it cannot tell apart from it — same pen and force (HP-GL), same Z, servo or power (G-code).
+fn sim_name(p: &Profile, kind: &str) -> String {
+    let t = &p.tools[kind];
+    let key = |u: &profile::Tool| (u.pen, u.force, u.z_down, u.servo_down, u.power);
+    p.tools
+        .iter()
+        .find(|(_, u)| key(u) == key(t))
+        .map(|(k, _)| k.clone())
+        .unwrap()
+}
+
+#[test]
+fn every_bundled_profile_cuts_the_house_through_the_simulator() {
+    use flatcut::toolpath::StrokeKind;
+    let spec = flatcut::spec::load(&manifest("patterns/house.toml")).unwrap();
+    for (file, _) in profile::BUNDLED {
+        let name = file.trim_end_matches(".toml");
+        let p = profile::find(name).unwrap();
+        let out = scratch(&format!("profile-{name}"));
+        let o = flatcut(&[
+            "cut",
+            "patterns/house.toml",
+            "--device",
+            name,
+            "--simulate",
+            "--sim-speed",
+            "0",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let rep: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("sim.json")).unwrap())
+                .unwrap();
+        assert_eq!(rep["overruns"], 0, "{name}");
+        assert_eq!(rep["flow_violations"], 0, "{name}");
+        assert!(rep["tool_down_at_end"].is_null(), "{name}");
+        assert!(out.join("sim.png").is_file(), "{name}");
+
+        // What the job asked for, in device units, per tool, with passes.
+        let (_, _, job) = flatcut::cli::cut::plan_job(&spec, &p, true).unwrap();
+        assert_eq!(job.sheets.len(), 1);
+        let sheet = &job.sheets[0];
+        let hpgl = p.language == flatcut::device::Language::Hpgl;
+        let round = |v: f64| {
+            if hpgl {
+                v.round()
+            } else {
+                (v * 1000.0).round() / 1000.0
+            }
+        };
+        let mut expected: Vec<(String, Vec<[f64; 2]>)> = Vec::new();
+        for s in &sheet.strokes {
+            let kind: StrokeKind = s.role.kind();
+            let Some(tool) = p.tool(kind) else { continue };
+            let mut pts: Vec<[f64; 2]> = s
+                .points
+                .iter()
+                .map(|q| {
+                    let d = flatcut::output::to_device(&p, sheet.width, sheet.height, *q);
+                    [round(d.x), round(d.y)]
+                })
+                .collect();
+            pts.dedup();
+            let passes = tool.passes.unwrap_or(1) as usize;
+            let tool_name = sim_name(&p, kind.name());
+            if pts.len() > 1 && pts.first() == pts.last() {
+                let mut all = pts.clone();
+                for _ in 1..passes {
+                    all.extend_from_slice(&pts[1..]);
+                }
+                expected.push((tool_name, all));
+            } else {
+                for _ in 0..passes {
+                    expected.push((tool_name.clone(), pts.clone()));
+                }
+            }
+        }
+        let got = rep["paths"].as_array().unwrap();
+        assert_eq!(got.len(), expected.len(), "{name}: path count");
+        let tol = if hpgl { 1.0 } else { 0.002 };
+        for (k, (g, (tool, pts))) in got.iter().zip(&expected).enumerate() {
+            assert_eq!(g["tool"].as_str().unwrap(), tool, "{name}: path {k}");
+            let gp: Vec<[f64; 2]> = g["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|q| [q[0].as_f64().unwrap(), q[1].as_f64().unwrap()])
+                .collect();
+            assert_eq!(gp.len(), pts.len(), "{name}: path {k} points");
+            for (a, b) in gp.iter().zip(pts) {
+                assert!(
+                    (a[0] - b[0]).abs() <= tol && (a[1] - b[1]).abs() <= tol,
+                    "{name}: path {k}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}

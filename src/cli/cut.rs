@@ -43,6 +43,40 @@ pub fn default_dir(name: &str) -> PathBuf {
     Path::new("out").join(name)
 }
 
+/// Spec → pieces → layout → job for a device: what `cut` sends (the device decides which
+/// stroke kinds are drawn at all).
+pub fn plan_job(
+    spec: &crate::spec::Spec,
+    profile: &crate::device::Profile,
+    quiet: bool,
+) -> Result<
+    (
+        Vec<crate::flatten::Flat>,
+        crate::nest::Layout,
+        crate::toolpath::Job,
+    ),
+    Error,
+> {
+    let (flats, pieces) = super::pieces(spec, quiet)?;
+    let nest_opts = crate::nest::NestOptions {
+        width: spec.sheet.width,
+        height: spec.sheet.height,
+        margin: spec.sheet.margin,
+        spacing: spec.sheet.spacing,
+    };
+    let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
+        file: spec.path.clone(),
+        source: Box::new(e.into()),
+    })?;
+    let tp = ToolpathOptions {
+        skip_folds: profile.tool(StrokeKind::Score).is_none(),
+        skip_drawing: profile.tool(StrokeKind::Draw).is_none(),
+    };
+    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+
+    Ok((flats, layout, job))
+}
+
 pub fn run(a: &CutArgs) -> Result<(), Error> {
     let mut spec = crate::spec::load(&a.input)?;
     if let Some(m) = a.material {
@@ -60,22 +94,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
             profile.name
         )));
     }
-    let (flats, pieces) = super::pieces(&spec, a.quiet)?;
-    let nest_opts = crate::nest::NestOptions {
-        width: spec.sheet.width,
-        height: spec.sheet.height,
-        margin: spec.sheet.margin,
-        spacing: spec.sheet.spacing,
-    };
-    let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
-        file: spec.path.clone(),
-        source: Box::new(e.into()),
-    })?;
-    let tp = ToolpathOptions {
-        skip_folds: profile.tool(StrokeKind::Score).is_none(),
-        skip_drawing: profile.tool(StrokeKind::Draw).is_none(),
-    };
-    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+    let (flats, layout, job) = plan_job(&spec, &profile, a.quiet)?;
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;

@@ -1,6 +1,6 @@
 //! The simulated cutter's HP-GL interpreter: the subset that flatcut's encoders and common
 //! cutter drivers send — `IN`, `DF`, `SP`, `PU`, `PD`, `PA`, `PR`, `VS`, `FS` — executed as a
-//! plotter would; anything else is ignored and counted by name, as HP-GL devices do with
+//! plotter would (and Roland's `!FS` force); anything else is ignored and counted by name, as HP-GL devices do with
 //! instructions they do not know (HP 7475A Interfacing and Programming Manual, ch. 14: an
 //! unknown instruction sets error 1 and is skipped).
 //!
@@ -69,8 +69,9 @@ pub fn executable_prefix<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<(u
 #[derive(Debug, Clone)]
 pub struct Hpgl {
     units_per_mm: f64,
-    /// Pen number → stroke kind name, from the profile's tool table.
-    pens: BTreeMap<u32, String>,
+    /// Pen number → (stroke kind, force) of the tools using it, from the profile's tool table.
+    pens: BTreeMap<u32, Vec<(String, Option<f64>)>>,
+    force: Option<f64>,
     /// Pen number → default speed from the profile, cm/s.
     pen_speed: BTreeMap<u32, f64>,
     pos: DVec2,
@@ -91,7 +92,9 @@ impl Hpgl {
         let mut pen_speed = BTreeMap::new();
         for (kind, tool) in &profile.tools {
             if let Some(p) = tool.pen {
-                pens.entry(p).or_insert_with(|| kind.clone());
+                pens.entry(p)
+                    .or_insert_with(Vec::new)
+                    .push((kind.clone(), tool.force));
                 if let Some(s) = tool.speed {
                     pen_speed.entry(p).or_insert(s);
                 }
@@ -100,6 +103,7 @@ impl Hpgl {
         Hpgl {
             units_per_mm: profile.units_per_mm,
             pens,
+            force: None,
             pen_speed,
             pos: DVec2::ZERO,
             down: false,
@@ -112,16 +116,27 @@ impl Hpgl {
         }
     }
 
+    /// The stroke kind of the tool in use: the profile's tool with this pen; where several
+    /// share the pen (one knife holder, different forces), the one whose force is nearest the
+    /// last `FS`.
     fn tool_name(&self) -> Option<String> {
         if self.pen == 0 {
             return None;
         }
-        Some(
-            self.pens
-                .get(&self.pen)
-                .cloned()
-                .unwrap_or_else(|| format!("pen {}", self.pen)),
-        )
+        let Some(tools) = self.pens.get(&self.pen) else {
+            return Some(format!("pen {}", self.pen));
+        };
+        let mut best: Option<(f64, &String)> = None;
+        for (name, force) in tools {
+            let d = match (self.force, force) {
+                (Some(a), Some(b)) => (a - b).abs(),
+                _ => 0.0,
+            };
+            if best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, name));
+            }
+        }
+        best.map(|(_, n)| n.clone())
     }
 
     fn speed_units_s(&self, down: bool) -> f64 {
@@ -165,6 +180,7 @@ impl Hpgl {
                 if op == "IN" {
                     self.lift();
                     self.pen = 0;
+                    self.force = None;
                 }
                 self.relative = false;
                 self.speed_cm_s = None;
@@ -184,6 +200,9 @@ impl Hpgl {
                 self.moves(&nums)
             }
             "PD" => {
+                if self.down && self.tool_name().as_deref() != self.current_tool() {
+                    self.rec.up();
+                }
                 self.down = true;
                 if let Some(t) = self.tool_name() {
                     self.rec.down(&t, self.pos);
@@ -194,13 +213,21 @@ impl Hpgl {
                 self.speed_cm_s = nums.first().copied().filter(|v| *v > 0.0);
                 0.0
             }
-            "FS" => 0.0,
+            "FS" | "!FS" => {
+                // The new force applies from the next pen-down, as on cutters.
+                self.force = nums.first().copied().filter(|v| *v >= 0.0);
+                0.0
+            }
             _ => {
                 self.instructions -= 1;
                 *self.ignored.entry(op).or_default() += 1;
                 0.0
             }
         }
+    }
+
+    fn current_tool(&self) -> Option<&str> {
+        self.rec.open_tool()
     }
 
     /// The tool that is down now, if any.

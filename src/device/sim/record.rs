@@ -51,6 +51,15 @@ impl Recorder {
         self.open = true;
     }
 
+    /// The tool of the path being drawn, if one is open.
+    pub fn open_tool(&self) -> Option<&str> {
+        if self.open {
+            self.paths.last().map(|p| p.tool.as_str())
+        } else {
+            None
+        }
+    }
+
     /// The tool is lifted.
     pub fn up(&mut self) {
         self.open = false;
