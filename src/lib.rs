@@ -41,8 +41,9 @@ pub enum Error {
     Profile(#[from] device::ProfileError),
     #[error(transparent)]
     Serial(#[from] device::serial::SerialError),
+    /// Boxed: it carries the job position and is much larger than the other variants.
     #[error(transparent)]
-    Stream(#[from] device::stream::StreamError),
+    Stream(Box<device::stream::StreamError>),
     #[error(transparent)]
     Sim(#[from] device::sim::SimError),
     #[error("{}: cannot write: {source}", path.display())]
@@ -63,6 +64,12 @@ pub enum Error {
     },
     #[error("{0}")]
     Usage(String),
+}
+
+impl From<device::stream::StreamError> for Error {
+    fn from(e: device::stream::StreamError) -> Self {
+        Error::Stream(Box::new(e))
+    }
 }
 
 impl Error {

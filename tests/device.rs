@@ -82,7 +82,11 @@ fn check_flow(flow: &str) {
     assert_eq!(rep.flow_violations, 0, "{flow}: host ignored a stop");
     assert!(rep.max_buffer_fill <= 256);
     if flow == "xon-xoff" {
-        assert!(rep.xoff_sent > 10, "flow control never acted: {}", rep.xoff_sent);
+        assert!(
+            rep.xoff_sent > 10,
+            "flow control never acted: {}",
+            rep.xoff_sent
+        );
         assert!(r.xoff_received > 10);
     }
     // Every move was drawn: one path, one step per PD after the first (which is at 0,0).
@@ -104,7 +108,6 @@ fn one_megabyte_over_rts_cts_into_256_bytes() {
 #[test]
 fn a_host_that_ignores_xoff_is_caught() {
     // Write straight into the pty, ignoring XOFF: the simulator must see the violation.
-    use std::io::Write;
     let p = hpgl_profile(115_200, "xon-xoff", 256);
     let mut cfg = SimConfig::new(p.clone());
     cfg.time_factor = Some(1.0);
@@ -154,7 +157,13 @@ fn grbl_character_counting_never_exceeds_128_bytes() {
     let p = grbl_profile("grbl-character-counting");
     let job = gcode_job(60);
     // ×20: a 10 mm side takes 10 ms, so the planner fills and lines wait in the buffer.
-    let (r, rep) = run(&p, job.as_bytes(), Some(20.0), Faults::default(), &opts(10.0));
+    let (r, rep) = run(
+        &p,
+        job.as_bytes(),
+        Some(20.0),
+        Faults::default(),
+        &opts(10.0),
+    );
     let r = r.unwrap();
     assert_eq!(rep.overruns, 0, "more than 128 bytes outstanding");
     assert!(rep.max_buffer_fill <= 128);
@@ -178,7 +187,6 @@ fn grbl_character_counting_never_exceeds_128_bytes() {
 #[test]
 fn a_naive_grbl_host_overruns_the_simulated_buffer() {
     // The check must be able to fail: pour a job in without counting.
-    use std::io::Write;
     let p = grbl_profile("grbl-character-counting");
     let mut cfg = SimConfig::new(p.clone());
     cfg.time_factor = Some(1.0);
@@ -217,8 +225,21 @@ fn grbl_error_stops_the_job_with_line_meaning_and_tool_up() {
     let (r, rep) = run(&p, job.as_bytes(), Some(50.0), faults, &opts(10.0));
     let e = r.unwrap_err();
     let msg = e.to_string();
-    assert!(matches!(e, StreamError::Grbl { code: 20, line: 30, .. }), "{msg}");
-    assert!(msg.contains("error:20") && msg.contains("unsupported"), "{msg}");
+    assert!(
+        matches!(
+            e,
+            StreamError::Grbl {
+                code: 20,
+                line: 30,
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("error:20") && msg.contains("unsupported"),
+        "{msg}"
+    );
     let text = job.lines().nth(29).unwrap();
     assert!(msg.contains(text), "{msg}");
     assert!(msg.contains("tool lifted"), "{msg}");
@@ -437,8 +458,7 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         let rep: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("sim.json")).unwrap())
-                .unwrap();
+            serde_json::from_str(&std::fs::read_to_string(out.join("sim.json")).unwrap()).unwrap();
         assert_eq!(rep["overruns"], 0, "{name}");
         assert_eq!(rep["flow_violations"], 0, "{name}");
         assert!(rep["tool_down_at_end"].is_null(), "{name}");
@@ -503,4 +523,45 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
             }
         }
     }
+}
+
+#[test]
+fn ctrl_c_stops_the_stream_lifts_the_tool_and_says_where() {
+    use std::process::{Command, Stdio};
+    let dir = scratch("ctrl-c");
+    let (prog, _) = big_hpgl(60_000);
+    let file = dir.join("long.plt");
+    std::fs::write(&file, &prog).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_flatcut"))
+        .args([
+            "send",
+            file.to_str().unwrap(),
+            "--device",
+            "sim",
+            "--sim-speed",
+            "1",
+            "-o",
+        ])
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let o = child.wait_with_output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("stopped by Ctrl-C"), "{err}");
+    assert!(err.contains("tool lifted"), "{err}");
+    assert!(err.contains("byte"), "{err}");
+    // The simulator's record is still written, and the knife is up.
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("sim.json")).unwrap()).unwrap();
+    assert!(rep["tool_down_at_end"].is_null(), "{rep}");
+    assert!(rep["bytes_received"].as_u64().unwrap() < prog.len() as u64);
 }

@@ -160,7 +160,10 @@ pub fn write_sim(
     if stem == "sim" {
         return Ok((png, json));
     }
-    let (p2, j2) = (dir.join(format!("{stem}.png")), dir.join(format!("{stem}.json")));
+    let (p2, j2) = (
+        dir.join(format!("{stem}.png")),
+        dir.join(format!("{stem}.json")),
+    );
     for (a, b) in [(&png, &p2), (&json, &j2)] {
         std::fs::rename(a, b).map_err(|source| Error::Write {
             path: b.clone(),

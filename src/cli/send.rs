@@ -27,9 +27,8 @@ pub struct SendArgs {
 
 pub fn run(a: &SendArgs) -> Result<(), Error> {
     let profile = crate::device::profile::find(&a.device)?;
-    let bytes = std::fs::read(&a.file).map_err(|e| {
-        Error::Usage(format!("{}: cannot read: {e}", a.file.display()))
-    })?;
+    let bytes = std::fs::read(&a.file)
+        .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", a.file.display())))?;
     let ext = a
         .file
         .extension()
@@ -49,9 +48,15 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         )));
     }
     if bytes.is_empty() {
-        return Err(Error::Usage(format!("{}: the file is empty", a.file.display())));
+        return Err(Error::Usage(format!(
+            "{}: the file is empty",
+            a.file.display()
+        )));
     }
-    let dir = a.output.clone().unwrap_or_else(|| PathBuf::from("out/send"));
+    let dir = a
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/send"));
     if super::link::simulated(&profile, &a.link) {
         super::create_dir(&dir)?;
     }

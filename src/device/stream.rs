@@ -22,6 +22,10 @@
 //! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
 //! GRBL status is polled with `?` at most five times a second while the bar is shown.
 
+// A stream error carries the job position for the user; it happens at most once per job, so
+// its size on the error path does not matter.
+#![allow(clippy::result_large_err)]
+
 use super::grbl::{self as proto, Response};
 use super::profile::{FlowControl, Language, Profile, Protocol};
 use super::serial::Link;
@@ -123,7 +127,9 @@ pub enum StreamError {
         at: Position,
         tool: ToolState,
     },
-    #[error("{port}: GRBL answered error:{code} ({meaning}) to line {line} `{text}` ({at}; {tool})")]
+    #[error(
+        "{port}: GRBL answered error:{code} ({meaning}) to line {line} `{text}` ({at}; {tool})"
+    )]
     Grbl {
         port: String,
         code: u32,
@@ -516,7 +522,9 @@ impl<'a> Grbl<'a> {
         let mut lines = Vec::new();
         let mut at = 0;
         for l in program.split(|&b| b == b'\n') {
-            let text = String::from_utf8_lossy(l).trim_end_matches('\r').to_string();
+            let text = String::from_utf8_lossy(l)
+                .trim_end_matches('\r')
+                .to_string();
             if !text.trim().is_empty() {
                 lines.push((at, text));
             }

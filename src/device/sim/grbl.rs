@@ -29,9 +29,20 @@ pub const RAPID_MM_MIN: f64 = 6000.0;
 
 #[derive(Debug, Clone)]
 enum ToolRule {
-    Knife { name: String, z_down: f64, z_up: f64 },
-    Servo { name: String, down: f64, up: f64 },
-    Laser { name: String, power: f64 },
+    Knife {
+        name: String,
+        z_down: f64,
+        z_up: f64,
+    },
+    Servo {
+        name: String,
+        down: f64,
+        up: f64,
+    },
+    Laser {
+        name: String,
+        power: f64,
+    },
 }
 
 /// A GRBL controller's parser state (not its buffers: those are the simulator's).
@@ -117,8 +128,9 @@ impl Grbl {
                 ToolRule::Servo { name, down, up } => (self.spindle_on
                     && (self.s - down).abs() < (self.s - up).abs())
                 .then(|| ((self.s - down).abs(), name)),
-                ToolRule::Laser { name, power } => (self.spindle_on && self.s > 0.0 && g1)
-                    .then(|| ((self.s - power).abs(), name)),
+                ToolRule::Laser { name, power } => {
+                    (self.spindle_on && self.s > 0.0 && g1).then(|| ((self.s - power).abs(), name))
+                }
             };
             if let Some((d, n)) = candidate {
                 if best.is_none_or(|(b, _)| d < b) {
@@ -184,7 +196,9 @@ impl Grbl {
             }
             let start = i + 1;
             let mut j = start;
-            while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'.' || b[j] == b'-' || b[j] == b'+') {
+            while j < b.len()
+                && (b[j].is_ascii_digit() || b[j] == b'.' || b[j] == b'-' || b[j] == b'+')
+            {
                 j += 1;
             }
             let v: f64 = text[start..j].parse().map_err(|_| 2u32)?;
@@ -193,8 +207,11 @@ impl Grbl {
         }
         let mut motion: Option<bool> = None;
         let mut dwell = false;
-        let (mut units, mut distance, mut spindle): (Option<bool>, Option<bool>, Option<Option<bool>>) =
-            (None, None, None);
+        let (mut units, mut distance, mut spindle): (
+            Option<bool>,
+            Option<bool>,
+            Option<Option<bool>>,
+        ) = (None, None, None);
         let mut end = false;
         let mut seen = [false; 26];
         let (mut x, mut y, mut z, mut f, mut s, mut p) = (None, None, None, None, None, None);
@@ -310,7 +327,11 @@ impl Grbl {
                 Some(v) => v * scale,
                 None => cur,
             };
-            let target = DVec3::new(coord(x, self.pos.x), coord(y, self.pos.y), coord(z, self.pos.z));
+            let target = DVec3::new(
+                coord(x, self.pos.x),
+                coord(y, self.pos.y),
+                coord(z, self.pos.z),
+            );
             let rate = if self.g1 {
                 self.feed.unwrap_or(RAPID_MM_MIN)
             } else {
@@ -335,7 +356,8 @@ impl Grbl {
     fn move_to(&mut self, target: DVec3) {
         let from = self.pos;
         // A Z move: the tool state changes at the end of it.
-        if (target.z - from.z).abs() > 0.0 && (target.truncate() - from.truncate()).length() == 0.0 {
+        if (target.z - from.z).abs() > 0.0 && (target.truncate() - from.truncate()).length() == 0.0
+        {
             self.pos = target;
             self.sync_tool();
             return;
@@ -435,7 +457,17 @@ mod tests {
     #[test]
     fn knife_paths_and_errors() {
         let mut g = Grbl::new(&knife());
-        for l in ["G21", "G90", "G94", "G0 Z2", "G0 X10 Y10", "G1 Z-1 F600", "G1 X20", "G1 Y20", "G0 Z2"] {
+        for l in [
+            "G21",
+            "G90",
+            "G94",
+            "G0 Z2",
+            "G0 X10 Y10",
+            "G1 Z-1 F600",
+            "G1 X20",
+            "G1 Y20",
+            "G0 Z2",
+        ] {
             g.execute(l).unwrap();
         }
         for l in ["G0 X0 Y0", "G1 Z-0.3 F900", "G1 X5", "G0 Z2"] {
@@ -443,10 +475,16 @@ mod tests {
         }
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "cut");
-        assert_eq!(g.rec.paths[0].points, vec![[10.0, 10.0], [20.0, 10.0], [20.0, 20.0]]);
+        assert_eq!(
+            g.rec.paths[0].points,
+            vec![[10.0, 10.0], [20.0, 10.0], [20.0, 20.0]]
+        );
         assert_eq!(g.rec.paths[1].tool, "score");
         // 10 mm at 600 mm/min = 1 s.
-        assert_eq!(g.execute("G0 Z-1").unwrap(), Effect::Motion(3.0 / RAPID_MM_MIN * 60.0));
+        assert_eq!(
+            g.execute("G0 Z-1").unwrap(),
+            Effect::Motion(3.0 / RAPID_MM_MIN * 60.0)
+        );
         assert_eq!(g.execute("G1 X15").unwrap(), Effect::Motion(1.0));
 
         let mut fresh = Grbl::new(&knife());
@@ -476,12 +514,26 @@ mod tests {
         )
         .unwrap();
         let mut g = Grbl::new(&p);
-        for l in ["G0 X1 Y1", "M4 S200", "G1 X2 F1500", "G1 Y2", "M5", "G0 X5", "M4 S1000", "G0 X6", "G1 X7 F300", "M5"] {
+        for l in [
+            "G0 X1 Y1",
+            "M4 S200",
+            "G1 X2 F1500",
+            "G1 Y2",
+            "M5",
+            "G0 X5",
+            "M4 S1000",
+            "G0 X6",
+            "G1 X7 F300",
+            "M5",
+        ] {
             g.execute(l).unwrap();
         }
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "draw");
-        assert_eq!(g.rec.paths[0].points, vec![[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]);
+        assert_eq!(
+            g.rec.paths[0].points,
+            vec![[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]
+        );
         assert_eq!(g.rec.paths[1].tool, "cut");
         assert_eq!(g.rec.paths[1].points, vec![[6.0, 1.0], [7.0, 1.0]]);
     }

@@ -171,7 +171,10 @@ impl Hpgl {
             .map(|s| s.parse::<f64>().ok().filter(|v| v.is_finite()))
             .collect();
         let Some(nums) = nums else {
-            *self.ignored.entry(format!("{op} (bad parameters)")).or_default() += 1;
+            *self
+                .ignored
+                .entry(format!("{op} (bad parameters)"))
+                .or_default() += 1;
             return 0.0;
         };
         self.instructions += 1;
@@ -285,7 +288,12 @@ mod tests {
         assert_eq!(m.rec.paths[1].tool, "cut");
         assert_eq!(
             m.rec.paths[1].points,
-            vec![[400.0, 400.0], [800.0, 400.0], [800.0, 800.0], [400.0, 400.0]]
+            vec![
+                [400.0, 400.0],
+                [800.0, 400.0],
+                [800.0, 800.0],
+                [400.0, 400.0]
+            ]
         );
         assert_eq!(m.ignored.get("ZZ"), Some(&1));
         // Travel: origin→(40,40), (80,40)→(400,400).
@@ -295,7 +303,10 @@ mod tests {
 
     #[test]
     fn partial_instructions_execute_whole_pairs() {
-        assert_eq!(executable_prefix(b"PD10,20,30,40,5".iter()), Some((14, *b"PD")));
+        assert_eq!(
+            executable_prefix(b"PD10,20,30,40,5".iter()),
+            Some((14, *b"PD"))
+        );
         assert_eq!(executable_prefix(b" pu1,2,".iter()), Some((7, *b"PU")));
         assert_eq!(executable_prefix(b"PD10,20".iter()), None);
         assert_eq!(executable_prefix(b"SP1".iter()), None);

@@ -5,7 +5,8 @@
 //! What it models, and the choices made where no device documentation decides:
 //! - **The wire.** A pty has no baud rate, so the simulator takes bytes off the master side
 //!   no faster than the profile's line would carry them (baud / 10 bytes a second, 8N1).
-//!   Bytes still in the pty are bytes the host has not put on the wire yet.
+//!   Bytes still in the pty are bytes the host has not put on the wire yet. Its answers go
+//!   back at the same rate; XON and XOFF go at once, ahead of queued answers.
 //! - **The input buffer.** `profile.buffer` bytes (GRBL: its 128-byte receive buffer). A byte
 //!   that arrives when it is full is lost and counted as an *overrun*, as a UART would.
 //! - **Flow control.** XON/XOFF: XOFF (0x13) when the free space falls to a quarter of the
@@ -225,6 +226,43 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
 
 use serialport::SerialPort;
 
+/// One direction of a serial line: bytes complete one every `1 / rate` seconds.
+struct Line {
+    byte_time: f64,
+    /// When the last byte taken finished arriving.
+    busy_until: Instant,
+}
+
+impl Line {
+    fn new(rate: f64) -> Line {
+        Line {
+            byte_time: 1.0 / rate,
+            busy_until: Instant::now(),
+        }
+    }
+
+    /// How many of `waiting` bytes have finished crossing the line by `now`.
+    fn ready(&mut self, now: Instant, waiting: usize) -> usize {
+        if waiting == 0 {
+            return 0;
+        }
+        if self.busy_until < now {
+            // Idle since the last byte: the clock cannot run ahead of the first sight of the
+            // next one, except for what the loop's own sleep hid (a quarter millisecond).
+            let floor = now - Duration::from_micros(250);
+            if self.busy_until < floor {
+                self.busy_until = floor;
+            }
+        }
+        let elapsed = now.saturating_duration_since(self.busy_until).as_secs_f64();
+        ((elapsed / self.byte_time) as usize).min(waiting)
+    }
+
+    fn took(&mut self, n: usize) {
+        self.busy_until += Duration::from_secs_f64(n as f64 * self.byte_time);
+    }
+}
+
 enum Interp {
     Hpgl(hpgl::Hpgl),
     Grbl(grbl::Grbl),
@@ -256,7 +294,11 @@ struct Device {
     garbage_sent: bool,
     stalled: bool,
     rep: SimReport,
+    /// Answers produced, then queued for the line.
     out: Vec<u8>,
+    tx: VecDeque<u8>,
+    /// Flow-control characters, sent at once.
+    urgent: Vec<u8>,
 }
 
 impl Device {
@@ -313,15 +355,18 @@ impl Device {
             stalled: false,
             rep,
             out: Vec::new(),
+            tx: VecDeque::new(),
+            urgent: Vec::new(),
             cfg,
         }
     }
 
     fn run(mut self) -> SimReport {
         let rate = self.cfg.profile.serial.baud.max(1) as f64 / 10.0;
-        // The wire may carry a small burst after an idle moment (the host's UART FIFO).
-        let burst = (rate * 0.002).max(SKID as f64);
-        let mut credit = 0.0f64;
+        // Line clocks: when the byte now on each wire will have arrived. A byte that finds
+        // the line idle starts when it is first seen, so it still takes its ten bit times.
+        let mut rx_line = Line::new(rate);
+        let mut tx_line = Line::new(rate);
         let mut last = Instant::now();
         let mut quiet_since = Instant::now();
         let mut buf = vec![0u8; 4096];
@@ -334,13 +379,16 @@ impl Device {
             let now = Instant::now();
             let dt = now.duration_since(last).as_secs_f64();
             last = now;
-            credit = (credit + dt * rate).min(burst);
 
             // Receive.
-            let Some(waiting) = self.master.as_mut().map(|m| m.bytes_to_read().unwrap_or(0) as usize) else {
+            let Some(waiting) = self
+                .master
+                .as_mut()
+                .map(|m| m.bytes_to_read().unwrap_or(0) as usize)
+            else {
                 break;
             };
-            let mut allowance = credit.floor() as usize;
+            let mut allowance = rx_line.ready(now, waiting);
             if self.stopped {
                 allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
                 self.watch_backlog(waiting);
@@ -357,7 +405,7 @@ impl Device {
                 };
                 match master.read(&mut buf[..n]) {
                     Ok(k) => {
-                        credit -= k as f64;
+                        rx_line.took(k);
                         quiet_since = now;
                         for &b in &buf[..k] {
                             self.receive(b);
@@ -383,10 +431,16 @@ impl Device {
                 self.execute();
             }
             self.flow_control();
-            if !self.out.is_empty() {
-                let out = std::mem::take(&mut self.out);
+            // Answers go back at the line rate too (XON/XOFF jump the queue, as a UART
+            // sends its flow-control characters ahead of pending data).
+            self.tx.extend(self.out.drain(..));
+            let mut send: Vec<u8> = std::mem::take(&mut self.urgent);
+            let k = tx_line.ready(now, self.tx.len());
+            send.extend(self.tx.drain(..k));
+            tx_line.took(k);
+            if !send.is_empty() {
                 if let Some(m) = self.master.as_mut() {
-                    if m.write_all(&out).is_err() {
+                    if m.write_all(&send).is_err() {
                         self.rep.ended = "host closed".into();
                         break;
                     }
@@ -396,13 +450,14 @@ impl Device {
             if ctl == FINISH
                 && (self.stalled
                     || (waiting == n && !self.has_complete_input() && self.motion.is_empty()))
+                && self.tx.is_empty()
                 && now.duration_since(quiet_since) > Duration::from_millis(30)
             {
                 self.rep.unexecuted_bytes = self.rx.len();
                 self.rep.ended = "finished".into();
                 break;
             }
-            let busy = n > 0 || (!self.rx.is_empty() && !self.stalled);
+            let busy = n > 0 || !self.tx.is_empty() || (!self.rx.is_empty() && !self.stalled);
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
         self.close()
@@ -610,7 +665,7 @@ impl Device {
                     self.taken_since_stop = 0;
                     self.backlog_at_grace = None;
                     if self.flow == FlowControl::XonXoff {
-                        self.out.push(XOFF);
+                        self.urgent.push(XOFF);
                         self.rep.xoff_sent += 1;
                     } else {
                         self.cts.store(false, Ordering::SeqCst);
@@ -621,7 +676,7 @@ impl Device {
                             // The XON is lost on the line: the device believes it sent it.
                             self.xon_lost = true;
                         } else {
-                            self.out.push(XON);
+                            self.urgent.push(XON);
                             self.rep.xon_sent += 1;
                         }
                     } else {
