@@ -499,16 +499,25 @@ mod tests {
     #[test]
     fn unknown_dialect_and_unusable_tools_are_errors() {
         let sheet = job(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]);
-        let p = parse_profile(&PENS.replace("'hp-gl'", "'dmpl'"), "test.toml").unwrap();
+        // Profiles are validated when read; a profile built in code still meets these checks.
+        let mut p = parse_profile(PENS, "test.toml").unwrap();
+        p.dialect = "dmpl".into();
         let e = emit(&sheet, &p).unwrap_err().to_string();
         assert!(
             e.contains("hpgl-pens") && e.contains("`dmpl`") && e.contains("camm-gl2"),
             "{e}"
         );
-        let p = parse_profile(&PENS.replace("pen=1", "speed=3"), "test.toml").unwrap();
+        let mut p = parse_profile(PENS, "test.toml").unwrap();
+        if let Some(t) = p.tools.get_mut("cut") {
+            t.pen = None;
+            t.speed = Some(3.0);
+        }
         let e = emit(&sheet, &p).unwrap_err().to_string();
         assert!(e.contains("tool `cut`") && e.contains("`pen`"), "{e}");
-        let p = parse_profile(&PENS.replace("pen=1", "pen=1\npasses=0"), "t.toml").unwrap();
+        let mut p = parse_profile(PENS, "t.toml").unwrap();
+        if let Some(t) = p.tools.get_mut("cut") {
+            t.passes = Some(0);
+        }
         assert!(emit(&sheet, &p).unwrap_err().to_string().contains("passes"));
     }
 

@@ -311,7 +311,7 @@ mod tests {
         .unwrap();
         assert_eq!(program(&sheet, &hpgl).unwrap(), b"IN;\nPU;SP0;\n");
         let gcode = crate::device::profile::parse(
-            "name='g'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\n[tools.cut]\npower=1\nspeed=1\n",
+            "name='g'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nmax_power=1000\n[tools.cut]\npower=1\nspeed=1\n",
             "test.toml",
         )
         .unwrap();

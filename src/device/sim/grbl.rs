@@ -480,12 +480,15 @@ mod tests {
             vec![[10.0, 10.0], [20.0, 10.0], [20.0, 20.0]]
         );
         assert_eq!(g.rec.paths[1].tool, "score");
-        // 10 mm at 600 mm/min = 1 s.
+        // Z 2 → -1 at the rapid rate; then 10 mm at the last feed, 900 mm/min.
         assert_eq!(
             g.execute("G0 Z-1").unwrap(),
             Effect::Motion(3.0 / RAPID_MM_MIN * 60.0)
         );
-        assert_eq!(g.execute("G1 X15").unwrap(), Effect::Motion(1.0));
+        assert_eq!(
+            g.execute("G1 X15").unwrap(),
+            Effect::Motion(10.0 / 900.0 * 60.0)
+        );
 
         let mut fresh = Grbl::new(&knife());
         assert_eq!(fresh.execute("G1 X1"), Err(22));
@@ -535,6 +538,6 @@ mod tests {
             vec![[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]
         );
         assert_eq!(g.rec.paths[1].tool, "cut");
-        assert_eq!(g.rec.paths[1].points, vec![[6.0, 1.0], [7.0, 1.0]]);
+        assert_eq!(g.rec.paths[1].points, vec![[6.0, 2.0], [7.0, 2.0]]);
     }
 }

@@ -231,6 +231,8 @@ struct Line {
     byte_time: f64,
     /// When the last byte taken finished arriving.
     busy_until: Instant,
+    /// Nothing was waiting at the last look.
+    idle: bool,
 }
 
 impl Line {
@@ -238,17 +240,20 @@ impl Line {
         Line {
             byte_time: 1.0 / rate,
             busy_until: Instant::now(),
+            idle: true,
         }
     }
 
     /// How many of `waiting` bytes have finished crossing the line by `now`.
     fn ready(&mut self, now: Instant, waiting: usize) -> usize {
         if waiting == 0 {
+            self.idle = true;
             return 0;
         }
-        if self.busy_until < now {
-            // Idle since the last byte: the clock cannot run ahead of the first sight of the
-            // next one, except for what the loop's own sleep hid (a quarter millisecond).
+        if self.idle {
+            // First sight of a byte after an idle line: it started at most one loop sleep
+            // (a quarter millisecond) ago; the line cannot have carried it any earlier.
+            self.idle = false;
             let floor = now - Duration::from_micros(250);
             if self.busy_until < floor {
                 self.busy_until = floor;
@@ -388,7 +393,8 @@ impl Device {
             else {
                 break;
             };
-            let mut allowance = rx_line.ready(now, waiting);
+            let on_line = rx_line.ready(now, waiting);
+            let mut allowance = on_line;
             if self.stopped {
                 allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
                 self.watch_backlog(waiting);
@@ -399,6 +405,11 @@ impl Device {
                 allowance = allowance.min(self.high.saturating_sub(self.rx.len()).max(1));
             }
             let n = allowance.min(waiting).min(buf.len());
+            if n < on_line {
+                // Held back by flow control: those bytes are still at the host, and the line
+                // clock starts again when they are let through.
+                rx_line.idle = true;
+            }
             if n > 0 {
                 let Some(master) = self.master.as_mut() else {
                     break;
