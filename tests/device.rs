@@ -565,3 +565,68 @@ fn ctrl_c_stops_the_stream_lifts_the_tool_and_says_where() {
     assert!(rep["tool_down_at_end"].is_null(), "{rep}");
     assert!(rep["bytes_received"].as_u64().unwrap() < prog.len() as u64);
 }
+
+#[test]
+fn user_profiles_add_and_replace_bundled_ones() {
+    use std::process::Command;
+    let home = scratch("xdg");
+    let dir = home.join("flatcut").join("devices");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("my-cutter.toml"),
+        "name='my-cutter'\ndescription='the one in the basement'\nlanguage='hpgl'\ndialect='hp-gl'\n\
+         units_per_mm=40\n[serial]\nbaud=38400\nflow_control='xon-xoff'\n[tools.cut]\npen=1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("sim.toml"),
+        "name='sim'\ndescription='my own sim'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n\
+         [serial]\nbaud=57600\nflow_control='xon-xoff'\n[tools.cut]\npen=1\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_flatcut"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("XDG_CONFIG_HOME", &home)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["devices"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("my-cutter") && out.contains("the one in the basement"),
+        "{out}"
+    );
+    assert!(
+        out.contains("my own sim") && out.contains("grbl-laser"),
+        "{out}"
+    );
+    let scratch_out = home.join("out");
+    let o = run(&[
+        "cut",
+        "patterns/tetrahedron.toml",
+        "--device",
+        "my-cutter",
+        "--simulate",
+        "--sim-speed",
+        "0",
+        "-o",
+        scratch_out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scratch_out.join("sim.json")).unwrap())
+            .unwrap();
+    assert_eq!(rep["baud"], 38400);
+    assert_eq!(rep["device"], "my-cutter");
+    // A broken user profile names its file and line.
+    std::fs::write(dir.join("broken.toml"), "name='b'\nspeeed=3\n").unwrap();
+    let o = run(&["devices"]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("broken.toml") && err.contains("line 2"),
+        "{err}"
+    );
+}
