@@ -109,7 +109,7 @@ pub fn deliver(
                 rep.seconds,
                 profile.serial.baud,
                 report.paths.len(),
-                report.per_tool.values().map(|t| t.length_mm).sum::<f64>(),
+                report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
                 report.violations(),
             ));
             said.push(format!(

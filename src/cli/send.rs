@@ -40,10 +40,10 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
     };
     if !expected.contains(&ext.as_str()) {
         return Err(Error::Usage(format!(
-            "{}: device `{}` speaks {:?}, which is sent from a .{} file; this file is `.{ext}`",
+            "{}: device `{}` speaks {}, which is sent from a .{} file; this file is `.{ext}`",
             a.file.display(),
             profile.name,
-            profile.language,
+            profile.language.label(),
             expected[0]
         )));
     }

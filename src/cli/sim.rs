@@ -62,9 +62,9 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
     let handle = sim::spawn(cfg)?;
     println!("listening on {}", handle.path);
     println!(
-        "simulating {} ({:?}, {} baud, {:?} flow control, {}-byte buffer); Ctrl-C to stop",
+        "simulating {} ({}, {} baud, {:?} flow control, {}-byte buffer); Ctrl-C to stop",
         profile.name,
-        profile.language,
+        profile.language.label(),
         profile.serial.baud,
         profile.serial.flow_control,
         profile.buffer
@@ -82,7 +82,7 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
         "received {} bytes, cut {} paths ({:.0} mm), {} overruns, {} flow-control violations",
         report.bytes_received,
         report.paths.len(),
-        report.per_tool.values().map(|t| t.length_mm).sum::<f64>(),
+        report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
         report.overruns,
         report.flow_violations
     );

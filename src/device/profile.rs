@@ -64,6 +64,14 @@ pub enum Language {
 }
 
 impl Language {
+    /// The language's name for people: `HP-GL`, `G-code`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Language::Hpgl => "HP-GL",
+            Language::Gcode => "G-code",
+        }
+    }
+
     /// File extension of programs in this language.
     pub fn extension(self) -> &'static str {
         match self {
