@@ -557,7 +557,7 @@ fn ctrl_c_stops_the_stream_lifts_the_tool_and_says_where() {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("stopped by Ctrl-C"), "{err}");
-    assert!(err.contains("tool lifted"), "{err}");
+    assert!(err.contains("machine lifts the tool"), "{err}");
     assert!(err.contains("byte"), "{err}");
     // The simulator's record is still written, and the knife is up.
     let rep: serde_json::Value =

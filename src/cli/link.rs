@@ -92,8 +92,15 @@ pub fn deliver(
                 .with_virtual_cts(handle.cts.clone());
             let sent = stream::send(&mut port, profile, bytes, &opts);
             drop(port);
-            // Let the simulated machine finish the motion it has buffered.
-            let report = handle.finish(Duration::from_secs(600))?;
+            // Let the simulated machine work off what it has buffered, as a real one would
+            // (after Ctrl-C that includes the tool-up command, queued behind the buffer);
+            // after Ctrl-C give it at most half a minute.
+            let wait = if opts.cancel.load(Ordering::SeqCst) {
+                Duration::from_secs(30)
+            } else {
+                Duration::from_secs(600)
+            };
+            let report = handle.finish(wait)?;
             let stem = if several {
                 format!("sim-{}", k + 1)
             } else {

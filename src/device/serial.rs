@@ -129,7 +129,15 @@ impl Link {
                 "the line was closed",
             )),
             Ok(n) => Ok(n),
-            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
+            // A signal (Ctrl-C) interrupting the wait is not a fault of the line.
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                ) =>
+            {
+                Ok(0)
+            }
             Err(e) => Err(e),
         }
     }
@@ -142,14 +150,31 @@ impl Link {
                 "the line was closed",
             )),
             Ok(n) => Ok(n),
-            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
+            // A signal (Ctrl-C) interrupting the wait is not a fault of the line.
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                ) =>
+            {
+                Ok(0)
+            }
             Err(e) => Err(e),
         }
     }
 
     /// Read what has already arrived without waiting.
     pub fn read_ready(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.port.bytes_to_read().map_err(std::io::Error::from)? as usize;
+        let n = match self.port.bytes_to_read() {
+            Ok(n) => n as usize,
+            Err(e) => {
+                let e = std::io::Error::from(e);
+                if e.kind() == std::io::ErrorKind::Interrupted {
+                    return Ok(0);
+                }
+                return Err(e);
+            }
+        };
         if n == 0 {
             return Ok(0);
         }
@@ -159,7 +184,12 @@ impl Link {
 
     /// Wait until the kernel has put everything written on the wire.
     pub fn flush(&mut self) -> std::io::Result<()> {
-        self.port.flush()
+        loop {
+            match self.port.flush() {
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                r => return r,
+            }
+        }
     }
 }
 

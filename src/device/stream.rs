@@ -15,7 +15,8 @@
 //! Before a GRBL job the controller is reset (Ctrl-X) and its welcome awaited, which also
 //! proves it is there. `error:N` or `ALARM:N` stops the job with the line, GRBL's meaning and
 //! the tool lifted. On Ctrl-C (the `cancel` flag), a hang-up or a timeout the stream stops,
-//! lifts the tool when the line still works (HP-GL: `;PU;SP0;`; GRBL: feed hold, wait for
+//! lifts the tool when the line still works (HP-GL: `;PU;SP0;`, which the device executes after
+//! what it has buffered, and the message says so; GRBL: feed hold, wait for
 //! the hold, soft reset, then the cut tool's "up" command) and reports how far it got: the
 //! stroke (counted from the program's pen-up moves) and the byte or line.
 //!
@@ -93,6 +94,8 @@ impl std::fmt::Display for Position {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ToolState {
     Lifted,
+    /// HP-GL: the tool-up command is sent; the device executes it after what it has buffered.
+    LiftQueued,
     /// The line failed before the tool-up command could be sent.
     Unknown,
 }
@@ -101,6 +104,10 @@ impl std::fmt::Display for ToolState {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ToolState::Lifted => write!(f, "tool lifted"),
+            ToolState::LiftQueued => write!(
+                f,
+                "tool-up sent: the machine lifts the tool once it has worked off its buffer"
+            ),
             ToolState::Unknown => write!(
                 f,
                 "the line is gone, so the tool could not be lifted: check the machine"
@@ -479,7 +486,7 @@ fn lift_hpgl(link: &mut Link, opts: &StreamOptions) -> ToolState {
         }
     }
     if sent == cmd.len() && link.flush().is_ok() {
-        ToolState::Lifted
+        ToolState::LiftQueued
     } else {
         ToolState::Unknown
     }
