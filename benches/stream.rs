@@ -62,8 +62,9 @@ fn once(p: &Profile, program: &[u8]) -> f64 {
     let t = Instant::now();
     let r = stream::send(&mut link, p, program, &o).expect("stream");
     let s = t.elapsed().as_secs_f64();
+    let written = link.written;
     drop(link);
-    let rep = h.finish(Duration::from_secs(30)).expect("sim");
+    let rep = h.finish(written, Duration::from_secs(30)).expect("sim");
     assert_eq!(rep.violations(), 0);
     assert_eq!(r.bytes, program.len());
     s

@@ -91,6 +91,7 @@ pub fn deliver(
             let mut port = crate::device::serial::open(profile, &handle.path, link.baud)?
                 .with_virtual_cts(handle.cts.clone());
             let sent = stream::send(&mut port, profile, bytes, &opts);
+            let written = port.written;
             drop(port);
             // Let the simulated machine work off what it has buffered, as a real one would
             // (after Ctrl-C that includes the tool-up command, queued behind the buffer);
@@ -100,7 +101,7 @@ pub fn deliver(
             } else {
                 Duration::from_secs(600)
             };
-            let report = handle.finish(wait)?;
+            let report = handle.finish(written, wait)?;
             let stem = if several {
                 format!("sim-{}", k + 1)
             } else {
@@ -108,6 +109,16 @@ pub fn deliver(
             };
             let (png, json) = write_sim(&report, profile, dir, &stem)?;
             let rep = sent?;
+            if report.violations() > 0 {
+                return Err(Error::Usage(format!(
+                    "the simulated {} lost data: {} bytes overran its {}-byte buffer and {} were sent while it asked to stop (see {}); a real machine would have cut this job wrong",
+                    profile.name,
+                    report.overruns,
+                    report.buffer,
+                    report.flow_violations,
+                    json.display()
+                )));
+            }
             said.push(format!(
                 "sent {name} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud); it cut {} paths, {:.0} mm, {} overruns",
                 profile.name,

@@ -37,6 +37,8 @@ pub struct Link {
     pub baud: u32,
     pub flow: FlowControl,
     virtual_cts: Option<Arc<AtomicBool>>,
+    /// Bytes written to the line so far.
+    pub written: usize,
 }
 
 /// Poll interval of reads and writes; operations loop on it to watch deadlines and Ctrl-C.
@@ -99,6 +101,7 @@ pub fn open(profile: &Profile, port: &str, baud: Option<u32>) -> Result<Link, Se
         baud,
         flow: s.flow_control,
         virtual_cts: None,
+        written: 0,
     })
 }
 
@@ -128,7 +131,10 @@ impl Link {
                 std::io::ErrorKind::BrokenPipe,
                 "the line was closed",
             )),
-            Ok(n) => Ok(n),
+            Ok(n) => {
+                self.written += n;
+                Ok(n)
+            }
             // A signal (Ctrl-C) interrupting the wait is not a fault of the line.
             Err(e)
                 if matches!(

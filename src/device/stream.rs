@@ -1,11 +1,13 @@
 //! Streaming a program into a device without ever overrunning it.
 //!
 //! - **Buffered** (HP-GL cutters): the program goes out in chunks of at most [`CHUNK`] bytes,
-//!   paced at the line rate (baud / 10 bytes a second) so that no more than a chunk is in the
-//!   kernel's queue when the device asks to stop. XON/XOFF: after every chunk the input is
+//!   paced at the line rate (baud / 10 bytes a second) so that no more than two chunks are in
+//!   the kernel's queue when the device asks to stop. XON/XOFF: after every chunk the input is
 //!   read; XOFF stops sending until XON. RTS/CTS: CTS is checked before every chunk. Without
-//!   flow control the pacing is all there is, and a device with a small buffer may overrun:
-//!   the profile should say `xon-xoff` or `rts-cts` wherever the machine can.
+//!   flow control nothing reports a full buffer, so byte b is not sent before the device can
+//!   have executed byte b − `buffer`, estimated from the program's own speeds (line time plus
+//!   motion time, +10 %): safe, slower than the machine could go; profiles should say
+//!   `xon-xoff` or `rts-cts` wherever the machine can.
 //! - **GRBL character counting** (GRBL wiki, "Interface", streaming protocols): lines are sent
 //!   while the bytes of the lines not yet answered (`ok` or `error:N`) fit in the device's
 //!   128-byte receive buffer. `$` commands are sent alone, after every earlier line is
@@ -323,7 +325,15 @@ fn buffered(
     let mut rep = StreamReport::default();
     let mut sent = 0usize;
     let mut stopped = false;
-    let mut wire_free = Instant::now();
+    let t0 = Instant::now();
+    let mut wire_free = t0;
+    // Without flow control nothing tells us the buffer is full: never send byte b before the
+    // device can have executed byte b − buffer, by the program's own speeds.
+    let timeline = if flow == FlowControl::None {
+        execution_timeline(profile, program)
+    } else {
+        Vec::new()
+    };
     let chunk_time = Duration::from_secs_f64(CHUNK as f64 / rate);
     let mut last_progress = Instant::now();
     let mut input = [0u8; 256];
@@ -331,19 +341,23 @@ fn buffered(
     let port = link.name.clone();
     let mut last_bar = Instant::now();
 
-    let fail = |link: &mut Link, kind: Failure, sent: usize| -> StreamError {
+    let fail = |link: &mut Link, kind: Failure, sent: usize, stopped: bool| -> StreamError {
         let at = position(bar, sent, total);
         let tool = if matches!(kind, Failure::HungUp(_)) {
             ToolState::Unknown
         } else {
-            lift_hpgl(link, opts)
+            let end = program[sent..]
+                .iter()
+                .position(|&b| b == b';')
+                .map_or(total, |i| sent + i + 1);
+            lift_hpgl(link, &program[sent..end], stopped)
         };
         kind.into_error(port.clone(), at, tool, opts.timeout)
     };
 
     while sent < total {
         if opts.cancel.load(Ordering::SeqCst) {
-            return Err(fail(link, Failure::Cancelled, sent));
+            return Err(fail(link, Failure::Cancelled, sent, stopped));
         }
         // Listen: XON/XOFF and anything else the device says.
         match link.read_ready(&mut input) {
@@ -364,7 +378,7 @@ fn buffered(
                     }
                 }
             }
-            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent)),
+            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
         let cts = link.clear_to_send();
         if stopped || !cts {
@@ -374,7 +388,7 @@ fn buffered(
                 } else {
                     "waiting for the device to raise CTS"
                 };
-                return Err(fail(link, Failure::Timeout(op), sent));
+                return Err(fail(link, Failure::Timeout(op), sent, stopped));
             }
             // Wait for the next byte (XON) or the CTS line.
             if flow == FlowControl::XonXoff {
@@ -389,7 +403,12 @@ fn buffered(
                     },
                     Ok(_) => {}
                     Err(_) => {
-                        return Err(fail(link, Failure::HungUp("while waiting for XON"), sent))
+                        return Err(fail(
+                            link,
+                            Failure::HungUp("while waiting for XON"),
+                            sent,
+                            stopped,
+                        ))
                     }
                 }
             } else {
@@ -407,6 +426,18 @@ fn buffered(
             continue;
         }
         let n = CHUNK.min(total - sent);
+        if !timeline.is_empty() && sent + n > profile.buffer {
+            let need = sent + n - profile.buffer;
+            let k = timeline.partition_point(|&(end, _)| end < need);
+            let t_ready = timeline.get(k).map_or(0.0, |&(_, t)| t);
+            let wait = t_ready - t0.elapsed().as_secs_f64();
+            if wait > 0.0 {
+                // Waiting on our own estimate is not the device failing to make progress.
+                last_progress = Instant::now();
+                std::thread::sleep(Duration::from_secs_f64(wait.min(0.01)));
+                continue;
+            }
+        }
         match link.write_some(&program[sent..sent + n]) {
             Ok(0) => {
                 if last_progress.elapsed() > opts.timeout {
@@ -414,6 +445,7 @@ fn buffered(
                         link,
                         Failure::Timeout("writing to the device (it stopped reading)"),
                         sent,
+                        stopped,
                     ));
                 }
             }
@@ -426,13 +458,32 @@ fn buffered(
                     last_bar = Instant::now();
                 }
             }
-            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent)),
+            Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
     }
     let _ = link.flush();
     bar.set(sent, "");
     rep.bytes = sent;
     Ok(rep)
+}
+
+/// For each HP-GL instruction, where it ends in the program and a safe upper bound of when
+/// (seconds after the first byte) the device will have executed it: the line time of every byte
+/// up to it plus the motion time of every instruction up to it (from the speeds the program
+/// and profile set, read by the simulator's interpreter), plus 10 %.
+fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
+    let rate = profile.serial.baud.max(1) as f64 / 10.0;
+    let mut m = super::sim::hpgl::Hpgl::new(profile);
+    let (mut at, mut motion) = (0usize, 0.0f64);
+    let mut out = Vec::new();
+    let mut rest = program;
+    while let Some(n) = super::sim::hpgl::next_instruction(rest) {
+        motion += m.execute(&rest[..n]);
+        at += n;
+        out.push((at, 1.1 * (motion + at as f64 / rate)));
+        rest = &rest[n..];
+    }
+    out
 }
 
 enum Failure {
@@ -457,13 +508,14 @@ impl Failure {
     }
 }
 
-/// Lift the tool of an HP-GL device: end any partial instruction, pen up, put the pen away.
-/// Honours XOFF/CTS for a short while; the device lifts after working off its buffer.
-fn lift_hpgl(link: &mut Link, opts: &StreamOptions) -> ToolState {
-    let _ = opts;
-    let cmd = b";PU;SP0;\n";
+/// Lift the tool of an HP-GL device: send the rest of the instruction in progress (a chunk may
+/// have ended inside a coordinate, which a bare `;` would turn into a stray cut), then pen up
+/// and put the pen away. Honours XOFF/CTS (starting from the state the stream was in) for a
+/// few seconds; the device lifts after working off its buffer, and the result says so.
+fn lift_hpgl(link: &mut Link, rest_of_instruction: &[u8], mut stopped: bool) -> ToolState {
+    let mut cmd = rest_of_instruction.to_vec();
+    cmd.extend_from_slice(b"\nPU;SP0;\n");
     let deadline = Instant::now() + Duration::from_secs(3);
-    let mut stopped = false;
     let mut sent = 0;
     let mut input = [0u8; 64];
     while sent < cmd.len() && Instant::now() < deadline {
@@ -499,8 +551,11 @@ struct Grbl<'a> {
     opts: &'a StreamOptions,
     bar: &'a Bar,
     port: String,
-    /// Lines of the program: (byte offset, text without newline, 1-based number).
-    lines: Vec<(usize, String)>,
+    /// Lines to send: (byte offset after the line, text without its ending, 1-based line number
+    /// in the file). GRBL ends a line at `\n` or `\r`, so both split here.
+    lines: Vec<(usize, String, usize)>,
+    /// Lines in the file.
+    file_lines: usize,
     /// Lines sent and not yet answered: (index into `lines`, bytes incl. newline).
     pending: std::collections::VecDeque<(usize, usize)>,
     in_flight: usize,
@@ -528,14 +583,16 @@ impl<'a> Grbl<'a> {
     ) -> Grbl<'a> {
         let mut lines = Vec::new();
         let mut at = 0;
-        for l in program.split(|&b| b == b'\n') {
-            let text = String::from_utf8_lossy(l)
-                .trim_end_matches('\r')
-                .to_string();
-            if !text.trim().is_empty() {
-                lines.push((at, text));
+        let mut file_lines = 0;
+        for (n, l) in program.split(|&b| b == b'\n').enumerate() {
+            for part in l.split(|&b| b == b'\r') {
+                at += part.len() + 1;
+                let text = String::from_utf8_lossy(part).to_string();
+                if !text.trim().is_empty() {
+                    lines.push((at.min(program.len()), text, n + 1));
+                    file_lines = n + 1;
+                }
             }
-            at += l.len() + 1;
         }
         let port = link.name.clone();
         Grbl {
@@ -546,6 +603,7 @@ impl<'a> Grbl<'a> {
             bar,
             port,
             lines,
+            file_lines,
             pending: Default::default(),
             in_flight: 0,
             acked: 0,
@@ -562,7 +620,7 @@ impl<'a> Grbl<'a> {
         let bytes = self.acked_bytes;
         let mut p = position(self.bar, bytes, self.program.len());
         p.line = Some(self.acked);
-        p.lines_total = self.lines.len();
+        p.lines_total = self.file_lines;
         p
     }
 
@@ -624,24 +682,59 @@ impl<'a> Grbl<'a> {
     fn wake(&mut self) -> Result<(), StreamError> {
         self.write_all(&[proto::SOFT_RESET], "resetting GRBL")?;
         let deadline = Instant::now() + self.opts.wake_timeout;
+        let mut alarm = false;
+        let mut awake = false;
         while Instant::now() < deadline {
-            if let Event::Answer(Response::Welcome) = self.poll()? {
-                // Drop whatever follows the welcome (messages, alarm notes).
-                std::thread::sleep(Duration::from_millis(20));
-                while let Event::Answer(r) = self.poll()? {
-                    if let Response::Alarm(_) = r {
-                        // An alarm from before: unlock it.
-                        self.write_all(b"$X\n", "unlocking GRBL")?;
-                    }
+            match self.poll()? {
+                Event::Answer(Response::Welcome) => {
+                    awake = true;
+                    // Let the messages that follow the welcome arrive.
+                    std::thread::sleep(Duration::from_millis(20));
                 }
-                self.partial.clear();
-                return Ok(());
+                Event::Answer(Response::Alarm(_)) => alarm = true,
+                Event::Answer(Response::Other(m)) if m.contains("$X") => alarm = true,
+                Event::Answer(_) => {}
+                Event::Nothing if awake => break,
+                Event::Nothing => {}
             }
         }
-        Err(StreamError::NoWelcome {
-            port: self.port.clone(),
-            secs: self.opts.wake_timeout.as_secs_f64(),
-        })
+        if !awake {
+            return Err(StreamError::NoWelcome {
+                port: self.port.clone(),
+                secs: self.opts.wake_timeout.as_secs_f64(),
+            });
+        }
+        self.partial.clear();
+        if alarm {
+            // Locked by an alarm from before (e.g. reset during motion): unlock, and wait for
+            // the answer so that it is not taken for the first line's.
+            self.write_all(b"$X\n", "unlocking GRBL after an alarm")?;
+            let deadline = Instant::now() + self.opts.wake_timeout;
+            loop {
+                match self.poll()? {
+                    Event::Answer(Response::Ok) => break,
+                    Event::Answer(Response::Error(code)) => {
+                        return Err(StreamError::Grbl {
+                            port: self.port.clone(),
+                            code,
+                            meaning: proto::error_meaning(code),
+                            line: 0,
+                            text: "$X (unlock after an alarm)".into(),
+                            at: self.position(),
+                            tool: ToolState::Unknown,
+                        })
+                    }
+                    _ if Instant::now() > deadline => {
+                        return Err(StreamError::NoWelcome {
+                            port: self.port.clone(),
+                            secs: self.opts.wake_timeout.as_secs_f64(),
+                        })
+                    }
+                    _ => {}
+                }
+            }
+        }
+        Ok(())
     }
 
     fn handle(&mut self, r: Response) -> Result<(), StreamError> {
@@ -650,8 +743,9 @@ impl<'a> Grbl<'a> {
             Response::Ok => {
                 if let Some((i, len)) = self.pending.pop_front() {
                     self.in_flight -= len;
-                    self.acked = i + 1;
-                    self.acked_bytes = self.lines[i].0 + len;
+                    self.acked = self.lines[i].2;
+                    self.acked_bytes = self.lines[i].0;
+                    let _ = len;
                     self.rep.lines += 1;
                 }
                 Ok(())
@@ -660,12 +754,13 @@ impl<'a> Grbl<'a> {
                 let (i, len) = self.pending.pop_front().unwrap_or((self.acked, 0));
                 self.in_flight = self.in_flight.saturating_sub(len);
                 let text = self.lines.get(i).map(|l| l.1.clone()).unwrap_or_default();
+                let line_no = self.lines.get(i).map_or(i + 1, |l| l.2);
                 let tool = self.lift();
                 Err(StreamError::Grbl {
                     port: self.port.clone(),
                     code,
                     meaning: proto::error_meaning(code),
-                    line: i + 1,
+                    line: line_no,
                     text,
                     at: self.position(),
                     tool,
@@ -765,7 +860,8 @@ impl<'a> Grbl<'a> {
         let deadline = Instant::now() + Duration::from_secs(3);
         while got < want && Instant::now() < deadline {
             match self.poll() {
-                Ok(Event::Answer(Response::Ok)) | Ok(Event::Answer(Response::Error(_))) => got += 1,
+                Ok(Event::Answer(Response::Ok)) => got += 1,
+                Ok(Event::Answer(Response::Error(_))) => return ToolState::Unknown,
                 Ok(_) => {}
                 Err(_) => return ToolState::Unknown,
             }
@@ -796,7 +892,7 @@ impl<'a> Grbl<'a> {
                 if text.len() > proto::LINE_MAX {
                     return Err(StreamError::LineTooLong {
                         port: self.port.clone(),
-                        line: next + 1,
+                        line: self.lines[next].2,
                         len: text.len(),
                         max: proto::LINE_MAX,
                     });
@@ -806,7 +902,7 @@ impl<'a> Grbl<'a> {
                 let fits = if send_response || system {
                     self.pending.is_empty()
                 } else {
-                    self.in_flight + len <= limit
+                    (self.pending.is_empty() || self.in_flight + len <= limit)
                         && !self
                             .pending
                             .front()

@@ -17,7 +17,8 @@
 //!   UART FIFO's worth) and then leaves the rest in the pty, as a stopped transmitter would
 //!   hold it. A host that ignores the stop is caught: the bytes waiting in the pty must stop
 //!   growing within [`STOP_GRACE`] of the stop, or the growth is counted as
-//!   `flow_violations`. This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
+//!   `flow_violations`. (Only stops longer than the grace can catch a host this way; the
+//!   grace is long enough for a loaded machine's kernel to act on XOFF.) This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
 //!   stream into the simulator.
 //! - **Execution.** HP-GL instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
@@ -25,7 +26,7 @@
 //!   interpreters compute ([`hpgl`], [`grbl`]) divided by the time factor (`None`: no time).
 //!   GRBL real-time bytes (`?`, `!`, `~`, Ctrl-X) act on arrival and are never buffered.
 //! - **Faults** for tests ([`Faults`]): hang up after N bytes, stall (stop reading and
-//!   executing) after N bytes, send garbage after N bytes, lose the first XON, answer a given
+//!   executing) after N bytes, send garbage after N bytes, lose the XONs, answer a given
 //!   GRBL line with `error:N`.
 //!
 //! Everything it cuts is recorded ([`record`]) and, on [`SimHandle::finish`], summarised in a
@@ -42,7 +43,7 @@ use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{Read, Write};
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -53,7 +54,7 @@ pub const XOFF: u8 = 0x13;
 /// Bytes the simulator still takes after asking the host to stop.
 pub const SKID: usize = 16;
 /// Time a host has to react to XOFF or CTS before growth of its backlog counts as a violation.
-pub const STOP_GRACE: Duration = Duration::from_millis(50);
+pub const STOP_GRACE: Duration = Duration::from_millis(250);
 /// GRBL planner blocks (`BLOCK_BUFFER_SIZE` 16, one kept free).
 pub const PLANNER_BLOCKS: usize = 15;
 
@@ -66,7 +67,7 @@ pub struct Faults {
     pub stall_after: Option<usize>,
     /// Send a burst of garbage to the host after this many bytes.
     pub garbage_after: Option<usize>,
-    /// Never send the first XON that is due.
+    /// Lose every XON on the line (the device believes it sent them).
     pub lose_xon: bool,
     /// GRBL: answer line N (1-based, counting every line received) with `error:code`.
     pub grbl_error: Option<(usize, u32)>,
@@ -166,13 +167,18 @@ pub struct SimHandle {
     /// The CTS line as the simulated device drives it (true: clear to send).
     pub cts: Arc<AtomicBool>,
     ctl: Arc<AtomicU8>,
+    expect: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
 }
 
 impl SimHandle {
     /// Let the device work off what it has received, then stop: waits until the input is
     /// executed and no byte has arrived for a moment, or `timeout` passes.
-    pub fn finish(mut self, timeout: Duration) -> Result<SimReport, SimError> {
+    ///
+    /// `bytes_sent` is what the host wrote: the simulator does not call it done before it has
+    /// received that many, so a loaded machine's slow pty cannot cut the job short.
+    pub fn finish(mut self, bytes_sent: usize, timeout: Duration) -> Result<SimReport, SimError> {
+        self.expect.store(bytes_sent, Ordering::SeqCst);
         self.ctl.store(FINISH, Ordering::SeqCst);
         let t = self.thread.take().ok_or(SimError::Thread)?;
         let deadline = Instant::now() + timeout;
@@ -211,15 +217,17 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
         .ok_or_else(|| SimError::Pty("the pty has no name".into()))?;
     let cts = Arc::new(AtomicBool::new(true));
     let ctl = Arc::new(AtomicU8::new(RUN));
-    let (c2, k2) = (cts.clone(), ctl.clone());
+    let expect = Arc::new(AtomicUsize::new(0));
+    let (c2, k2, e2) = (cts.clone(), ctl.clone(), expect.clone());
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, e2).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
         cts,
         ctl,
+        expect,
         thread: Some(thread),
     })
 }
@@ -280,6 +288,7 @@ struct Device {
     slave: Option<serialport::TTYPort>,
     cts: Arc<AtomicBool>,
     ctl: Arc<AtomicU8>,
+    expect: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -313,6 +322,7 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
+        expect: Arc<AtomicUsize>,
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -342,6 +352,7 @@ impl Device {
             slave: Some(slave),
             cts,
             ctl,
+            expect,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -425,7 +436,11 @@ impl Device {
                             self.taken_since_stop += k;
                         }
                     }
-                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                        ) => {}
                     Err(_) => {
                         self.rep.ended = "host closed".into();
                         break;
@@ -459,6 +474,9 @@ impl Device {
             }
 
             if ctl == FINISH
+                && (self.rep.bytes_received >= self.expect.load(Ordering::SeqCst)
+                    || self.stalled
+                    || self.stopped)
                 && (self.stalled
                     || (waiting == n && !self.has_complete_input() && self.motion.is_empty()))
                 && self.tx.is_empty()
@@ -683,7 +701,7 @@ impl Device {
                     }
                 } else if self.stopped && fill <= self.low && !self.stalled {
                     if self.flow == FlowControl::XonXoff {
-                        if self.cfg.faults.lose_xon && !self.xon_lost {
+                        if self.cfg.faults.lose_xon {
                             // The XON is lost on the line: the device believes it sent it.
                             self.xon_lost = true;
                         } else {
