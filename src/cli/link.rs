@@ -86,6 +86,10 @@ pub fn deliver(
     for (k, (name, bytes)) in programs.iter().enumerate() {
         if simulated(profile, link) {
             let mut cfg = SimConfig::new(profile.clone());
+            // The simulated line runs at the rate the host uses.
+            if let Some(b) = link.baud {
+                cfg.profile.serial.baud = b;
+            }
             cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
             let handle = sim::spawn(cfg)?;
             let mut port = crate::device::serial::open(profile, &handle.path, link.baud)?
@@ -125,7 +129,7 @@ pub fn deliver(
                 rep.bytes,
                 rep.strokes,
                 rep.seconds,
-                profile.serial.baud,
+                report.baud,
                 report.paths.len(),
                 report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
                 report.violations(),

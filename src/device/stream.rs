@@ -67,7 +67,7 @@ impl Default for StreamOptions {
 /// How far a job got.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Position {
-    /// Bytes the device has taken (buffered) or that were answered (GRBL).
+    /// Bytes of the program written to the line (buffered) or answered (GRBL).
     pub bytes: usize,
     pub bytes_total: usize,
     /// Strokes begun, of all.
@@ -738,7 +738,11 @@ impl<'a> Grbl<'a> {
     }
 
     fn handle(&mut self, r: Response) -> Result<(), StreamError> {
-        self.last_answer = Instant::now();
+        // Only answers to lines count as progress: a controller that reports its status but
+        // never takes another line (stuck in Hold) must still time out.
+        if matches!(r, Response::Ok | Response::Error(_) | Response::Alarm(_)) {
+            self.last_answer = Instant::now();
+        }
         match r {
             Response::Ok => {
                 if let Some((i, len)) = self.pending.pop_front() {
@@ -850,8 +854,17 @@ impl<'a> Grbl<'a> {
             }
         }
         up.push_str("M5\n");
-        if self.link.write_some(up.as_bytes()).is_err() {
-            return ToolState::Unknown;
+        let bytes = up.as_bytes();
+        let mut sent = 0;
+        let deadline = Instant::now() + Duration::from_secs(2);
+        while sent < bytes.len() {
+            match self.link.write_some(&bytes[sent..]) {
+                Ok(k) => sent += k,
+                Err(_) => return ToolState::Unknown,
+            }
+            if Instant::now() > deadline {
+                return ToolState::Unknown;
+            }
         }
         let _ = self.link.flush();
         // Wait for the answers so the command is known to be taken.

@@ -486,7 +486,7 @@ impl Device {
                 self.rep.ended = "finished".into();
                 break;
             }
-            let busy = n > 0 || !self.tx.is_empty() || (!self.rx.is_empty() && !self.stalled);
+            let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
         self.close()
