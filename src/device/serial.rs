@@ -135,16 +135,7 @@ impl Link {
                 self.written += n;
                 Ok(n)
             }
-            // A signal (Ctrl-C) interrupting the wait is not a fault of the line.
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                ) =>
-            {
-                Ok(0)
-            }
-            Err(e) => Err(e),
+            Err(e) => nothing_yet(e),
         }
     }
 
@@ -156,16 +147,7 @@ impl Link {
                 "the line was closed",
             )),
             Ok(n) => Ok(n),
-            // A signal (Ctrl-C) interrupting the wait is not a fault of the line.
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                ) =>
-            {
-                Ok(0)
-            }
-            Err(e) => Err(e),
+            Err(e) => nothing_yet(e),
         }
     }
 
@@ -196,6 +178,15 @@ impl Link {
                 r => return r,
             }
         }
+    }
+}
+
+/// `Ok(0)` when an operation only found nothing to do yet: its wait timed out, or a signal
+/// (Ctrl-C) interrupted it, which is not a fault of the line. Other errors stand.
+fn nothing_yet(e: std::io::Error) -> std::io::Result<usize> {
+    match e.kind() {
+        std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted => Ok(0),
+        _ => Err(e),
     }
 }
 
