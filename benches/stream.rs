@@ -10,8 +10,8 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flatcut::device::profile::{self, Profile};
 use flatcut::device::sim::{self, SimConfig};
-use flatcut::device::{serial, stream};
-use std::time::{Duration, Instant};
+use flatcut::device::stream;
+use std::time::Duration;
 
 fn hpgl(size: usize) -> Vec<u8> {
     let mut s = String::from("IN;SP1;PU0,0;\n");
@@ -51,23 +51,22 @@ fn grbl_profile(protocol: &str) -> Profile {
 
 /// Stream once; seconds taken by the host.
 fn once(p: &Profile, program: &[u8]) -> f64 {
-    let h = sim::spawn(SimConfig::new(p.clone())).expect("pty");
-    let mut link = serial::open(p, &h.path, None)
-        .expect("open")
-        .with_virtual_cts(h.cts.clone());
     let o = stream::StreamOptions {
         progress: false,
         ..Default::default()
     };
-    let t = Instant::now();
-    let r = stream::send(&mut link, p, program, &o).expect("stream");
-    let s = t.elapsed().as_secs_f64();
-    let written = link.written;
-    drop(link);
-    let rep = h.finish(written, Duration::from_secs(30)).expect("sim");
+    let (r, rep) = sim::stream_job(
+        SimConfig::new(p.clone()),
+        program,
+        &o,
+        Duration::from_secs(30),
+    )
+    .expect("simulator");
+    let r = r.expect("stream");
     assert_eq!(rep.violations(), 0);
     assert_eq!(r.bytes, program.len());
-    s
+    // Host time: from the first byte until the stream returned with the last one written.
+    r.seconds
 }
 
 fn bench(c: &mut Criterion) {

@@ -44,15 +44,7 @@ fn run(
     let mut cfg = SimConfig::new(profile.clone());
     cfg.time_factor = time_factor;
     cfg.faults = faults;
-    let h = sim::spawn(cfg).unwrap();
-    let mut link = serial::open(profile, &h.path, None)
-        .unwrap()
-        .with_virtual_cts(h.cts.clone());
-    let r = stream::send(&mut link, profile, program, o);
-    let written = link.written;
-    drop(link);
-    let rep = h.finish(written, Duration::from_secs(120)).unwrap();
-    (r, rep)
+    sim::stream_job(cfg, program, o, Duration::from_secs(120)).unwrap()
 }
 
 /// About `size` bytes of HP-GL: 1 mm pen-down steps zig-zagging over a 100 mm square.

@@ -12,7 +12,7 @@ use crate::device::sim::{self, SimConfig};
 use crate::device::stream::{self, StreamOptions};
 use crate::Error;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::Duration;
@@ -91,27 +91,15 @@ pub fn deliver(
                 cfg.profile.serial.baud = b;
             }
             cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
-            let handle = sim::spawn(cfg)?;
-            let mut port = crate::device::serial::open(profile, &handle.path, link.baud)?
-                .with_virtual_cts(handle.cts.clone());
-            let sent = stream::send(&mut port, profile, bytes, &opts);
-            let written = port.written;
-            drop(port);
-            // Let the simulated machine work off what it has buffered, as a real one would
-            // (after Ctrl-C that includes the tool-up command, queued behind the buffer);
-            // after Ctrl-C give it at most half a minute.
-            let wait = if opts.cancel.load(Ordering::SeqCst) {
-                Duration::from_secs(30)
-            } else {
-                Duration::from_secs(600)
-            };
-            let report = handle.finish(written, wait)?;
+            // The simulated machine works off what it has buffered, as a real one would (after
+            // Ctrl-C that includes the tool-up command, queued behind the buffer).
+            let (sent, report) = sim::stream_job(cfg, bytes, &opts, Duration::from_secs(600))?;
             let stem = if several {
                 format!("sim-{}", k + 1)
             } else {
                 "sim".into()
             };
-            let (png, json) = write_sim(&report, profile, dir, &stem)?;
+            let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
             let rep = sent?;
             if report.violations() > 0 {
                 return Err(Error::Usage(format!(
@@ -169,28 +157,4 @@ fn wait_for_sheet(k: usize, n: usize, quiet: bool) {
     eprintln!("load sheet {k} of {n} and press Enter");
     let mut s = String::new();
     let _ = std::io::stdin().read_line(&mut s);
-}
-
-/// Write the simulator's picture and report as `<stem>.png` / `<stem>.json` in `dir`.
-pub fn write_sim(
-    report: &sim::SimReport,
-    profile: &Profile,
-    dir: &Path,
-    stem: &str,
-) -> Result<(PathBuf, PathBuf), Error> {
-    let (png, json) = sim::write_outputs(report, profile, dir)?;
-    if stem == "sim" {
-        return Ok((png, json));
-    }
-    let (p2, j2) = (
-        dir.join(format!("{stem}.png")),
-        dir.join(format!("{stem}.json")),
-    );
-    for (a, b) in [(&png, &p2), (&json, &j2)] {
-        std::fs::rename(a, b).map_err(|source| Error::Write {
-            path: b.clone(),
-            source,
-        })?;
-    }
-    Ok((p2, j2))
 }

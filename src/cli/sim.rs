@@ -77,7 +77,7 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
         std::thread::sleep(Duration::from_millis(50));
     }
     let report = handle.finish(0, Duration::from_secs(2))?;
-    let (png, json) = sim::write_outputs(&report, &profile, &a.output)?;
+    let (png, json) = sim::write_outputs(&report, &profile, &a.output, "sim")?;
     println!(
         "received {} bytes, cut {} paths ({:.0} mm), {} overruns, {} flow-control violations",
         report.bytes_received,

@@ -284,12 +284,8 @@ pub fn send(
     let start = Instant::now();
     let starts = stroke_starts(program, profile.language);
     let bar = Bar::new(program.len(), starts, opts.progress);
-    let grbl = profile.language == Language::Gcode
-        || matches!(
-            profile.protocol,
-            Protocol::GrblCharacterCounting | Protocol::GrblSendResponse
-        );
-    let result = if grbl {
+    // Profile validation ties the GRBL protocols to G-code, so the language decides.
+    let result = if profile.language == Language::Gcode {
         Grbl::new(link, profile, program, opts, &bar).run()
     } else {
         buffered(link, profile, program, opts, &bar)
@@ -749,7 +745,6 @@ impl<'a> Grbl<'a> {
                     self.in_flight -= len;
                     self.acked = self.lines[i].2;
                     self.acked_bytes = self.lines[i].0;
-                    let _ = len;
                     self.rep.lines += 1;
                 }
                 Ok(())

@@ -349,25 +349,9 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
 mod tests {
     use super::*;
     use crate::device::profile::parse as parse_profile;
-    use crate::toolpath::{Stroke, StrokeRole};
+    use crate::output::fixtures::{sheet, stroke};
+    use crate::toolpath::StrokeRole;
     use glam::DVec2;
-
-    fn stroke(role: StrokeRole, pts: &[(f64, f64)]) -> Stroke {
-        Stroke {
-            role,
-            points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
-            closed: pts.len() > 2 && pts.first() == pts.last(),
-            piece: None,
-        }
-    }
-
-    fn sheet(strokes: Vec<Stroke>) -> SheetJob {
-        SheetJob {
-            width: 100.0,
-            height: 100.0,
-            strokes,
-        }
-    }
 
     fn profile(tools: &str) -> Profile {
         let text = format!(

@@ -371,30 +371,13 @@ pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
 mod tests {
     use super::*;
     use crate::device::profile::parse as parse_profile;
-    use crate::toolpath::{Stroke, StrokeRole};
-    use glam::DVec2;
+    use crate::output::fixtures::{sheet, stroke};
+    use crate::toolpath::StrokeRole;
 
     /// The bundled `hpgl-pens` profile as it was when the exact text below was pinned: pens
     /// only, no axes, no init or end.
     const PENS: &str = "name='hpgl-pens'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\n\
         units_per_mm=40.0\n[tools.cut]\npen=1\n[tools.score]\npen=2\n[tools.draw]\npen=3\n";
-
-    fn stroke(role: StrokeRole, pts: &[(f64, f64)]) -> Stroke {
-        Stroke {
-            role,
-            points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
-            closed: pts.len() > 2 && pts.first() == pts.last(),
-            piece: None,
-        }
-    }
-
-    fn job(strokes: Vec<Stroke>) -> SheetJob {
-        SheetJob {
-            width: 100.0,
-            height: 100.0,
-            strokes,
-        }
-    }
 
     fn text(sheet: &SheetJob, profile_text: &str) -> String {
         let profile = parse_profile(profile_text, "test.toml").unwrap();
@@ -402,7 +385,7 @@ mod tests {
     }
 
     fn small_job() -> SheetJob {
-        job(vec![
+        sheet(vec![
             stroke(StrokeRole::Label, &[(1.0, 1.0), (2.0, 1.0)]),
             stroke(
                 StrokeRole::Cut,
@@ -445,7 +428,7 @@ mod tests {
 
     #[test]
     fn plain_hpgl_force_speed_passes_init_end() {
-        let sheet = job(vec![
+        let sheet = sheet(vec![
             stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)]),
             stroke(StrokeRole::Cut, &[(3.0, 1.0), (4.0, 1.0)]),
             stroke(StrokeRole::FoldValley, &[(1.0, 2.0), (2.0, 2.0)]),
@@ -485,7 +468,7 @@ mod tests {
             .replace("dialect='hp-gl'", "dialect='camm-gl2'")
             .replace("init=['!ST1', 'VS5;']\nend=['PU0,0']\n", "");
         let t = text(
-            &job(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]),
+            &sheet(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]),
             &profile,
         );
         assert_eq!(
@@ -498,7 +481,7 @@ mod tests {
 
     #[test]
     fn unknown_dialect_and_unusable_tools_are_errors() {
-        let sheet = job(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]);
+        let sheet = sheet(vec![stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)])]);
         // Profiles are validated when read; a profile built in code still meets these checks.
         let mut p = parse_profile(PENS, "test.toml").unwrap();
         p.dialect = "dmpl".into();
@@ -524,19 +507,19 @@ mod tests {
     #[test]
     fn out_of_range_names_sheet_and_stroke() {
         let p = parse_profile(PENS, "test.toml").unwrap();
-        let sheet = job(vec![
+        let far = sheet(vec![
             stroke(StrokeRole::Cut, &[(1.0, 1.0), (2.0, 1.0)]),
             stroke(StrokeRole::Cut, &[(1.0, 1.0), (300_000.0, 1.0)]),
         ]);
-        let e = emit(&sheet, &p).unwrap_err().on_sheet(3).to_string();
+        let e = emit(&far, &p).unwrap_err().on_sheet(3).to_string();
         assert!(
             e.contains("sheet 3, stroke 2 (cut)") && e.contains("8388607"),
             "{e}"
         );
         // Roland addresses further.
         let p = parse_profile(&PENS.replace("'hp-gl'", "'camm-gl2'"), "t.toml").unwrap();
-        assert!(emit(&sheet, &p).is_ok());
-        let nan = job(vec![stroke(StrokeRole::Cut, &[(1.0, f64::NAN)])]);
+        assert!(emit(&far, &p).is_ok());
+        let nan = sheet(vec![stroke(StrokeRole::Cut, &[(1.0, f64::NAN)])]);
         assert!(emit(&nan, &p).is_err());
     }
 

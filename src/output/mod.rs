@@ -229,6 +229,32 @@ pub fn fmt_mm(v: f64) -> String {
     s
 }
 
+/// Small jobs for the encoders' tests.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use crate::toolpath::{SheetJob, Stroke, StrokeRole};
+    use glam::DVec2;
+
+    /// A stroke through `pts`, closed when it ends where it starts.
+    pub fn stroke(role: StrokeRole, pts: &[(f64, f64)]) -> Stroke {
+        Stroke {
+            role,
+            points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
+            closed: pts.len() > 2 && pts.first() == pts.last(),
+            piece: None,
+        }
+    }
+
+    /// A 100 × 100 mm sheet with these strokes.
+    pub fn sheet(strokes: Vec<Stroke>) -> SheetJob {
+        SheetJob {
+            width: 100.0,
+            height: 100.0,
+            strokes,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

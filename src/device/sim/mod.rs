@@ -37,7 +37,7 @@ pub mod hpgl;
 pub mod record;
 
 use crate::device::grbl as proto;
-use crate::device::profile::{FlowControl, Language, Profile, Protocol};
+use crate::device::profile::{FlowControl, Language, Profile};
 use record::SimPath;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
@@ -300,7 +300,6 @@ struct Device {
     stopped_at: Option<Instant>,
     taken_since_stop: usize,
     backlog_at_grace: Option<usize>,
-    xon_lost: bool,
     /// Remaining seconds (real time) of each queued motion.
     motion: VecDeque<f64>,
     held: bool,
@@ -363,7 +362,6 @@ impl Device {
             stopped_at: None,
             taken_since_stop: 0,
             backlog_at_grace: None,
-            xon_lost: false,
             motion: VecDeque::new(),
             held: false,
             grbl_lines: 0,
@@ -701,10 +699,9 @@ impl Device {
                     }
                 } else if self.stopped && fill <= self.low && !self.stalled {
                     if self.flow == FlowControl::XonXoff {
-                        if self.cfg.faults.lose_xon {
-                            // The XON is lost on the line: the device believes it sent it.
-                            self.xon_lost = true;
-                        } else {
+                        // With `lose_xon` the XON is lost on the line: the device believes it
+                        // sent it.
+                        if !self.cfg.faults.lose_xon {
                             self.urgent.push(XON);
                             self.rep.xon_sent += 1;
                         }
@@ -769,12 +766,46 @@ impl Device {
     }
 }
 
-/// Draw what the simulator cut, in the machine's axes (mm), and write `sim.png` and
-/// `sim.json` into `dir`. Returns the two paths.
+/// Stream `program` through a pseudo-terminal into a new simulator set up by `cfg`, exactly
+/// as flatcut's transport streams to a real port (CTS read from the simulator's flag), then let
+/// the simulated machine work off what it holds, as a real one would: at most `finish_within`,
+/// and at most 30 s once the stream was cancelled (Ctrl-C). Returns the stream's outcome and
+/// the simulator's report; the report exists even when the stream failed.
+pub fn stream_job(
+    cfg: SimConfig,
+    program: &[u8],
+    opts: &crate::device::stream::StreamOptions,
+    finish_within: Duration,
+) -> Result<
+    (
+        Result<crate::device::stream::StreamReport, crate::device::stream::StreamError>,
+        SimReport,
+    ),
+    crate::Error,
+> {
+    let profile = cfg.profile.clone();
+    let handle = spawn(cfg)?;
+    let mut port = crate::device::serial::open(&profile, &handle.path, None)?
+        .with_virtual_cts(handle.cts.clone());
+    let sent = crate::device::stream::send(&mut port, &profile, program, opts);
+    let written = port.written;
+    drop(port);
+    let wait = if opts.cancel.load(Ordering::SeqCst) {
+        finish_within.min(Duration::from_secs(30))
+    } else {
+        finish_within
+    };
+    let report = handle.finish(written, wait)?;
+    Ok((sent, report))
+}
+
+/// Draw what the simulator cut, in the machine's axes (mm), and write `<stem>.png` and
+/// `<stem>.json` into `dir`. Returns the two paths.
 pub fn write_outputs(
     rep: &SimReport,
     profile: &Profile,
     dir: &Path,
+    stem: &str,
 ) -> Result<(std::path::PathBuf, std::path::PathBuf), crate::Error> {
     use crate::toolpath::{SheetJob, Stroke, StrokeRole};
     use glam::DVec2;
@@ -811,20 +842,10 @@ pub fn write_outputs(
     };
     let px = crate::output::png::DEFAULT_PX_PER_MM;
     let png = crate::output::png::render(&sheet, 0, px)?;
-    let png_path = dir.join("sim.png");
-    let json_path = dir.join("sim.json");
+    let png_path = dir.join(format!("{stem}.png"));
+    let json_path = dir.join(format!("{stem}.json"));
     crate::cli::write_atomic(&png_path, &png)?;
     let text = serde_json::to_string_pretty(rep).unwrap_or_default() + "\n";
     crate::cli::write_atomic(&json_path, text.as_bytes())?;
     Ok((png_path, json_path))
-}
-
-/// `Protocol` the simulator expects for a profile (GRBL profiles always count characters on
-/// the device side: the device does not know how the host paces).
-pub fn is_grbl(p: &Profile) -> bool {
-    p.language == Language::Gcode
-        || matches!(
-            p.protocol,
-            Protocol::GrblCharacterCounting | Protocol::GrblSendResponse
-        )
 }
