@@ -255,6 +255,7 @@ mod tests {
             marks: vec![],
             label: vec![],
             area: s * s,
+            grain: None,
         }
     }
 

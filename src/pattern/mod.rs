@@ -96,6 +96,9 @@ pub struct Piece {
     pub label: Vec<Vec<DVec2>>,
     /// Area in mm² (equal in 3D and flat: the unfolding is isometric).
     pub area: f64,
+    /// Direction of the grain line in the piece's frame (radians from +x), for materials with
+    /// a grain (fabric). The nest stage keeps it parallel to the roll (sheet y axis), either way.
+    pub grain: Option<f64>,
 }
 
 impl Piece {
@@ -291,6 +294,7 @@ fn piece(
         marks,
         label,
         area,
+        grain: None,
     })
 }
 
