@@ -4,4 +4,5 @@
 
 pub mod font;
 pub mod mesh;
+pub mod boolean;
 pub mod polygon;
