@@ -32,6 +32,8 @@ pub struct CutArgs {
     #[arg(long)]
     pub dry_run: bool,
     #[command(flatten)]
+    pub pattern: super::PatternArgs,
+    #[command(flatten)]
     pub link: super::link::LinkArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
@@ -82,6 +84,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     if let Some(m) = a.material {
         spec.material.kind = m;
     }
+    a.pattern.apply(&mut spec)?;
     let device = a
         .device
         .clone()

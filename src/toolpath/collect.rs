@@ -7,7 +7,8 @@
 //! half a turn about its own centre when the placement would put it upside down.
 
 use super::{Stroke, StrokeRole, ToolpathOptions};
-use crate::nest::{Layout, Sheet};
+use crate::nest::{Layout, Placement, Sheet};
+use crate::pattern::Text;
 use glam::DVec2;
 
 /// All strokes of a sheet, piece by piece, in sheet millimetres.
@@ -16,24 +17,48 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
     for &k in &sheet.pieces {
         let piece = &layout.pieces[k];
         let at = layout.placements[k];
-        let mut open = |role, pts: &[DVec2]| {
+        // `place`: the points are in the piece's frame (else already on the sheet).
+        let mut open = |role, pts: &[DVec2], place: bool| {
             out.push(Stroke {
                 role,
-                points: pts.iter().map(|p| at.apply(*p)).collect(),
+                points: if place {
+                    pts.iter().map(|p| at.apply(*p)).collect()
+                } else {
+                    pts.to_vec()
+                },
                 closed: false,
                 piece: Some(k),
                 outer: false,
             })
         };
         if !opts.skip_drawing {
-            for s in &piece.label {
-                open(StrokeRole::Label, s);
-            }
-            for m in &piece.marks {
-                for s in &m.strokes {
-                    open(StrokeRole::Mark, s);
+            for t in std::iter::once(&piece.label)
+                .chain(piece.marks.iter().map(|m| &m.text))
+                .chain(&piece.notes)
+            {
+                let role = if t.dir.is_none() {
+                    StrokeRole::Label
+                } else {
+                    StrokeRole::Mark
+                };
+                for pts in upright(t, &at) {
+                    open(role, &pts, false);
                 }
             }
+            for ring in &piece.seam_line {
+                let mut pts = ring.clone();
+                pts.extend(ring.first().copied());
+                open(StrokeRole::Seam, &pts, true);
+            }
+            for s in &piece.grain_line {
+                open(StrokeRole::Grain, s, true);
+            }
+            for n in piece.notches.iter().filter(|n| !n.cut) {
+                open(StrokeRole::Mark, &n.stroke, true);
+            }
+        }
+        for n in piece.notches.iter().filter(|n| n.cut) {
+            open(StrokeRole::Notch, &n.stroke, true);
         }
         if !opts.skip_folds {
             for f in &piece.folds {
@@ -41,7 +66,7 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
                     crate::pattern::FoldKind::Mountain => StrokeRole::FoldMountain,
                     crate::pattern::FoldKind::Valley => StrokeRole::FoldValley,
                 };
-                open(role, &[f.a, f.b]);
+                open(role, &[f.a, f.b], true);
             }
         }
         for (i, ring) in piece.outline.iter().enumerate() {
@@ -57,4 +82,30 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
         }
     }
     out
+}
+
+/// The strokes of a text on the sheet, reading upright: a label keeps its own orientation
+/// (only its centre moves with the piece); text set along an edge turns with the piece, and
+/// half a turn more about its centre when it would read right to left or downwards.
+fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
+    let Some((lo, hi)) = crate::geom::polygon::bounds(t.points()) else {
+        return Vec::new();
+    };
+    let c = 0.5 * (lo + hi);
+    let cs = at.apply(c);
+    let map: Box<dyn Fn(DVec2) -> DVec2> = match t.dir {
+        None => Box::new(move |q| cs + (q - c)),
+        Some(r) => {
+            let d = at.apply(c + r) - cs;
+            if d.x < -1e-9 || (d.x.abs() <= 1e-9 && d.y < 0.0) {
+                Box::new(move |q| 2.0 * cs - at.apply(q))
+            } else {
+                Box::new(move |q| at.apply(q))
+            }
+        }
+    };
+    t.strokes
+        .iter()
+        .map(|s| s.iter().map(|q| map(*q)).collect())
+        .collect()
 }
