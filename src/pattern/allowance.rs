@@ -287,13 +287,14 @@ fn tab_region(p: &Piece, si: usize, placed: &[Shape], h: f64) -> Option<Candidat
     (area > 0.0).then_some(Candidate { region, area })
 }
 
-/// V notches where bend lines meet the border.
+/// V notches where bend lines meet the outline.
 fn bend_notches(p: &mut Piece) {
     let mut vs: Vec<Vec<DVec2>> = Vec::new();
     for f in p.folds.iter().filter(|f| !f.tab) {
         for (end, other) in [(f.a, f.b), (f.b, f.a)] {
+            // Only where the outline is the border (no allowance or tab there).
             let on_border = p
-                .border
+                .outline
                 .iter()
                 .flatten()
                 .any(|q| q.distance(end) < 1e-6 * (1.0 + end.length()));
