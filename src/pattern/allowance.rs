@@ -20,6 +20,10 @@
 //! corners (corners sharper than 30° are bevelled); holes shrink by the same amount. The
 //! border becomes the drawn sewing line; notches are slits cut from the new outline inward.
 //!
+//! Every outline is finally [`clean`]ed: zero-width slits of the net closed, features below
+//! what a knife can cut (0.1 mm) dropped, so that the rounded device coordinates still make
+//! simple rings.
+//!
 //! **Bend notches** (metal, `--bend-notches`): a V 1.5 mm deep and 2 mm wide cut into the
 //! outline where a bend line meets it. **Kerf**: every cut contour moves `kerf / 2` away from
 //! the material (outline out, holes in), last, so that the cut edge lands on the border.
@@ -36,12 +40,19 @@ pub const TAB_GAP: f64 = 0.5;
 /// Adds tabs, allowance, bend notches and kerf to the pieces of one flat, then the notch
 /// strokes.
 pub(super) fn apply(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
+    for p in pieces.iter_mut() {
+        if let Some(outline) = clean(&p.border) {
+            p.outline = outline;
+        }
+    }
     if opts.tabs != Tabs::None && opts.tab_height > 0.0 {
         tabs(flat, pieces, opts);
     }
     for p in pieces.iter_mut() {
         if opts.allowance > 0.0 {
-            if let Some(outline) = single(boolean::offset(&p.border, opts.allowance)) {
+            if let Some(outline) =
+                single(boolean::offset(&p.border, opts.allowance)).and_then(|o| clean(&o))
+            {
                 p.outline = outline;
                 p.seam_line = p.border.clone();
             }
@@ -50,12 +61,49 @@ pub(super) fn apply(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
             bend_notches(p);
         }
         if opts.kerf > 0.0 {
-            if let Some(outline) = single(boolean::offset(&p.outline, 0.5 * opts.kerf)) {
+            if let Some(outline) =
+                single(boolean::offset(&p.outline, 0.5 * opts.kerf)).and_then(|o| clean(&o))
+            {
                 p.outline = outline;
             }
         }
         super::marks::notch_strokes(p, opts);
     }
+}
+
+/// Features narrower than twice this (mm) are closed or dropped from cut outlines: no knife
+/// separates them, and rounding to device units would turn them into crossings.
+pub const CLEAN_MM: f64 = 0.05;
+
+/// A cut outline a machine can follow: the rings as one region (a zero-width slit of the net,
+/// where both copies of an edge lie on each other, is closed: the faces simply stay joined
+/// there), gaps narrower than `2 CLEAN_MM` closed and slivers as thin dropped
+/// (morphological closing then opening, mitred), vertices closer than `CLEAN_MM / 2` to the
+/// previous one merged. `None` when that does not leave exactly one shape.
+pub fn clean(rings: &[Vec<DVec2>]) -> Option<Vec<Vec<DVec2>>> {
+    let step =
+        |shapes: Vec<Shape>, d: f64| -> Vec<Shape> { boolean::offset(&boolean::rings(shapes), d) };
+    let closed = step(boolean::offset(rings, CLEAN_MM), -CLEAN_MM);
+    let opened = step(step(closed.clone(), -CLEAN_MM), CLEAN_MM);
+    // An opening that splits the piece at a thin neck would lose part of it: keep the closing.
+    let shape = single(opened).or_else(|| single(closed))?;
+    let shape: Vec<Vec<DVec2>> = shape
+        .into_iter()
+        .map(|ring| {
+            let mut out: Vec<DVec2> = Vec::with_capacity(ring.len());
+            for q in ring {
+                if out.last().is_none_or(|l| l.distance(q) >= 0.5 * CLEAN_MM) {
+                    out.push(q);
+                }
+            }
+            while out.len() > 3 && out[0].distance(out[out.len() - 1]) < 0.5 * CLEAN_MM {
+                out.pop();
+            }
+            out
+        })
+        .filter(|r| r.len() >= 3)
+        .collect();
+    (!shape.is_empty()).then_some(shape)
 }
 
 /// The one shape of a boolean result, with its outer ring first.
@@ -153,7 +201,7 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
             .iter()
             .flat_map(|t| boolean::rings(boolean::offset(t, 0.01)))
             .collect();
-        let mut u = boolean::union(&p.border, &all);
+        let mut u = boolean::union(&p.outline, &all);
         // Keep the border's own holes; fill the pockets (usually specks of a few µm² where a
         // tab meets a corner of the border) that tabs close off.
         let inside: Vec<DVec2> = p.border[1..]
@@ -170,7 +218,7 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
                 k == 1 || inside.iter().any(|c| polygon::contains(r, *c))
             });
         }
-        match single(u) {
+        match single(u).and_then(|o| clean(&o)) {
             Some(outline) if polygon::is_simple_ring(&outline[0]) => p.outline = outline,
             _ => {
                 // Cannot happen with tabs kept apart by TAB_GAP; keep the piece cuttable.
@@ -293,11 +341,10 @@ fn bend_notches(p: &mut Piece) {
     for f in p.folds.iter().filter(|f| !f.tab) {
         for (end, other) in [(f.a, f.b), (f.b, f.a)] {
             // Only where the outline is the border (no allowance or tab there).
-            let on_border = p
-                .outline
-                .iter()
-                .flatten()
-                .any(|q| q.distance(end) < 1e-6 * (1.0 + end.length()));
+            let on_border = p.outline.iter().any(|r| {
+                (0..r.len())
+                    .any(|i| polygon::segment_distance(end, r[i], r[(i + 1) % r.len()]) < 1e-3)
+            });
             let Some(u) = (other - end).try_normalize() else {
                 continue;
             };
@@ -321,7 +368,7 @@ fn bend_notches(p: &mut Piece) {
             v.reverse();
         }
     }
-    if let Some(outline) = single(boolean::difference(&p.outline, &vs)) {
+    if let Some(outline) = single(boolean::difference(&p.outline, &vs)).and_then(|o| clean(&o)) {
         p.outline = outline;
     }
 }

@@ -12,9 +12,10 @@
 //! of pieces, rings and segments; the first piece met is side A.
 //!
 //! **Notches** go at equal arc lengths from side A's start, which is side B's end: every
-//! `spacing` mm, plus a second notch 3 mm (at most a tenth of the seam) after the first one,
+//! `spacing` mm (on side B at the same fraction of the same mesh edge), plus a second notch 3 mm (at most a tenth of the seam) after the first one,
 //! so that the pattern of notches is not symmetric and the pieces cannot be joined reversed.
-//! A seam shorter than 1¼ spacings gets its pair at a third of its length.
+//! A seam shorter than 1¼ spacings gets its pair at a third of its length; one shorter than
+//! 5 mm gets none.
 //!
 //! **Text.** The seam id is written along the longest segment of each side, inside the face
 //! (as the edge ids before it: at most 3 mm, 30 % of the segment, 35 % of the face's depth).
@@ -68,7 +69,7 @@ pub struct SeamSide {
     pub count: usize,
     /// The chain on this piece, `count + 1` points in border order.
     pub points: Vec<DVec2>,
-    /// Its length (mm).
+    /// Its length (mm): the sum of its mesh edges' lengths, as laid flat on their faces.
     pub length: f64,
     /// Notch positions as arc lengths from this side's first point (mm).
     pub notches: Vec<f64>,
@@ -161,7 +162,19 @@ pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts
             let ring = &pieces[l.0].border[l.1];
             let n = ring.len();
             let points: Vec<DVec2> = (0..=count).map(|i| ring[(l.2 + i) % n]).collect();
-            let length = points.windows(2).map(|w| w[0].distance(w[1])).sum();
+            // Each segment measured on its own face (the next border point belongs to the
+            // next face, placed within the unfolding's tolerance): the 3D edge length.
+            let length = (0..count)
+                .map(|i| {
+                    let j = (l.2 + i) % n;
+                    let f = pieces[l.0].border_faces[l.1][j];
+                    let c = &flat.face_2d[f];
+                    match c.iter().position(|q| *q == ring[j]) {
+                        Some(k) => c[k].distance(c[(k + 1) % c.len()]),
+                        None => ring[j].distance(ring[(j + 1) % n]),
+                    }
+                })
+                .sum();
             SeamSide {
                 id,
                 is_a,
@@ -179,10 +192,16 @@ pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts
         let mut sb = side(b, false, pieces[a.0].id);
         if let Some(spacing) = opts.notches {
             let at_a = notch_positions(sa.length, spacing);
+            // Side B runs the chain backwards, segment for segment (each segment is one mesh
+            // edge); a notch goes at the same fraction of the same edge on both sides, which
+            // holds even where the two flat copies differ by the unfolding's tolerance.
             sb.notches = at_a
                 .iter()
                 .rev()
-                .map(|s| (sb.length - s).max(0.0))
+                .map(|&s| {
+                    let (k, t) = segment_at(&sa.points, s);
+                    arc_at(&sb.points, count - 1 - k, 1.0 - t)
+                })
                 .collect();
             sa.notches = at_a;
         }
@@ -198,7 +217,7 @@ pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts
 
 /// Arc lengths of the notches along a seam of length `len` from side A's start.
 pub fn notch_positions(len: f64, spacing: f64) -> Vec<f64> {
-    if len.is_nan() || len <= 1.0 || spacing.is_nan() || spacing <= 0.0 {
+    if len.is_nan() || len < 5.0 || spacing.is_nan() || spacing <= 0.0 {
         return Vec::new();
     }
     let mut at: Vec<f64> = Vec::new();
@@ -297,6 +316,34 @@ pub(super) fn notch_strokes(p: &mut Piece, opts: &PatternOptions) {
         }
     }
     p.notches = notches;
+}
+
+/// Segment index and fraction along it of arc length `s` on a polyline.
+pub fn segment_at(points: &[DVec2], s: f64) -> (usize, f64) {
+    let mut left = s;
+    let n = points.len().saturating_sub(1);
+    for (k, w) in points.windows(2).enumerate() {
+        let l = w[0].distance(w[1]);
+        if left <= l || k + 1 == n {
+            return (
+                k,
+                if l > 0.0 {
+                    (left / l).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+            );
+        }
+        left -= l;
+    }
+    (0, 0.0)
+}
+
+/// Arc length of the point at fraction `t` of segment `k` of a polyline.
+pub fn arc_at(points: &[DVec2], k: usize, t: f64) -> f64 {
+    let before: f64 = points.windows(2).take(k).map(|w| w[0].distance(w[1])).sum();
+    let l = points.get(k + 1).map_or(0.0, |b| points[k].distance(*b));
+    before + t * l
 }
 
 /// The point at arc length `s` along a polyline and the direction of its segment there.

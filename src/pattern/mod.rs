@@ -473,8 +473,10 @@ mod tests {
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];
         assert_eq!(p.outline.len(), 1);
-        assert_eq!(p.outline[0].len(), 14);
-        assert!((p.cut_length() - 1400.0).abs() < 1e-9);
+        assert_eq!(p.border[0].len(), 14);
+        // The cut outline is the border without its two straight-through vertices.
+        assert_eq!(p.outline[0].len(), 12);
+        assert!((p.cut_length() - 1400.0).abs() < 1e-6);
         assert!((p.fold_length() - 500.0).abs() < 1e-9);
         assert!(p.folds.iter().all(|f| f.kind == FoldKind::Mountain));
         assert!(p.folds.iter().all(|f| (f.angle_deg - 90.0).abs() < 1e-9));
