@@ -11,33 +11,6 @@ use flatcut::spec::{MaterialKind, Spec};
 use flatcut::toolpath::StrokeRole;
 use glam::{DVec2, DVec3};
 
-const FANDISK: &str = r#"
-name = "fandisk"
-[[surface]]
-kind = "mesh"
-path = "fandisk.obj"
-scale = 100
-units = "mm"
-[sheet]
-width = 297
-height = 420
-margin = 5
-spacing = 3
-"#;
-
-fn fandisk_spec(dir: &std::path::Path) -> std::path::PathBuf {
-    let path = dir.join("fandisk.toml");
-    std::fs::write(
-        &path,
-        FANDISK.replace(
-            "fandisk.obj",
-            &shared_data("meshes/fandisk.obj").to_string_lossy(),
-        ),
-    )
-    .unwrap();
-    path
-}
-
 fn load(path: &std::path::Path, material: MaterialKind, notches: Option<f64>) -> Spec {
     let mut spec = flatcut::spec::load(path).unwrap();
     spec.material.kind = material;

@@ -432,8 +432,6 @@ fn net(
     }
     let area = faces.iter().map(|&f| mesh.face_area(f)).sum();
     Ok(Piece {
-        id,
-        name,
         surface: flat.surface.name.clone(),
         faces: faces.to_vec(),
         outline: border.clone(),
@@ -441,15 +439,8 @@ fn net(
         border_edges,
         border_faces,
         folds,
-        marks: Vec::new(),
-        seams: Vec::new(),
-        notches: Vec::new(),
-        notes: Vec::new(),
-        seam_line: Vec::new(),
-        grain_line: Vec::new(),
-        label: Text::default(),
         area,
-        grain: None,
+        ..Piece::from_outline(id, name, Vec::new())
     })
 }
 
