@@ -86,26 +86,42 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
 
 /// The strokes of a text on the sheet, reading upright: a label keeps its own orientation
 /// (only its centre moves with the piece); text set along an edge turns with the piece, and
-/// half a turn more about its centre when it would read right to left or downwards.
+/// half a turn more about its centre when it would read right to left or downwards. On a
+/// mirrored piece the text is set again in its (symmetric) box so that it never reads
+/// mirrored. The box is centred where the piece puts it, so the text stays where it was.
 fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
     let Some((lo, hi)) = crate::geom::polygon::bounds(t.points()) else {
         return Vec::new();
     };
     let c = 0.5 * (lo + hi);
     let cs = at.apply(c);
-    let map: Box<dyn Fn(DVec2) -> DVec2> = match t.dir {
-        None => Box::new(move |q| cs + (q - c)),
-        Some(r) => {
-            let d = at.apply(c + r) - cs;
-            if d.x < -1e-9 || (d.x.abs() <= 1e-9 && d.y < 0.0) {
-                Box::new(move |q| 2.0 * cs - at.apply(q))
-            } else {
-                Box::new(move |q| at.apply(q))
-            }
-        }
+    let (r, up) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
+        Some(r) => (r, r.perp()),
     };
+    // The box's axes on the sheet.
+    let (mut e1, mut e2) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
+        Some(_) => (
+            (at.apply(c + r) - cs).normalize_or_zero(),
+            (at.apply(c + up) - cs).normalize_or_zero(),
+        ),
+    };
+    if e1.perp_dot(e2) < 0.0 {
+        e1 = -e1;
+    }
+    if e1.x < -1e-9 || (e1.x.abs() <= 1e-9 && e1.y < 0.0) {
+        (e1, e2) = (-e1, -e2);
+    }
     t.strokes
         .iter()
-        .map(|s| s.iter().map(|q| map(*q)).collect())
+        .map(|s| {
+            s.iter()
+                .map(|q| {
+                    let d = *q - c;
+                    cs + e1 * d.dot(r) + e2 * d.dot(up)
+                })
+                .collect()
+        })
         .collect()
 }
