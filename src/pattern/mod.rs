@@ -14,6 +14,8 @@
 //! edge length and 35 % of the face's depth behind the edge; the piece label goes in the
 //! incircle of the piece's largest triangle, at most 8 mm high.
 
+pub mod bends;
+
 use crate::flatten::Flat;
 use crate::geom::{font, polygon};
 use glam::DVec2;
@@ -246,7 +248,7 @@ fn piece(
     let (outline, outline_edges): (Vec<_>, Vec<_>) = loops.into_iter().unzip();
 
     // Folds and edge ids.
-    let threshold = opts.fold_threshold_deg.to_radians();
+    let fold_at = bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
     let mut folds = Vec::new();
     let mut marks = Vec::new();
     for &f in faces {
@@ -254,8 +256,7 @@ fn piece(
             let (a, b) = flat.corner_edge(f, i);
             if flat.joined[e] {
                 // Each fold once: from the face listed first on the edge.
-                let d = flat.dihedral[e];
-                if topo.edges[e].uses[0] == (f, i) && d.abs() > threshold {
+                if let (true, Some(d)) = (topo.edges[e].uses[0] == (f, i), fold_at[e]) {
                     folds.push(Fold {
                         a,
                         b,
