@@ -89,7 +89,9 @@ pub enum BendLines {
     /// None: the blank gets no bend lines.
     None,
     /// Rulings about this far apart (mm, measured between bridge midpoints along the strip),
-    /// each with the angle accumulated since the previous one.
+    /// each with the angle accumulated since the previous one (the last one also takes what
+    /// bends after it). Only rulings that bend themselves are picked, so no bend line falls
+    /// inside a flat triangle.
     Spacing(f64),
 }
 
@@ -649,7 +651,7 @@ impl Strip {
                     }
                 }
                 BendLines::Spacing(s) => {
-                    if along - last_pick >= s && acc.to_degrees().abs() > EPS_DEG {
+                    if along - last_pick >= s && signed.to_degrees().abs() > EPS_DEG {
                         out.push(Bend {
                             verts,
                             angle_deg: acc.to_degrees(),
@@ -659,6 +661,10 @@ impl Strip {
                     }
                 }
             }
+        }
+        // What bent after the last pick belongs to it (so the angles add up to the total).
+        if let (BendLines::Spacing(_), Some(last)) = (lines, out.last_mut()) {
+            last.angle_deg += acc.to_degrees();
         }
         out
     }
