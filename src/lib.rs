@@ -36,6 +36,8 @@ pub enum Error {
     #[error(transparent)]
     Nest(#[from] nest::NestError),
     #[error(transparent)]
+    Esicup(#[from] nest::esicup::EsicupError),
+    #[error(transparent)]
     Output(#[from] output::OutputError),
     #[error(transparent)]
     Profile(#[from] device::ProfileError),

@@ -38,6 +38,8 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
         height: Some(420.0),
         margin: 5.0,
         spacing: 3.0,
+        seconds: 0.2,
+        ..Default::default()
     };
     let layout = flatcut::nest::nest(pieces, &opts).expect("nest");
     let mesh = &flat.surface.mesh;

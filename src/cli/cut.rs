@@ -33,6 +33,8 @@ pub struct CutArgs {
     pub dry_run: bool,
     #[command(flatten)]
     pub link: super::link::LinkArgs,
+    #[command(flatten)]
+    pub search: super::nest::SearchArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -44,7 +46,8 @@ pub fn default_dir(name: &str) -> PathBuf {
 }
 
 /// Spec → pieces → layout → job for a device: what `cut` sends (the device decides which
-/// stroke kinds are drawn at all).
+/// stroke kinds are drawn at all), with the default nesting search.
+#[allow(clippy::type_complexity)]
 pub fn plan_job(
     spec: &crate::spec::Spec,
     profile: &crate::device::Profile,
@@ -57,13 +60,32 @@ pub fn plan_job(
     ),
     Error,
 > {
+    plan_job_with(spec, profile, &Default::default(), quiet)
+}
+
+/// [`plan_job`] with the nesting search flags (`--nest-time`, `--seed`, `--threads`).
+pub fn plan_job_with(
+    spec: &crate::spec::Spec,
+    profile: &crate::device::Profile,
+    search: &super::nest::SearchArgs,
+    quiet: bool,
+) -> Result<
+    (
+        Vec<crate::flatten::Flat>,
+        crate::nest::Layout,
+        crate::toolpath::Job,
+    ),
+    Error,
+> {
     let (flats, pieces) = super::pieces(spec, quiet)?;
-    let nest_opts = crate::nest::NestOptions {
+    let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
         height: spec.sheet.height,
         margin: spec.sheet.margin,
         spacing: spec.sheet.spacing,
+        ..Default::default()
     };
+    search.apply(&mut nest_opts)?;
     let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
         file: spec.path.clone(),
         source: Box::new(e.into()),
@@ -94,7 +116,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
             profile.name
         )));
     }
-    let (flats, layout, job) = plan_job(&spec, &profile, a.quiet)?;
+    let (flats, layout, job) = plan_job_with(&spec, &profile, &a.search, a.quiet)?;
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;

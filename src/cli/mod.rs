@@ -6,6 +6,7 @@ pub mod check;
 pub mod cut;
 pub mod flatten;
 pub mod link;
+pub mod nest;
 pub mod ports;
 pub mod send;
 pub mod sim;
@@ -23,6 +24,7 @@ Examples:
   flatcut cut lamp.obj --device hpgl-pens --dry-run   a bare OBJ with defaults (paper, A4, 5 mm margin)
   flatcut cut box.toml --material fabric -o out       flags override the spec file
   flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
+  flatcut nest fu.json --nest-time 10 -o out/fu        nest an ESICUP instance, print the density
   flatcut check model.obj                             faces, edges, boundary loops, angle defect
   flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
   flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
@@ -47,6 +49,9 @@ pub enum Command {
     /// Unfold and write the pieces (SVG, PNG, report) without nesting on sheets.
     #[command(after_help = EXAMPLES)]
     Flatten(flatten::FlattenArgs),
+    /// Nest an ESICUP strip-packing instance (JSON): solution.json, layout.svg, density.
+    #[command(after_help = EXAMPLES)]
+    Nest(nest::NestArgs),
     /// Report what a mesh is made of and whether it can be unfolded exactly.
     #[command(after_help = EXAMPLES)]
     Check(check::CheckArgs),
@@ -67,6 +72,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Cut(a) => cut::run(&a),
         Command::Flatten(a) => flatten::run(&a),
+        Command::Nest(a) => nest::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Send(a) => send::run(&a),
         Command::Sim(a) => sim::run(&a),
