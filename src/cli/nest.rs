@@ -73,7 +73,11 @@ pub fn run(a: &NestArgs) -> Result<(), Error> {
         seed: opts.seed,
         threads: opts.threads,
     };
+    let t0 = std::time::Instant::now();
     let sol = esicup::solve(&inst, &cfg)?;
+    if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
+        eprintln!("work {} in {:.2} s", sol.work, t0.elapsed().as_secs_f64());
+    }
     let dir = a
         .output
         .clone()

@@ -248,7 +248,7 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
     if !boxes_near(a, pa, b, pb, s) {
         return false;
     }
-    *work += (a.segs.len() * b.segs.len()) as u64 / 8 + 1;
+    *work += (a.segs.len() * b.segs.len()) as u64 / 16 + 4;
     // Work in a's frame.
     let d = pb - pa;
     // Window where both shapes' material can meet.
@@ -306,7 +306,7 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
 
 /// Overlap proxy of two shapes known to collide (see the module docs); always > 0.
 pub fn overlap_proxy(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u64) -> f64 {
-    *work += (a.poles.len() * b.poles.len()) as u64 / 8 + 1;
+    *work += (a.poles.len() * b.poles.len()) as u64 / 16 + 2;
     let r0 = match (a.poles.first(), b.poles.first()) {
         (Some(x), Some(y)) => x.1.min(y.1),
         _ => return 1e-6,

@@ -116,7 +116,7 @@ impl Sep {
 /// Weighted overlap of item `k` of `st` if it were `cand`; stops early above `bound`.
 fn evaluate(ctx: &mut Ctx, st: &State, sep: &Sep, k: usize, cand: &Placed, bound: f64) -> f64 {
     let s = ctx.prob.spacing;
-    ctx.work += 1 + st.placed.len() as u64 / 16;
+    ctx.work += 2 + st.placed.len() as u64 / 16;
     let mut acc = 0.0;
     for (j, b) in st.placed.iter().enumerate() {
         if j == k || !boxes_near(&cand.shape, cand.pos, &b.shape, b.pos, s) {
@@ -216,6 +216,21 @@ fn move_item(ctx: &mut Ctx, st: &mut State, sep: &mut Sep, k: usize, len: f64) {
     sep.update_row(ctx, st, k);
 }
 
+/// One iteration of the separator (for the benchmark): every overlapping item of `st` moves
+/// once, then the weights are updated; returns the overlap left.
+pub fn sweep(ctx: &mut Ctx, st: &mut State, len: f64) -> f64 {
+    let mut sep = Sep::new(ctx, st);
+    let mut order: Vec<usize> = (0..sep.n).filter(|&k| sep.overlapping(k)).collect();
+    ctx.rng.shuffle(&mut order);
+    for &k in &order {
+        if sep.overlapping(k) {
+            move_item(ctx, st, &mut sep, k, len);
+        }
+    }
+    sep.update_weights();
+    sep.total()
+}
+
 /// Resolve the overlaps of `st` in a container `len` long; true when it ends feasible (then
 /// `st` is the feasible layout), else `st` is the least-overlapping layout found.
 pub fn separate(ctx: &mut Ctx, st: &mut State, len: f64, strikes: usize, patience: usize) -> bool {
@@ -263,7 +278,7 @@ pub fn separate(ctx: &mut Ctx, st: &mut State, len: f64, strikes: usize, patienc
 
 /// Cut a slice `delta` wide out at a random x of a layout `len` long: items right of the cut
 /// move left; every item is kept inside the new length. None if an item cannot fit.
-fn shrink(ctx: &mut Ctx, st: &State, len: f64, new_len: f64) -> Option<State> {
+pub fn shrink(ctx: &mut Ctx, st: &State, len: f64, new_len: f64) -> Option<State> {
     let delta = len - new_len;
     let cut = ctx.rng.range(0.0, new_len);
     let mut out = st.clone();
