@@ -11,10 +11,11 @@
 //!   shape's first pole centre (an interior point) lies in the other's material (inside the
 //!   outer ring and outside every hole) — the containment cases;
 //! - `s = 0`: some pair of segments crosses properly (touching, collinear overlap and shared
-//!   vertices are allowed, so that rectangles tile exactly), or a probe point of one shape (its
-//!   pole centres and edge midpoints) lies in the other's material farther than 1e-9 mm from its
-//!   boundary (this catches containment and the collinear "sliding" overlaps that have no proper
-//!   crossing).
+//!   vertices are allowed, so that rectangles tile exactly), or the first pole centre of one
+//!   lies in the other's material; when boundaries touch (some orientation test is exactly
+//!   zero), every pole centre and edge midpoint is probed, and counts when it lies in the
+//!   other's material farther than 1e-9 mm from its boundary (this catches the collinear
+//!   "sliding" overlaps that have no proper crossing).
 //!
 //! A piece inside the hole of another does not collide with it: holes are usable.
 //!
@@ -84,6 +85,8 @@ pub struct Shape {
     pub mids: Vec<DVec2>,
     pub poles: Vec<(DVec2, f64)>,
     pub size: DVec2,
+    /// Area of the material.
+    pub area: f64,
     /// Add to a turned item point to get the shape point: `shape = orient(q) + shift`.
     pub shift: DVec2,
 }
@@ -129,6 +132,10 @@ impl Shape {
             .iter()
             .map(|(c, r)| (orient.apply(*c) + shift, *r))
             .collect();
+        let area = turned
+            .iter()
+            .map(|r| crate::geom::polygon::signed_area(r))
+            .sum();
         Shape {
             orient,
             rings: turned,
@@ -136,6 +143,7 @@ impl Shape {
             mids,
             poles,
             size: hi - lo,
+            area,
             shift,
         }
     }
@@ -255,6 +263,9 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
     let wlo = d.max(DVec2::ZERO) - DVec2::splat(s);
     let whi = (d + b.size).min(a.size) + DVec2::splat(s);
     let s2 = s * s;
+    // Zero spacing: do some boundaries touch (a zero orientation)? Only then can material
+    // overlap without a proper crossing and without one shape's pole in the other.
+    let mut touch = false;
     for [a0, a1] in &a.segs {
         let (alo, ahi) = (a0.min(*a1), a0.max(*a1));
         if ahi.x < wlo.x || ahi.y < wlo.y || alo.x > whi.x || alo.y > whi.y {
@@ -263,21 +274,32 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
         for [b0, b1] in &b.segs {
             let (b0, b1) = (*b0 + d, *b1 + d);
             let (blo, bhi) = (b0.min(b1), b0.max(b1));
-            if blo.x >= ahi.x + s || blo.y >= ahi.y + s || alo.x >= bhi.x + s || alo.y >= bhi.y + s
-            {
+            // Strictly apart only: touching segments must set `touch` below.
+            if blo.x > ahi.x + s || blo.y > ahi.y + s || alo.x > bhi.x + s || alo.y > bhi.y + s {
                 continue;
             }
             if s > 0.0 {
                 if seg_seg_dist2(*a0, *a1, b0, b1) < s2 {
                     return true;
                 }
-            } else if cross_properly(*a0, *a1, b0, b1) {
-                return true;
+            } else {
+                let o1 = orient2(*a0, *a1, b0);
+                let o2 = orient2(*a0, *a1, b1);
+                let o3 = orient2(b0, b1, *a0);
+                let o4 = orient2(b0, b1, *a1);
+                if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0))
+                    && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0))
+                {
+                    return true;
+                }
+                if o1 == 0.0 || o2 == 0.0 || o3 == 0.0 || o4 == 0.0 {
+                    touch = true;
+                }
             }
         }
     }
     // No boundaries meet: either apart, or one inside the other.
-    if s > 0.0 {
+    if s > 0.0 || !touch {
         let inside_b = a
             .poles
             .first()
@@ -307,25 +329,42 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
 /// Overlap proxy of two shapes known to collide (see the module docs); always > 0.
 pub fn overlap_proxy(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u64) -> f64 {
     *work += (a.poles.len() * b.poles.len()) as u64 / 16 + 2;
-    let r0 = match (a.poles.first(), b.poles.first()) {
-        (Some(x), Some(y)) => x.1.min(y.1),
-        _ => return 1e-6,
-    };
-    let eps = 0.02 * r0;
+    if a.poles.is_empty() || b.poles.is_empty() {
+        return 1e-6;
+    }
+    let eps = 0.01 * a.size.max_element().max(b.size.max_element());
     let d = pb - pa;
+    let f = |pd: f64| {
+        if pd >= eps {
+            pd
+        } else {
+            eps * eps / (2.0 * eps - pd)
+        }
+    };
     let mut sum = 0.0;
-    for (ca, ra) in &a.poles {
-        for (cb, rb) in &b.poles {
-            let pd = ra + rb + s - ca.distance(*cb + d);
-            let f = if pd >= eps {
-                pd
-            } else {
-                eps * eps / (2.0 * eps - pd)
-            };
-            sum += f * ra.min(*rb);
+    // Poles far from the other shape's bounding box add (almost) nothing: skipped.
+    let box_dist = |c: DVec2, lo: DVec2, hi: DVec2| c.clamp(lo, hi).distance_squared(c);
+    let (ra_max, rb_max) = (a.poles[0].1, b.poles[0].1);
+    let mut near_b: [(DVec2, f64); 16] = [(DVec2::ZERO, 0.0); 16];
+    let mut nb = 0;
+    for (cb, rb) in b.poles.iter().take(16) {
+        let reach = rb + s + ra_max;
+        if box_dist(*cb + d, DVec2::ZERO, a.size) < reach * reach {
+            near_b[nb] = (*cb, *rb);
+            nb += 1;
         }
     }
-    sum.max(1e-9)
+    for (ca, ra) in &a.poles {
+        let ca = *ca - d;
+        let reach = ra + s + rb_max;
+        if box_dist(ca, DVec2::ZERO, b.size) >= reach * reach {
+            continue;
+        }
+        for (cb, rb) in &near_b[..nb] {
+            sum += f(ra + rb + s - ca.distance(*cb)) * ra.min(*rb);
+        }
+    }
+    (sum + eps * eps).sqrt() * (a.area.abs() * b.area.abs()).sqrt().sqrt()
 }
 
 /// Poles of inaccessibility of a polygon with holes: disjoint inscribed circles, largest

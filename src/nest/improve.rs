@@ -149,7 +149,7 @@ fn move_item(ctx: &mut Ctx, st: &mut State, sep: &mut Sep, k: usize, len: f64) {
     let mut best = cur.clone();
     let mut best_e = sep.row_weighted(k);
     let fits = |sz: DVec2| sz.x <= len + 1e-9 && sz.y <= height + 1e-9;
-    for _ in 0..CONTAINER_SAMPLES {
+    for _ in 0..super::problem::tune("CS", CONTAINER_SAMPLES as f64) as usize {
         if best_e <= 0.0 {
             break;
         }
@@ -168,7 +168,7 @@ fn move_item(ctx: &mut Ctx, st: &mut State, sep: &mut Sep, k: usize, len: f64) {
             best = cand;
         }
     }
-    for _ in 0..FOCUS_SAMPLES {
+    for _ in 0..super::problem::tune("FS", FOCUS_SAMPLES as f64) as usize {
         if best_e <= 0.0 {
             break;
         }
@@ -254,6 +254,13 @@ pub fn separate(ctx: &mut Ctx, st: &mut State, len: f64, strikes: usize, patienc
                 }
             }
             let total = sep.total();
+            if std::env::var_os("FLATCUT_NEST_DEBUG2").is_some() {
+                eprintln!(
+                    "  sweep total {total:.6} overlapping {} / {} idle {idle}",
+                    (0..sep.n).filter(|&k| sep.overlapping(k)).count(),
+                    sep.n
+                );
+            }
             if total == 0.0 {
                 return true;
             }
@@ -311,34 +318,101 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
         .fold(0.0, f64::max);
     let lower = (area / height).max(widest);
     let mut best_len = best.extent().min(max_len);
-    let mut ratio: f64 = 0.02;
-    let mut fails = 0;
+    let mut ratio: f64 = super::problem::tune("R0", 0.02);
+    let mut tries = 0;
+    // The infeasible layout being worked on (exploration) and its length.
+    let mut cur: Option<(State, f64)> = None;
     let start = ctx.progress();
     while !ctx.done() && best_len > lower * (1.0 + 1e-6) {
         let explore = ctx.progress() < start + 0.75 * (1.0 - start);
-        let r = if explore {
-            ratio
+        let (mut cand, new_len) = match cur.take() {
+            Some((mut st, len)) if explore => {
+                disrupt(ctx, &mut st, len);
+                (st, len)
+            }
+            _ => {
+                let r = if explore {
+                    ratio
+                } else {
+                    ctx.rng.range(0.0005, 0.005)
+                };
+                let new_len = (best_len * (1.0 - r)).max(lower);
+                let Some(cand) = shrink(ctx, &best, best_len, new_len) else {
+                    break;
+                };
+                (cand, new_len)
+            }
+        };
+        let (strikes, patience) = if explore {
+            (
+                super::problem::tune("ES", 3.0) as usize,
+                super::problem::tune("EP", 50.0) as usize,
+            )
         } else {
-            ctx.rng.range(0.0005, 0.005)
+            (
+                super::problem::tune("CS2", 2.0) as usize,
+                super::problem::tune("CP", 25.0) as usize,
+            )
         };
-        let new_len = (best_len * (1.0 - r)).max(lower);
-        let Some(mut cand) = shrink(ctx, &best, best_len, new_len) else {
-            break;
-        };
-        let (strikes, patience) = if explore { (3, 50) } else { (2, 25) };
-        if separate(ctx, &mut cand, new_len, strikes, patience) {
+        let ok = separate(ctx, &mut cand, new_len, strikes, patience);
+        if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
+            eprintln!(
+                "{} len {new_len:.4} ok {ok} work {:.3}",
+                if explore { "E" } else { "C" },
+                ctx.progress()
+            );
+        }
+        if ok {
             best_len = cand.extent().min(new_len);
             best = cand;
-            fails = 0;
+            tries = 0;
         } else if explore {
-            fails += 1;
-            if fails >= 2 {
+            tries += 1;
+            if tries >= super::problem::tune("TRIES", 3.0) as usize {
                 ratio = (ratio * 0.5).max(0.001);
-                fails = 0;
+                tries = 0;
+            } else {
+                cur = Some((cand, new_len));
             }
         }
     }
     best
+}
+
+/// Disruption of an infeasible layout (sparrow): two large items (area at least the median)
+/// of different shapes swap places; when all large items look alike, one of them moves to a
+/// random place instead.
+fn disrupt(ctx: &mut Ctx, st: &mut State, len: f64) {
+    let height = ctx.prob.container.height();
+    let n = st.placed.len();
+    if n < 2 {
+        return;
+    }
+    let mut areas: Vec<f64> = st.items.iter().map(|&i| ctx.prob.items[i].area).collect();
+    areas.sort_by(f64::total_cmp);
+    let median = areas[n / 2];
+    let large: Vec<usize> = (0..n)
+        .filter(|&k| ctx.prob.items[st.items[k]].area >= median)
+        .collect();
+    let i = large[ctx.rng.below(large.len())];
+    let differs = |k: usize| {
+        let (a, b) = (&ctx.prob.items[st.items[i]], &ctx.prob.items[st.items[k]]);
+        (a.area - b.area).abs() > 1e-9 * a.area.abs().max(1.0)
+    };
+    let others: Vec<usize> = large.iter().copied().filter(|&k| differs(k)).collect();
+    if others.is_empty() {
+        let sz = st.placed[i].shape.size;
+        st.placed[i].pos = DVec2::new(
+            ctx.rng.range(0.0, (len - sz.x).max(0.0)),
+            ctx.rng.range(0.0, (height - sz.y).max(0.0)),
+        );
+        return;
+    }
+    let j = others[ctx.rng.below(others.len())];
+    let (pi, pj) = (st.placed[i].pos, st.placed[j].pos);
+    let (si, sj) = (st.placed[i].shape.size, st.placed[j].shape.size);
+    st.placed[i].pos = clamp_pos(pj, si, len, height);
+    st.placed[j].pos = clamp_pos(pi, sj, len, height);
 }
 
 /// Fewer bins, then the last one short (see the module docs).
