@@ -192,8 +192,8 @@ fn esicup_same_seed_same_solution() {
     );
 }
 
-/// flatcut's own patterns on their sheets (and on a roll): every point inside the margins,
-/// outlines apart by the spacing.
+/// flatcut's own patterns on their sheets (and on a roll), four copies of every piece so that
+/// pieces meet: every point inside the margins, outlines apart by the spacing.
 #[test]
 fn patterns_nest_feasibly_on_sheets_and_roll() {
     let mut names: Vec<_> = std::fs::read_dir(manifest("patterns"))
@@ -206,7 +206,16 @@ fn patterns_nest_feasibly_on_sheets_and_roll() {
     assert!(names.len() >= 4);
     for path in names {
         let spec = flatcut::spec::load(&path).expect("spec");
-        let (_, pieces) = flatcut::cli::pieces(&spec, true).expect("pieces");
+        let (_, one) = flatcut::cli::pieces(&spec, true).expect("pieces");
+        let pieces: Vec<_> = (0..4)
+            .flat_map(|c| {
+                one.iter().map(move |p| {
+                    let mut p = p.clone();
+                    p.id += 1000 * c;
+                    p
+                })
+            })
+            .collect();
         for roll in [false, true] {
             let what = format!(
                 "{} ({})",

@@ -20,15 +20,20 @@
 //! A piece inside the hole of another does not collide with it: holes are usable.
 //!
 //! The **overlap proxy** between two colliding shapes follows sparrow (Gardeyn, Vanden Berghe,
-//! Wauters 2025, §4.2): each shape is approximated by a set of disjoint inscribed circles, its
-//! poles of inaccessibility (the largest inscribed circle, then the largest circle in what
-//! remains, …). For every pair of poles the penetration depth `pd = r₁ + r₂ + s − d` is turned
-//! into a decaying positive value (`pd` when `pd ≥ ε`, `ε² / (2ε − pd)` otherwise) weighted by
-//! the smaller radius, so that the proxy is positive for every colliding pair and grows
-//! smoothly as shapes are pushed into each other. Choices where the paper is silent: at most
-//! 12 poles per item, poles smaller than 8 % of the first are dropped, ε is 2 % of the smaller
-//! first-pole radius, the poles are found on a grid of about 4000 points refined by pattern
-//! search.
+//! Wauters, "An open-source heuristic to reboot 2D nesting research", 2025, arXiv:2509.13329):
+//! each shape is approximated by a set of disjoint inscribed circles, its poles of
+//! inaccessibility (the largest inscribed circle, then the largest circle in what remains, …).
+//! For every pair of poles the penetration depth `pd = r₁ + r₂ + s − d` is turned into a
+//! decaying positive value (`pd` when `pd ≥ ε`, `ε² / (2ε − pd)` otherwise) weighted by the
+//! smaller radius; the sum `Σ` gives the proxy `√(Σ + ε²) · (A₁ A₂)^¼` with `A` the areas and
+//! `ε` 1 % of the larger bounding-box side. It is positive for every colliding pair, grows
+//! smoothly as shapes are pushed into each other, and — through the square root and the `ε²`
+//! floor — makes many shallow overlaps cost more than one deeper one, which keeps the
+//! separator from scattering overlaps. Choices where the paper is silent: at most 12 poles
+//! per item, poles smaller than 8 % of the first are dropped, the poles are found on a grid of
+//! about 4000 points refined by pattern search, and pole pairs that cannot meet (a pole
+//! farther from the other shape's bounding box than the two largest radii plus the spacing)
+//! are skipped.
 //!
 //! Why not jagua-rs: it computes in `f32` and takes no holes; this engine is exact in `f64`
 //! (so a feasible layout needs no safety margin and no separate verification pass), handles

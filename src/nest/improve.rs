@@ -14,20 +14,22 @@
 //! run (least unweighted overlap) is restored after 50 sweeps without improvement (a "strike");
 //! after 3 strikes the separator gives up; zero overlap is a feasible layout.
 //!
-//! **Strip** ([`optimise_strip`]): exploration, then compression. Exploration shrinks the
-//! best feasible strip by a ratio (start 2 %, halved after two failures in a row, at least
-//! 0.1 %) by cutting a slice out at a random x and moving the items right of it left, then
-//! separates; success becomes the new best. Compression (the last quarter of the budget)
-//! shrinks by small random ratios (0.05–0.5 %) with a shorter separator. Only feasible layouts
-//! are kept, so stopping at any time returns a valid layout.
+//! **Strip** ([`optimise_strip`]): exploration (80 % of the budget, as in sparrow), then
+//! compression. Exploration shrinks the best feasible strip by a ratio (start 2 %) by cutting
+//! a slice out at a random x and moving the items right of it left, then separates; success
+//! becomes the new best. A failed width is retried from the failed layout after a disruption
+//! (two large items of different shapes swap places, as in sparrow); after three failures the
+//! ratio halves (down to 0.1 %) and the search restarts from the best layout. Compression
+//! shrinks the best by small random ratios (0.05–0.5 %) with a shorter separator. Only
+//! feasible layouts are kept, so stopping at any time returns a valid layout.
 //!
 //! **Bins** ([`optimise_bins`]): the items of the last bin are moved one by one into earlier
 //! bins (bottom-left if there is room, else inserted and separated); a bin that empties is
 //! dropped. Then the last bin is compressed as a strip of its height whose length is at most
 //! the bin's, so that what is left of it is one rectangle at its right end.
 //!
-//! Choices where sparrow is silent or differs: the search always restarts from the best
-//! feasible layout (sparrow keeps a pool of infeasible ones); the refinement step starts at
+//! Choices where sparrow is silent or differs: exploration works on one infeasible layout at a
+//! time (sparrow keeps a pool of them); the refinement step starts at
 //! 10 % of the item's larger side and stops below 0.1 %; weights persist across strikes within
 //! one separation and start at 1 for each.
 
@@ -149,7 +151,7 @@ fn move_item(ctx: &mut Ctx, st: &mut State, sep: &mut Sep, k: usize, len: f64) {
     let mut best = cur.clone();
     let mut best_e = sep.row_weighted(k);
     let fits = |sz: DVec2| sz.x <= len + 1e-9 && sz.y <= height + 1e-9;
-    for _ in 0..super::problem::tune("CS", CONTAINER_SAMPLES as f64) as usize {
+    for _ in 0..CONTAINER_SAMPLES {
         if best_e <= 0.0 {
             break;
         }
@@ -168,7 +170,7 @@ fn move_item(ctx: &mut Ctx, st: &mut State, sep: &mut Sep, k: usize, len: f64) {
             best = cand;
         }
     }
-    for _ in 0..super::problem::tune("FS", FOCUS_SAMPLES as f64) as usize {
+    for _ in 0..FOCUS_SAMPLES {
         if best_e <= 0.0 {
             break;
         }
@@ -318,13 +320,13 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
         .fold(0.0, f64::max);
     let lower = (area / height).max(widest);
     let mut best_len = best.extent().min(max_len);
-    let mut ratio: f64 = super::problem::tune("R0", 0.02);
+    let mut ratio: f64 = 0.02;
     let mut tries = 0;
     // The infeasible layout being worked on (exploration) and its length.
     let mut cur: Option<(State, f64)> = None;
     let start = ctx.progress();
     while !ctx.done() && best_len > lower * (1.0 + 1e-6) {
-        let explore = ctx.progress() < start + 0.75 * (1.0 - start);
+        let explore = ctx.progress() < start + 0.8 * (1.0 - start);
         let (mut cand, new_len) = match cur.take() {
             Some((mut st, len)) if explore => {
                 disrupt(ctx, &mut st, len);
@@ -343,17 +345,7 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
                 (cand, new_len)
             }
         };
-        let (strikes, patience) = if explore {
-            (
-                super::problem::tune("ES", 3.0) as usize,
-                super::problem::tune("EP", 50.0) as usize,
-            )
-        } else {
-            (
-                super::problem::tune("CS2", 2.0) as usize,
-                super::problem::tune("CP", 25.0) as usize,
-            )
-        };
+        let (strikes, patience) = if explore { (3, 50) } else { (2, 25) };
         let ok = separate(ctx, &mut cand, new_len, strikes, patience);
         if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
             eprintln!(
@@ -368,7 +360,7 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
             tries = 0;
         } else if explore {
             tries += 1;
-            if tries >= super::problem::tune("TRIES", 3.0) as usize {
+            if tries >= 3 {
                 ratio = (ratio * 0.5).max(0.001);
                 tries = 0;
             } else {

@@ -19,14 +19,6 @@ use std::time::Instant;
 /// Work units per second of the time limit (see the module docs).
 pub const WORK_PER_SECOND: f64 = 4.0e7;
 
-/// Temporary tuning knob (env FLATCUT_TUNE_<NAME>).
-pub fn tune(name: &str, default: f64) -> f64 {
-    std::env::var(format!("FLATCUT_TUNE_{name}"))
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
 /// Allowed orientations of an item.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Orients {
