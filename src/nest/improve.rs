@@ -20,7 +20,8 @@
 //! becomes the new best. A failed width is retried from the failed layout after a disruption
 //! (two large items of different shapes swap places, as in sparrow); after three failures the
 //! ratio halves (down to 0.1 %) and the search restarts from the best layout. Compression
-//! shrinks the best by small random ratios (0.05–0.5 %) with a shorter separator. Only
+//! shrinks the best by small random ratios (between 0.01 % and a bound that falls from 0.5 % to
+//! 0.01 % over the phase) with a shorter separator. Only
 //! feasible layouts are kept, so stopping at any time returns a valid layout.
 //!
 //! **Bins** ([`optimise_bins`]): the items of the last bin are moved one by one into earlier
@@ -100,14 +101,15 @@ impl Sep {
     }
     fn update_weights(&mut self) {
         let max = self.ov.iter().copied().fold(0.0, f64::max);
+        let (ml, mu, dec) = (1.2, 2.0, 0.95);
         for i in 0..self.n {
             for j in i + 1..self.n {
                 let v = self.ov[i * self.n + j];
                 let w = &mut self.w[i * self.n + j];
                 if v > 0.0 && max > 0.0 {
-                    *w *= 1.2 + 0.8 * v / max;
+                    *w *= ml + (mu - ml) * v / max;
                 } else {
-                    *w = (*w * 0.95).max(1.0);
+                    *w = (*w * dec).max(1.0);
                 }
                 self.w[j * self.n + i] = self.w[i * self.n + j];
             }
@@ -336,7 +338,10 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
                 let r = if explore {
                     ratio
                 } else {
-                    ctx.rng.range(0.0005, 0.005)
+                    // 0.5 % down to 0.01 % over the compression phase, at random below.
+                    let t = ((ctx.progress() - start) / (1.0 - start) - 0.8) / 0.2;
+                    let hi = 0.005 * (1.0 - t.clamp(0.0, 1.0)) + 0.0001;
+                    ctx.rng.range(0.0001, hi)
                 };
                 let new_len = (best_len * (1.0 - r)).max(lower);
                 let Some(cand) = shrink(ctx, &best, best_len, new_len) else {

@@ -206,6 +206,9 @@ pub enum NestError {
     },
     #[error("piece {piece} has no usable outline (fewer than 3 points or no area)")]
     BadOutline { piece: String },
+    /// The final check found a layout the search thought feasible infeasible (a bug).
+    #[error("nesting produced an invalid layout (flatcut bug): {0}")]
+    Infeasible(String),
 }
 
 /// Orientations of one piece in the sheet frame (degrees), see the module docs.
@@ -388,7 +391,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         }
         _ => None,
     };
-    Ok(Layout {
+    let layout = Layout {
         pieces,
         placements,
         sheets,
@@ -396,7 +399,10 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         margin: opts.margin,
         spacing: opts.spacing,
         remnant,
-    })
+    };
+    // Never trust the search alone: every point inside, every pair apart, checked again.
+    verify(&layout).map_err(NestError::Infeasible)?;
+    Ok(layout)
 }
 
 /// Exact check of a layout: every piece's points inside its sheet's margins, and the outlines
