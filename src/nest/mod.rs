@@ -568,6 +568,60 @@ mod tests {
     }
 
     #[test]
+    fn nest_small_piece_goes_into_the_hole_of_a_frame() {
+        // A 100 mm frame with an 80 mm hole fills a 104 mm sheet; a 50 mm square only fits in
+        // the hole, so one sheet is enough.
+        let mut frame = rect_piece(1, 100.0, 100.0);
+        frame.outline.push(vec![
+            DVec2::new(10.0, 10.0),
+            DVec2::new(10.0, 90.0),
+            DVec2::new(90.0, 90.0),
+            DVec2::new(90.0, 10.0),
+        ]);
+        frame.area = 100.0 * 100.0 - 80.0 * 80.0;
+        let opts = NestOptions {
+            width: 104.0,
+            height: Some(104.0),
+            margin: 2.0,
+            spacing: 2.0,
+            seconds: 0.5,
+            ..Default::default()
+        };
+        let l = nest(vec![frame, rect_piece(2, 50.0, 50.0)], &opts).unwrap();
+        verify(&l).unwrap();
+        assert_eq!(l.sheets.len(), 1);
+    }
+
+    #[test]
+    fn nest_mirrored_pairs_stay_apart() {
+        // Right triangles, mirror allowed: whatever the search picks is feasible, and the
+        // mirror image keeps the outline's area.
+        let tri = |id| {
+            let mut p = rect_piece(id, 60.0, 30.0);
+            p.outline = vec![vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(60.0, 0.0),
+                DVec2::new(0.0, 30.0),
+            ]];
+            p.area = 900.0;
+            p
+        };
+        let opts = NestOptions {
+            width: 100.0,
+            height: None,
+            mirror: true,
+            seconds: 0.3,
+            ..Default::default()
+        };
+        let l = nest((1..=6).map(tri).collect(), &opts).unwrap();
+        verify(&l).unwrap();
+        for (p, at) in l.pieces.iter().zip(&l.placements) {
+            let pts: Vec<DVec2> = p.outline[0].iter().map(|q| at.apply(*q)).collect();
+            assert!((polygon::signed_area(&pts).abs() - 900.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
     fn nest_forty_rectangles_take_four_sheets_and_leave_one_rectangle() {
         let pieces = (1..=40).map(|i| rect_piece(i, 90.0, 60.0)).collect();
         let opts = NestOptions {
