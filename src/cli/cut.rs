@@ -170,11 +170,24 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         );
         for i in 0..layout.sheets.len() {
             println!(
-                "  sheet {}: {:.0} × {:.0} mm, {:.1} % used",
+                "  {} {}: {:.0} × {:.0} mm, {:.1} % used",
+                if layout.roll { "roll" } else { "sheet" },
                 i + 1,
                 layout.sheets[i].width,
                 layout.sheets[i].height,
                 100.0 * layout.utilisation(i)
+            );
+        }
+        if let Some(len) = layout.roll_length() {
+            println!("  roll length used: {len:.1} mm");
+        }
+        if let Some((lo, hi)) = layout.remnant {
+            println!(
+                "  left on the last sheet: {:.0} × {:.0} mm at ({:.0}, {:.0})",
+                hi.x - lo.x,
+                hi.y - lo.y,
+                lo.x,
+                lo.y
             );
         }
         println!("wrote {}: {}", dir.display(), files.join(", "));
