@@ -20,6 +20,8 @@ pub struct FlattenArgs {
     pub material: Option<crate::spec::MaterialKind>,
     #[command(flatten)]
     pub pattern: super::PatternArgs,
+    #[command(flatten)]
+    pub search: super::nest::SearchArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -58,12 +60,14 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
                 .map(|(lo, hi)| (hi - lo).x)
         })
         .fold(0.0, f64::max);
-    let opts = crate::nest::NestOptions {
+    let mut opts = crate::nest::NestOptions {
         width: spec.sheet.width.max(widest + 2.0 * spec.sheet.margin + 1.0),
         height: None,
         margin: spec.sheet.margin,
         spacing: spec.sheet.spacing,
+        ..Default::default()
     };
+    a.search.apply(&mut opts)?;
     let layout = crate::nest::nest(pieces, &opts).map_err(|e| Error::In {
         file: spec.path.clone(),
         source: Box::new(e.into()),

@@ -7,6 +7,7 @@ pub mod cut;
 pub mod fitting;
 pub mod flatten;
 pub mod link;
+pub mod nest;
 pub mod ports;
 pub mod send;
 pub mod sim;
@@ -26,6 +27,7 @@ Examples:
   flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
   flatcut fitting cone --bottom-diameter 300 --top-diameter 160 --height 200 --thickness 2 --dry-run
   flatcut fitting square-to-round --width 400 --depth 300 --diameter 250 --height 300 --bend-lines 50
+  flatcut nest fu.json --nest-time 10 -o out/fu        nest an ESICUP instance, print the density
   flatcut check model.obj                             faces, edges, boundary loops, angle defect
   flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
   flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
@@ -54,6 +56,9 @@ pub enum Command {
     /// Unfold and write the pieces (SVG, PNG, report) without nesting on sheets.
     #[command(after_help = EXAMPLES)]
     Flatten(flatten::FlattenArgs),
+    /// Nest an ESICUP strip-packing instance (JSON): solution.json, layout.svg, density.
+    #[command(after_help = EXAMPLES)]
+    Nest(nest::NestArgs),
     /// Report what a mesh is made of and whether it can be unfolded exactly.
     #[command(after_help = EXAMPLES)]
     Check(check::CheckArgs),
@@ -75,6 +80,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Cut(a) => cut::run(&a),
         Command::Fitting(a) => fitting::run(&a),
         Command::Flatten(a) => flatten::run(&a),
+        Command::Nest(a) => nest::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Send(a) => send::run(&a),
         Command::Sim(a) => sim::run(&a),

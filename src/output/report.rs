@@ -2,7 +2,8 @@
 //! its source file, area, cut and fold lengths, every fold line with its kind and bend angle,
 //! sheet and placement), seams (`{id, piece_a, piece_b, length_a_mm, length_b_mm, notches}`:
 //! notch positions in mm from side A's start, and `notches_b_mm` from side B's start, which is
-//! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation),
+//! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation; on a
+//! roll the length used, on sheets the rectangle left free on the last sheet),
 //! surfaces (source, faces, pieces, repairs made on import) and the files written.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
@@ -67,6 +68,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "notches": p.notches.len(),
                 "sheet": at.sheet + 1,
                 "rotation_deg": r6(at.rotation.to_degrees()),
+                "mirrored": at.mirror,
                 "offset_mm": [r6(at.offset.x), r6(at.offset.y)],
                 "bbox_mm": [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)],
             })
@@ -135,6 +137,8 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         "device": info.device,
         "material": { "kind": info.material, "thickness_mm": info.thickness_mm },
         "roll": layout.roll,
+        "roll_length_mm": layout.roll_length().map(r6),
+        "remnant_mm": layout.remnant.map(|(lo, hi)| [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)]),
         "margin_mm": layout.margin,
         "spacing_mm": layout.spacing,
         "surfaces": surfaces,
