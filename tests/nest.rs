@@ -239,13 +239,18 @@ fn patterns_nest_feasibly_on_sheets_and_roll() {
             for (p, at) in l.pieces.iter().zip(&l.placements) {
                 assert!(!at.mirror, "{what}: mirrored without permission");
                 let s = &l.sheets[at.sheet];
-                for q in p.points().map(|q| at.apply(q)) {
+                // The cut outline exactly; marks on the border within CLEAN_MM of it (the
+                // outline leaves out features a knife cannot cut).
+                let clean = flatcut::pattern::allowance::CLEAN_MM;
+                let outline = p.outline.iter().flatten().map(|q| (at.apply(*q), 1e-6));
+                let marks = p.points().map(|q| (at.apply(q), clean));
+                for (q, tol) in outline.chain(marks) {
                     let m = opts.margin;
                     assert!(
-                        q.x >= m - 1e-6
-                            && q.y >= m - 1e-6
-                            && q.x <= s.width - m + 1e-6
-                            && q.y <= s.height - m + 1e-6,
+                        q.x >= m - tol
+                            && q.y >= m - tol
+                            && q.x <= s.width - m + tol
+                            && q.y <= s.height - m + tol,
                         "{what}: piece {} leaves the sheet at {q}",
                         p.name
                     );
