@@ -325,3 +325,30 @@ fn nest_command_writes_solution_and_rejects_bad_instances() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("no-such.json"));
 }
+
+/// Checks solution files written by `flatcut nest` (e.g. the 60 s runs for the issue note):
+/// `NEST_SOLUTIONS=/tmp/nest- cargo test --test nest -- --ignored` reads
+/// `/tmp/nest-<instance>/solution.json` for each instance present.
+#[test]
+#[ignore]
+fn solution_files_are_feasible() {
+    let Ok(prefix) = std::env::var("NEST_SOLUTIONS") else {
+        panic!("set NEST_SOLUTIONS to the directory prefix");
+    };
+    let mut checked = 0;
+    for name in ["albano", "fu", "jakobs1", "shirts", "trousers"] {
+        let file = std::path::PathBuf::from(format!("{prefix}{name}/solution.json"));
+        let Ok(text) = std::fs::read_to_string(&file) else {
+            continue;
+        };
+        let sol: Value = serde_json::from_str(&text).unwrap();
+        let inst: Value = serde_json::from_str(
+            &std::fs::read_to_string(shared_data(&format!("nesting/{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        let d = check_solution(&inst, &sol, name);
+        println!("{name}: feasible, density {:.4} %", 100.0 * d);
+        checked += 1;
+    }
+    assert!(checked > 0);
+}
