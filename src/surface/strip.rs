@@ -363,100 +363,180 @@ impl Strip {
         }
     }
 
+    /// Bank vectors to the previous and next point of each vertex of a curve (zero where the
+    /// curve has none), with their cross product.
+    fn banks(pts: &[DVec3], closed: bool) -> Vec<([DVec3; 3], [f64; 2])> {
+        (0..pts.len())
+            .map(|i| {
+                let (a, b) = Self::neighbours(pts.len(), closed, i);
+                let e0 = a.map_or(DVec3::ZERO, |k| pts[k] - pts[i]);
+                let e1 = b.map_or(DVec3::ZERO, |k| pts[k] - pts[i]);
+                ([e0, e1, e0.cross(e1)], [e0.length(), e1.length()])
+            })
+            .collect()
+    }
+
     /// GODT / GMBT / GMAT / GODT+GMBT by dynamic programming on the dual-node graph.
+    ///
+    /// Everything at a node (i, j) comes from the bridge `d = q_j − p_i` and the four bank
+    /// vectors there: the area vectors of the triangles before it (`d × e_p⁻`, `d × e_q⁻`) and
+    /// after it (`e_p⁺ × d`, `e_q⁺ × d`), and the triple products of the convexity test, which
+    /// `d` reduces to `d̂·(e_a × e_b)` (the `d` part of `q_{j±1} − p_i` drops out). This is
+    /// [`Strip::locally_convex`] and [`Strip::energy`] rewritten without repeated work; the
+    /// tests check both against the plain versions through a Dijkstra on the same graph.
     fn global(&self, method: Method) -> Vec<Step> {
+        match method {
+            Method::Godt => self.global_dp::<true, false, false>(),
+            Method::Gmbt => self.global_dp::<false, true, false>(),
+            Method::Gmat => self.global_dp::<false, false, true>(),
+            _ => self.global_dp::<true, true, false>(),
+        }
+    }
+
+    /// [`Strip::global`] for one objective, known at compile time.
+    fn global_dp<const COUNT: bool, const ENERGY: bool, const AREA: bool>(&self) -> Vec<Step> {
         let (m, n) = (self.m(), self.n());
-        let use_count = matches!(method, Method::Godt | Method::GodtGmbt);
-        let use_energy = matches!(method, Method::Gmbt | Method::GodtGmbt);
-        let use_area = method == Method::Gmat;
-        let inf = Cost {
-            count: u32::MAX,
-            value: f64::INFINITY,
-        };
-        let zero = Cost {
-            count: 0,
-            value: 0.0,
-        };
-        // cur[j][s]: cost of reaching (i, j) by a step of kind s.
-        let mut cur = vec![[inf; 2]; n];
-        let mut next = vec![[inf; 2]; n];
-        cur[0] = [zero, zero];
+        let (use_count, use_energy, use_area) = (COUNT, ENERGY, AREA);
+        let pb = Self::banks(&self.p, self.closed);
+        let qb = Self::banks(&self.q, self.closed);
+        const INF: u32 = u32::MAX;
+        // Costs of reaching (i, j) by a P step [0] or a Q step [1]: rows i (cur) and i+1.
+        let mut cc = vec![[INF; 2]; n];
+        let mut cv = vec![[f64::INFINITY; 2]; n];
+        let mut nc = vec![[INF; 2]; n];
+        let mut nv = vec![[f64::INFINITY; 2]; n];
+        cc[0] = [0, 0];
+        cv[0] = [0.0, 0.0];
         let mut back = vec![0u8; m * n];
-        // Triangles of P-steps from row i−1 (prev) and i (this row).
-        let need_tris = use_energy || use_area;
-        let none = (DVec3::ZERO, 0.0);
-        let mut tp_prev = vec![none; n];
-        let mut tp_cur = vec![none; n];
         for i in 0..m {
-            let mut tq_left = none; // Q-step triangle from (i, j−1)
+            let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
+            let pi = self.p[i];
+            let last_row = i + 1 == m;
             for j in 0..n {
-                let c = cur[j];
-                if i + 1 == m && j + 1 == n {
+                let last_col = j + 1 == n;
+                if last_row && last_col {
                     break;
                 }
-                let invalid = use_count && !self.is_end(i, j) && !self.locally_convex(i, j);
-                let (tp, tq) = if need_tris {
-                    (
-                        if i + 1 < m { self.tri_p(i, j) } else { none },
-                        if j + 1 < n { self.tri_q(i, j) } else { none },
-                    )
-                } else {
-                    (none, none)
-                };
-                let l2 = self.p[i].distance_squared(self.q[j]);
+                let ([eq0, eq1, cq], [lq0, lq1]) = qb[j];
+                let d = self.q[j] - pi;
+                let l2 = d.length_squared();
+                // Area vectors (twice the area) of the triangles around the bridge.
+                let np0 = d.cross(ep0); // before, by a P step
+                let nq0 = d.cross(eq0); // before, by a Q step
+                let np1 = ep1.cross(d); // after, by a P step
+                let nq1 = eq1.cross(d); // after, by a Q step
                 let start = i == 0 && j == 0;
-                for (t, tri_t, ok) in [(0usize, tp, i + 1 < m), (1usize, tq, j + 1 < n)] {
-                    if !ok {
+                let sq = [
+                    np0.length_squared(),
+                    np1.length_squared(),
+                    nq0.length_squared(),
+                    nq1.length_squared(),
+                ];
+                let len = [sq[0].sqrt(), sq[1].sqrt(), sq[2].sqrt(), sq[3].sqrt()];
+                // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺.
+                let t01 = d.dot(cp);
+                let t23 = d.dot(cq);
+                let t02 = -ep0.dot(nq0);
+                let t03 = ep0.dot(nq1);
+                let t12 = -ep1.dot(nq0);
+                let t13 = ep1.dot(nq1);
+                let tt = [
+                    [0.0, t01, t02, t03],
+                    [-t01, 0.0, t12, t13],
+                    [-t02, -t12, 0.0, t23],
+                    [-t03, -t13, -t23, 0.0],
+                ];
+                let invalid = use_count && !start && {
+                    let l = l2.sqrt();
+                    // len: projected neighbour lengths times l.
+                    let es = [lp0, lp1, lq0, lq1];
+                    let on = [0, 1, 2, 3].map(|k| len[k] > 1e-12 * l * es[k].max(l));
+                    // Branch-free: some vector s has every other one on one side of it.
+                    let mut any = false;
+                    let mut real = 0;
+                    for s in 0..4 {
+                        let (mut pos, mut neg) = (true, true);
+                        for u in 0..4 {
+                            // tt is l² times the 2D cross; len is l times the projected length.
+                            let tol = 1e-9 * len[s] * len[u];
+                            let x = tt[s][u] * l;
+                            let skip = u == s || !on[u];
+                            pos &= skip | (x >= -tol);
+                            neg &= skip | (x <= tol);
+                        }
+                        real += usize::from(on[s]);
+                        any |= on[s] & (pos | neg);
+                    }
+                    !(any || real <= 1)
+                };
+                let inc = u32::from(invalid);
+                let cur_c = cc[j];
+                let cur_v = cv[j];
+                for t in 0..2 {
+                    if (t == 0 && last_row) || (t == 1 && last_col) {
                         continue;
                     }
-                    let mut best = inf;
+                    let k2 = if t == 0 { 1 } else { 3 };
+                    let n2 = if t == 0 { np1 } else { nq1 };
+                    let mut best_c = INF;
+                    let mut best_v = f64::INFINITY;
                     let mut arg = 0u8;
-                    for (s, prev_tri) in [(0usize, tp_prev[j]), (1usize, tq_left)] {
-                        if c[s].count == u32::MAX {
+                    for s in 0..2 {
+                        if cur_c[s] == INF {
                             continue;
                         }
-                        let mut w = c[s];
-                        if invalid {
-                            w.count += 1;
-                        }
+                        let c = cur_c[s] + inc;
+                        let mut v = cur_v[s];
                         if use_energy && !start {
-                            w.value += bend_energy(prev_tri, tri_t, l2);
+                            // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no
+                            // cross product: A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²).
+                            let k1 = 2 * s;
+                            let n1 = if s == 0 { np0 } else { nq0 };
+                            let den = sq[k1] * sq[k2];
+                            if den > 0.0 && l2 > 0.0 {
+                                let x = tt[k1][k2];
+                                let s2 = (x * x * l2 / den).min(1.0);
+                                let sn = if n1.dot(n2) >= 0.0 { s2 } else { 2.0 - s2 };
+                                v += 0.5 * (len[k1] + len[k2]) * sn / l2;
+                            }
                         }
                         if use_area {
-                            w.value += tri_t.1;
+                            v += 0.5 * len[k2];
                         }
-                        if w.better(&best) {
-                            best = w;
+                        if c < best_c || (c == best_c && v < best_v) {
+                            best_c = c;
+                            best_v = v;
                             arg = s as u8;
                         }
                     }
+                    if best_c == INF {
+                        continue;
+                    }
                     let (ti, tj) = if t == 0 { (i + 1, j) } else { (i, j + 1) };
-                    let slot = if t == 0 {
-                        &mut next[tj][0]
+                    let (sc, sv) = if t == 0 {
+                        (&mut nc[tj][0], &mut nv[tj][0])
                     } else {
-                        &mut cur[tj][1]
+                        (&mut cc[tj][1], &mut cv[tj][1])
                     };
-                    if best.better(slot) {
-                        *slot = best;
+                    if best_c < *sc || (best_c == *sc && best_v < *sv) {
+                        *sc = best_c;
+                        *sv = best_v;
                         let b = &mut back[ti * n + tj];
                         *b = (*b & !(1 << t)) | (arg << t);
                     }
                 }
-                tp_cur[j] = tp;
-                tq_left = tq;
             }
-            if i + 1 == m {
+            if last_row {
                 break;
             }
-            std::mem::swap(&mut cur, &mut next);
-            for x in next.iter_mut() {
-                *x = [inf; 2];
-            }
-            std::mem::swap(&mut tp_prev, &mut tp_cur);
+            std::mem::swap(&mut cc, &mut nc);
+            std::mem::swap(&mut cv, &mut nv);
+            nc.iter_mut().for_each(|x| *x = [INF; 2]);
+            nv.iter_mut().for_each(|x| *x = [f64::INFINITY; 2]);
         }
-        // `cur` holds row m−1; pick the better end state.
-        let end = cur[n - 1];
-        let mut s = if end[1].better(&end[0]) { 1 } else { 0 };
+        // `cc`/`cv` hold row m−1; pick the better end state (ties: P).
+        let (ec, ev) = (cc[n - 1], cv[n - 1]);
+        let mut s = usize::from(ec[1] < ec[0] || (ec[1] == ec[0] && ev[1] < ev[0]));
         let mut steps = Vec::with_capacity(m + n - 2);
         let (mut i, mut j) = (m - 1, n - 1);
         while i > 0 || j > 0 {
@@ -782,13 +862,15 @@ fn bend_energy(t1: (DVec3, f64), t2: (DVec3, f64), l2: f64) -> f64 {
     (t1.1 + t2.1) * s / l2
 }
 
-/// Path cost: invalid bridges, then energy or area.
+/// Path cost: invalid bridges, then energy or area (the reference Dijkstra of the tests).
+#[cfg(test)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cost {
     count: u32,
     value: f64,
 }
 
+#[cfg(test)]
 impl Cost {
     fn better(&self, o: &Cost) -> bool {
         self.count < o.count || (self.count == o.count && self.value < o.value)
