@@ -408,6 +408,7 @@ impl Strip {
         cc[0] = [0, 0];
         cv[0] = [0.0, 0.0];
         let mut back = vec![0u8; m * n];
+        #[allow(clippy::needless_range_loop)] // i is also a grid coordinate
         for i in 0..m {
             let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
             let pi = self.p[i];
