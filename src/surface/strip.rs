@@ -408,11 +408,16 @@ impl Strip {
         cc[0] = [0, 0];
         cv[0] = [0.0, 0.0];
         let mut back = vec![0u8; m * n];
+        // A triangle after one bridge is the triangle before the next: keep the area vectors
+        // (with squared and plain lengths) of the P-step triangles of the previous row and of
+        // the Q-step triangle of the previous column.
+        let mut above = vec![(DVec3::ZERO, 0.0, 0.0); n];
         #[allow(clippy::needless_range_loop)] // i is also a grid coordinate
         for i in 0..m {
             let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
             let pi = self.p[i];
             let last_row = i + 1 == m;
+            let mut left = (DVec3::ZERO, 0.0, 0.0);
             for j in 0..n {
                 let last_col = j + 1 == n;
                 if last_row && last_col {
@@ -422,18 +427,25 @@ impl Strip {
                 let d = self.q[j] - pi;
                 let l2 = d.length_squared();
                 // Area vectors (twice the area) of the triangles around the bridge.
-                let np0 = d.cross(ep0); // before, by a P step
-                let nq0 = d.cross(eq0); // before, by a Q step
-                let np1 = ep1.cross(d); // after, by a P step
-                let nq1 = eq1.cross(d); // after, by a Q step
+                let fresh = |v: DVec3| {
+                    let q = v.length_squared();
+                    (v, q, q.sqrt())
+                };
+                // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
+                let p0 = if i == 0 {
+                    fresh(d.cross(ep0))
+                } else {
+                    above[j]
+                };
+                let q0 = if j == 0 { fresh(d.cross(eq0)) } else { left };
+                let p1 = fresh(ep1.cross(d));
+                let q1 = fresh(eq1.cross(d));
+                above[j] = p1;
+                left = q1;
+                let (np0, nq0, np1, nq1) = (p0.0, q0.0, p1.0, q1.0);
                 let start = i == 0 && j == 0;
-                let sq = [
-                    np0.length_squared(),
-                    np1.length_squared(),
-                    nq0.length_squared(),
-                    nq1.length_squared(),
-                ];
-                let len = [sq[0].sqrt(), sq[1].sqrt(), sq[2].sqrt(), sq[3].sqrt()];
+                let sq = [p0.1, p1.1, q0.1, q1.1];
+                let len = [p0.2, p1.2, q0.2, q1.2];
                 // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺.
                 let t01 = d.dot(cp);
                 let t23 = d.dot(cq);
