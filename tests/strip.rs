@@ -202,6 +202,27 @@ fn strip_fittings_flatten_isometrically_into_one_piece() {
         assert_eq!(m.vertices.len(), bridges + 1, "m + n − 2 triangles");
         check_isometric(&flats[0]);
         assert!(!pieces[0].folds.is_empty(), "{}: bend lines", args[0]);
+        // Exact areas where the surface is known: four planar trapezoids; a cylinder cut by a
+        // plane through its centre line at 200 mm has the area of a 200 mm cylinder.
+        let exact = match args[0] {
+            "rect-to-rect" => {
+                let h = |dx: f64| (dx * dx + 250.0f64 * 250.0).sqrt();
+                Some((
+                    2.0 * 300.0 * h(100.0) + 200.0 * h(50.0) + 200.0 * h(150.0),
+                    1e-9,
+                ))
+            }
+            "pipe-miter" => Some((PI * 150.0 * 200.0, 1e-3)),
+            _ => None,
+        };
+        if let Some((want, tol)) = exact {
+            let got = pieces[0].area;
+            assert!(
+                (got - want).abs() / want < tol,
+                "{}: area {got} want {want}",
+                args[0]
+            );
+        }
     }
 }
 
