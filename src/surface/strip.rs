@@ -764,10 +764,12 @@ impl Strip {
     }
 
     /// The strip moved by `delta` mm against the surface normal (toward the inside, for the
-    /// neutral surface of sheet metal): each boundary vertex slides within its curve's plane
-    /// (the Newell plane of a closed curve; freely for an open one) until it lies on its
-    /// tangent plane moved by `delta`. Tangent planes are area-weighted vertex normals of the
-    /// BBT `steps`; the two copies of a closed strip's seam vertex share theirs.
+    /// neutral surface of sheet metal). Closed curves stay in their (Newell) plane: each bank
+    /// edge moves within it to where the plane of its BBT triangle, moved by `delta`, cuts it,
+    /// and each vertex goes to where its two moved edges meet (a polygon offset with one
+    /// distance per edge, so straight sides stay straight and corners stay sharp); the two
+    /// copies of the seam vertex stay together. Open curves: each vertex moves along its
+    /// area-weighted vertex normal.
     pub fn offset(&self, steps: &[Step], delta: f64) -> Strip {
         if delta == 0.0 {
             return self.clone();
@@ -776,10 +778,17 @@ impl Strip {
         let ring = |i: usize, len: usize| if self.closed && i + 1 == len { 0 } else { i };
         let mut np = vec![DVec3::ZERO; m];
         let mut nq = vec![DVec3::ZERO; n];
+        // Normal of the triangle on each bank edge.
+        let mut edge_p = vec![DVec3::ZERO; m];
+        let mut edge_q = vec![DVec3::ZERO; n];
         let (mut i, mut j) = (0, 0);
         for s in steps {
             let (nn, a) = self.tri_step(i, j, *s);
             let w = nn * a;
+            match s {
+                Step::P => edge_p[i] = nn,
+                Step::Q => edge_q[j] = nn,
+            }
             match s {
                 Step::P => {
                     np[ring(i, m)] += w;
@@ -821,9 +830,14 @@ impl Strip {
                 })
                 .collect()
         };
+        let planar = |pts: &[DVec3], edges: &[DVec3], normals: &[DVec3], len: usize| {
+            plane(pts)
+                .and_then(|big| offset_ring(pts, edges, big, delta))
+                .unwrap_or_else(|| moved(pts, normals, len))
+        };
         Strip {
-            p: moved(&self.p, &np, m),
-            q: moved(&self.q, &nq, n),
+            p: planar(&self.p, &edge_p, &np, m),
+            q: planar(&self.q, &edge_q, &nq, n),
             closed: self.closed,
         }
     }
@@ -842,6 +856,52 @@ impl Strip {
         };
         reach(&self.p).min(reach(&self.q))
     }
+}
+
+/// A closed polyline (last point repeating the first) lying in the plane of normal `big`,
+/// offset in that plane: edge k moves by `delta / cos` toward `−u`, where `u` is its
+/// triangle's normal `edges[k]` projected into the plane; vertices go to where consecutive
+/// moved edges meet (onto the moved edge when the two are parallel). `None` when an edge has no
+/// usable triangle normal.
+fn offset_ring(pts: &[DVec3], edges: &[DVec3], big: DVec3, delta: f64) -> Option<Vec<DVec3>> {
+    use glam::DVec2;
+    let r = pts.len().checked_sub(1)?;
+    if r < 3 {
+        return None;
+    }
+    let (a, b) = big.any_orthonormal_pair();
+    let to2 = |x: DVec3| DVec2::new(x.dot(a), x.dot(b));
+    let mut lines = Vec::with_capacity(r);
+    for k in 0..r {
+        let nn = edges[k].normalize_or_zero();
+        let u = (nn - big * nn.dot(big)).normalize_or_zero();
+        let c = u.dot(nn);
+        if c < 0.05 {
+            return None;
+        }
+        let x = to2(pts[k] - u * (delta / c));
+        let e = to2(pts[k + 1] - pts[k]);
+        if e.length_squared() <= 0.0 {
+            return None;
+        }
+        lines.push((x, e));
+    }
+    let mut out = Vec::with_capacity(pts.len());
+    for k in 0..r {
+        let (x1, e1) = lines[(k + r - 1) % r];
+        let (x2, e2) = lines[k];
+        let det = e1.perp_dot(e2);
+        let v = to2(pts[k]);
+        let p = if det.abs() > 1e-6 * e1.length() * e2.length() {
+            x1 + e1 * ((x2 - x1).perp_dot(e2) / det)
+        } else {
+            x2 + e2 * ((v - x2).dot(e2) / e2.length_squared())
+        };
+        let dv = p - v;
+        out.push(pts[k] + a * dv.x + b * dv.y);
+    }
+    out.push(out[0]);
+    Some(out)
 }
 
 /// Whether two closed loops are the same points up to rotation of the start (either way).
