@@ -36,9 +36,11 @@
 //! - Orientation and start (the paper takes P and Q as given): open strips are used as given
 //!   except that Q is reversed when that makes the two end bridges shorter in sum. Closed
 //!   strips (both curves closed loops) are oriented alike (Q is reversed when its Newell normal
-//!   points against P's) and start at the shortest bridge `p_i q_j` over all pairs (ties: lowest
-//!   i, then j): that is the seam, the shortest element, where a sheet-metal worker puts the
-//!   seam of an oblique cone. Both loops are rotated to start there and their first point is
+//!   points against P's) and start at the shortest locally convex bridge `p_i q_j` over all
+//!   pairs (ties: lowest i, then j; the shortest bridge of all if none is convex). That is the
+//!   seam: a ruling of the developable, and its shortest element, where a sheet-metal worker
+//!   puts the seam of an oblique cone (a plain shortest bridge can cut across a flat triangle
+//!   of an offset square-to-round, which no ruling does). Both loops are rotated to start there and their first point is
 //!   repeated at the end, so the strip is an open band whose two copies of the seam are cut.
 //! - Faces are wound `p_i p_{i+1} q_j` and `p_i q_{j+1} q_j`: with P below Q and both running
 //!   counter-clockwise seen from +z (as the fittings build them), normals point outward.
@@ -205,15 +207,27 @@ impl Strip {
         if newell(&pp).dot(newell(&qq)) < 0.0 {
             qq.reverse();
         }
-        // Seam: the shortest bridge.
+        // Seam: the shortest locally convex bridge, else the shortest bridge.
+        let ring = Strip {
+            p: pp.iter().chain(pp.first()).copied().collect(),
+            q: qq.iter().chain(qq.first()).copied().collect(),
+            closed: true,
+        };
         let (mut bi, mut bj, mut best) = (0, 0, f64::INFINITY);
+        let (mut ci, mut cj, mut best_convex) = (0, 0, f64::INFINITY);
         for (i, a) in pp.iter().enumerate() {
             for (j, b) in qq.iter().enumerate() {
                 let d = a.distance_squared(*b);
                 if d < best {
                     (bi, bj, best) = (i, j, d);
                 }
+                if d < best_convex && ring.locally_convex(i, j) {
+                    (ci, cj, best_convex) = (i, j, d);
+                }
             }
+        }
+        if best_convex.is_finite() {
+            (bi, bj) = (ci, cj);
         }
         pp.rotate_left(bi);
         qq.rotate_left(bj);
