@@ -426,13 +426,13 @@ impl Strip {
         // A triangle after one bridge is the triangle before the next: keep the area vectors
         // (with squared and plain lengths) of the P-step triangles of the previous row and of
         // the Q-step triangle of the previous column.
-        let mut above = vec![(DVec3::ZERO, 0.0, 0.0); n];
+        let mut above = vec![(DVec3::ZERO, 0.0, 0.0, 0.0); n];
         #[allow(clippy::needless_range_loop)] // i is also a grid coordinate
         for i in 0..m {
             let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
             let pi = self.p[i];
             let last_row = i + 1 == m;
-            let mut left = (DVec3::ZERO, 0.0, 0.0);
+            let mut left = (DVec3::ZERO, 0.0, 0.0, 0.0);
             for j in 0..n {
                 let last_col = j + 1 == n;
                 if last_row && last_col {
@@ -442,9 +442,11 @@ impl Strip {
                 let d = self.q[j] - pi;
                 let l2 = d.length_squared();
                 // Area vectors (twice the area) of the triangles around the bridge.
+                // (area vector, its squared length, length, 1 / squared length or 0); the squared
+                // length is kept for symmetry with `fresh`, only the others are read.
                 let fresh = |v: DVec3| {
                     let q = v.length_squared();
-                    (v, q, q.sqrt())
+                    (v, q, q.sqrt(), if q > 0.0 { 1.0 / q } else { 0.0 })
                 };
                 // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
                 let p0 = if i == 0 {
@@ -459,8 +461,9 @@ impl Strip {
                 left = q1;
                 let (np0, nq0, np1, nq1) = (p0.0, q0.0, p1.0, q1.0);
                 let start = i == 0 && j == 0;
-                let sq = [p0.1, p1.1, q0.1, q1.1];
                 let len = [p0.2, p1.2, q0.2, q1.2];
+                let inv = [p0.3, p1.3, q0.3, q1.3];
+                let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
                 // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺.
                 let t01 = d.dot(cp);
                 let t23 = d.dot(cq);
@@ -520,13 +523,12 @@ impl Strip {
                             // cross product: A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²).
                             let k1 = 2 * s;
                             let n1 = if s == 0 { np0 } else { nq0 };
-                            let den = sq[k1] * sq[k2];
-                            if den > 0.0 && l2 > 0.0 {
-                                let x = tt[k1][k2];
-                                let s2 = (x * x * l2 / den).min(1.0);
-                                let sn = if n1.dot(n2) >= 0.0 { s2 } else { 2.0 - s2 };
-                                v += 0.5 * (len[k1] + len[k2]) * sn / l2;
-                            }
+                            let x = tt[k1][k2];
+                            let s2 = (x * x * l2 * inv[k1] * inv[k2]).min(1.0);
+                            let sn = if n1.dot(n2) >= 0.0 { s2 } else { 2.0 - s2 };
+                            // A degenerate triangle (inv 0) bends nothing.
+                            let live = f64::from(u8::from(inv[k1] > 0.0 && inv[k2] > 0.0));
+                            v += live * 0.5 * (len[k1] + len[k2]) * sn * inv_l2;
                         }
                         if use_area {
                             v += 0.5 * len[k2];
