@@ -36,6 +36,8 @@ pub enum Error {
     #[error(transparent)]
     Nest(#[from] nest::NestError),
     #[error(transparent)]
+    Esicup(#[from] nest::esicup::EsicupError),
+    #[error(transparent)]
     Output(#[from] output::OutputError),
     #[error(transparent)]
     Profile(#[from] device::ProfileError),
@@ -76,7 +78,7 @@ impl Error {
     /// 2 for a bug in flatcut, 1 for everything the user or the environment can fix.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Pattern(_) => 2,
+            Error::Pattern(_) | Error::Nest(nest::NestError::Infeasible(_)) => 2,
             Error::In { source, .. } | Error::At { source, .. } => source.exit_code(),
             _ => 1,
         }

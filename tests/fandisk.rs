@@ -7,19 +7,7 @@ use common::*;
 use flatcut::geom::polygon;
 use glam::DVec2;
 
-const SPEC: &str = r#"
-name = "fandisk"
-[[surface]]
-kind = "mesh"
-path = "fandisk.obj"
-scale = 100
-units = "mm"
-[sheet]
-width = 297
-height = 420
-margin = 5
-spacing = 3
-"#;
+const SPEC: &str = FANDISK_SPEC;
 
 #[test]
 fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
@@ -38,6 +26,8 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
         height: Some(420.0),
         margin: 5.0,
         spacing: 3.0,
+        seconds: 0.2,
+        ..Default::default()
     };
     let layout = flatcut::nest::nest(pieces, &opts).expect("nest");
     let mesh = &flat.surface.mesh;
@@ -55,36 +45,20 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
             }
             // Same orientation: a mirror image would not fold back into the part.
             assert!(polygon::signed_area(&placed) > 0.0);
+            // Inside the margins; the cut outline, which is what the nest places, leaves out
+            // features narrower than 0.1 mm, so a face corner may stand up to CLEAN_MM beyond it.
+            let tol = flatcut::pattern::allowance::CLEAN_MM;
             for p in &placed {
-                assert!(p.x >= 5.0 - 1e-9 && p.x <= 292.0 + 1e-9, "{p}");
-                assert!(p.y >= 5.0 - 1e-9 && p.y <= 415.0 + 1e-9, "{p}");
+                assert!(p.x >= 5.0 - tol && p.x <= 292.0 + tol, "{p}");
+                assert!(p.y >= 5.0 - tol && p.y <= 415.0 + tol, "{p}");
             }
             checked += 1;
         }
     }
     assert_eq!(checked, 12_946);
-    // Pieces apart from each other by the spacing (their bounding boxes, which hold them).
-    let boxes: Vec<(usize, DVec2, DVec2)> = layout
-        .pieces
-        .iter()
-        .zip(&layout.placements)
-        .map(|(p, at)| {
-            let (lo, hi) = polygon::bounds(p.points().map(|q| at.apply(q))).unwrap();
-            (at.sheet, lo, hi)
-        })
-        .collect();
-    for (i, a) in boxes.iter().enumerate() {
-        for b in &boxes[..i] {
-            if a.0 != b.0 {
-                continue;
-            }
-            let apart = a.1.x >= b.2.x + 3.0 - 1e-6
-                || b.1.x >= a.2.x + 3.0 - 1e-6
-                || a.1.y >= b.2.y + 3.0 - 1e-6
-                || b.1.y >= a.2.y + 3.0 - 1e-6;
-            assert!(apart, "pieces overlap: {a:?} {b:?}");
-        }
-    }
+    // Pieces apart from each other by the spacing: outlines checked exactly (dense nesting
+    // interleaves them, so bounding boxes say nothing).
+    flatcut::nest::verify(&layout).expect("outlines apart");
 }
 
 #[test]

@@ -33,7 +33,11 @@ pub struct CutArgs {
     #[arg(long)]
     pub dry_run: bool,
     #[command(flatten)]
+    pub pattern: super::PatternArgs,
+    #[command(flatten)]
     pub link: super::link::LinkArgs,
+    #[command(flatten)]
+    pub search: super::nest::SearchArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -45,7 +49,8 @@ pub fn default_dir(name: &str) -> PathBuf {
 }
 
 /// Spec → pieces → layout → job for a device: what `cut` sends (the device decides which
-/// stroke kinds are drawn at all).
+/// stroke kinds are drawn at all), with the default nesting search.
+#[allow(clippy::type_complexity)]
 pub fn plan_job(
     spec: &crate::spec::Spec,
     profile: &crate::device::Profile,
@@ -58,13 +63,32 @@ pub fn plan_job(
     ),
     Error,
 > {
+    plan_job_with(spec, profile, &Default::default(), quiet)
+}
+
+/// [`plan_job`] with the nesting search flags (`--nest-time`, `--seed`, `--threads`).
+pub fn plan_job_with(
+    spec: &crate::spec::Spec,
+    profile: &crate::device::Profile,
+    search: &super::nest::SearchArgs,
+    quiet: bool,
+) -> Result<
+    (
+        Vec<crate::flatten::Flat>,
+        crate::nest::Layout,
+        crate::toolpath::Job,
+    ),
+    Error,
+> {
     let (flats, pieces) = super::pieces(spec, quiet)?;
-    let nest_opts = crate::nest::NestOptions {
+    let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
         height: spec.sheet.height,
         margin: spec.sheet.margin,
         spacing: spec.sheet.spacing,
+        ..Default::default()
     };
+    search.apply(&mut nest_opts)?;
     let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
         file: spec.path.clone(),
         source: Box::new(e.into()),
@@ -87,8 +111,9 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
 }
 
 /// The rest of `cut` for a spec already in hand (`cut` reads it from a file, `fitting` builds
-/// it from its flags): plan, write the files, send.
-pub fn run_spec(spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
+/// it from its flags): the pattern flags on top, plan, write the files, send.
+pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
+    a.pattern.apply(&mut spec)?;
     let device = a
         .device
         .clone()
@@ -101,7 +126,7 @@ pub fn run_spec(spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
             profile.name
         )));
     }
-    let (flats, layout, job) = plan_job(&spec, &profile, a.quiet)?;
+    let (flats, layout, job) = plan_job_with(&spec, &profile, &a.search, a.quiet)?;
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;
@@ -156,11 +181,24 @@ pub fn run_spec(spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         );
         for i in 0..layout.sheets.len() {
             println!(
-                "  sheet {}: {:.0} × {:.0} mm, {:.1} % used",
+                "  {} {}: {:.0} × {:.0} mm, {:.1} % used",
+                if layout.roll { "roll" } else { "sheet" },
                 i + 1,
                 layout.sheets[i].width,
                 layout.sheets[i].height,
                 100.0 * layout.utilisation(i)
+            );
+        }
+        if let Some(len) = layout.roll_length() {
+            println!("  roll length used: {len:.1} mm");
+        }
+        if let Some((lo, hi)) = layout.remnant {
+            println!(
+                "  left on the last sheet: {:.0} × {:.0} mm at ({:.0}, {:.0})",
+                hi.x - lo.x,
+                hi.y - lo.y,
+                lo.x,
+                lo.y
             );
         }
         println!("wrote {}: {}", dir.display(), files.join(", "));

@@ -259,6 +259,8 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         output: a.output.clone(),
         device: a.device.clone(),
         material: None,
+        pattern: Default::default(),
+        search: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),
         quiet: a.quiet,

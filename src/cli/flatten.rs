@@ -15,6 +15,13 @@ pub struct FlattenArgs {
     /// Directory for the pictures and report (default: out/<name>).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Material: paper, fabric or metal (overrides the spec).
+    #[arg(long)]
+    pub material: Option<crate::spec::MaterialKind>,
+    #[command(flatten)]
+    pub pattern: super::PatternArgs,
+    #[command(flatten)]
+    pub search: super::nest::SearchArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -37,7 +44,11 @@ pub fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, 
 }
 
 pub fn run(a: &FlattenArgs) -> Result<(), Error> {
-    let spec = crate::spec::load(&a.input)?;
+    let mut spec = crate::spec::load(&a.input)?;
+    if let Some(m) = a.material {
+        spec.material.kind = m;
+    }
+    a.pattern.apply(&mut spec)?;
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
     // One strip wide enough for the widest piece: the pieces, not the sheets, are the result.
     let widest = pieces
@@ -49,12 +60,14 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
                 .map(|(lo, hi)| (hi - lo).x)
         })
         .fold(0.0, f64::max);
-    let opts = crate::nest::NestOptions {
+    let mut opts = crate::nest::NestOptions {
         width: spec.sheet.width.max(widest + 2.0 * spec.sheet.margin + 1.0),
         height: None,
         margin: spec.sheet.margin,
         spacing: spec.sheet.spacing,
+        ..Default::default()
     };
+    a.search.apply(&mut opts)?;
     let layout = crate::nest::nest(pieces, &opts).map_err(|e| Error::In {
         file: spec.path.clone(),
         source: Box::new(e.into()),

@@ -7,6 +7,7 @@ pub mod cut;
 pub mod fitting;
 pub mod flatten;
 pub mod link;
+pub mod nest;
 pub mod ports;
 pub mod send;
 pub mod sim;
@@ -26,6 +27,7 @@ Examples:
   flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
   flatcut fitting cone --bottom-diameter 300 --top-diameter 160 --height 200 --thickness 2 --dry-run
   flatcut fitting square-to-round --width 400 --depth 300 --diameter 250 --height 300 --bend-lines 50
+  flatcut nest fu.json --nest-time 10 -o out/fu        nest an ESICUP instance, print the density
   flatcut check model.obj                             faces, edges, boundary loops, angle defect
   flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
   flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
@@ -54,6 +56,9 @@ pub enum Command {
     /// Unfold and write the pieces (SVG, PNG, report) without nesting on sheets.
     #[command(after_help = EXAMPLES)]
     Flatten(flatten::FlattenArgs),
+    /// Nest an ESICUP strip-packing instance (JSON): solution.json, layout.svg, density.
+    #[command(after_help = EXAMPLES)]
+    Nest(nest::NestArgs),
     /// Report what a mesh is made of and whether it can be unfolded exactly.
     #[command(after_help = EXAMPLES)]
     Check(check::CheckArgs),
@@ -75,11 +80,57 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Cut(a) => cut::run(&a),
         Command::Fitting(a) => fitting::run(&a),
         Command::Flatten(a) => flatten::run(&a),
+        Command::Nest(a) => nest::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Send(a) => send::run(&a),
         Command::Sim(a) => sim::run(&a),
         Command::Ports => ports::ports(),
         Command::Devices => ports::devices(),
+    }
+}
+
+/// Pattern settings on the command line; they override the spec's `[pattern]` table.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct PatternArgs {
+    /// Glue tabs: none, one-side or both (default: one-side for paper, else none).
+    #[arg(long, value_enum)]
+    pub tabs: Option<crate::pattern::Tabs>,
+    /// Notches along every seam, every MM millimetres (default 50 with the flag; fabric has
+    /// them at 50 mm anyway; 0 turns them off).
+    #[arg(long, value_name = "MM", num_args = 0..=1, default_missing_value = "50")]
+    pub notches: Option<f64>,
+    /// Seam allowance in mm (default: 10 for fabric, else 0).
+    #[arg(long, value_name = "MM")]
+    pub allowance: Option<f64>,
+    /// Width of the cut in mm: cut contours move half of it away from the piece.
+    #[arg(long, value_name = "MM")]
+    pub kerf: Option<f64>,
+    /// V notches in the outline where bend lines meet it (sheet metal).
+    #[arg(long)]
+    pub bend_notches: bool,
+}
+
+impl PatternArgs {
+    /// Puts the flags into the spec (flags win), refusing values that make no sense.
+    pub fn apply(&self, spec: &mut Spec) -> Result<(), Error> {
+        let check = |v: Option<f64>, flag: &str| match v {
+            Some(x) if !(x.is_finite() && x >= 0.0) => Err(Error::Usage(format!(
+                "--{flag} {x}: must be a length in mm, at least 0"
+            ))),
+            _ => Ok(()),
+        };
+        check(self.notches, "notches")?;
+        check(self.allowance, "allowance")?;
+        check(self.kerf, "kerf")?;
+        let p = &mut spec.pattern;
+        p.tabs = self.tabs.or(p.tabs);
+        p.notches = self.notches.or(p.notches);
+        p.allowance = self.allowance.or(p.allowance);
+        p.kerf = self.kerf.or(p.kerf);
+        if self.bend_notches {
+            p.bend_notches = Some(true);
+        }
+        Ok(())
     }
 }
 
@@ -105,10 +156,7 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
         }
         flats.push(crate::flatten::unfold(surface, &UnfoldOptions::default())?);
     }
-    let opts = PatternOptions {
-        fold_threshold_deg: spec.pattern.fold_threshold_deg,
-        ..PatternOptions::default()
-    };
+    let opts = PatternOptions::from_spec(spec);
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
 }

@@ -236,12 +236,183 @@ pub fn is_simple_ring(ring: &[DVec2]) -> bool {
     true
 }
 
+/// Distance from `p` to the segment `a`–`b`.
+pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + ab * t)
+}
+
+/// Even-odd containment in a set of rings (an outer ring and its holes).
+pub fn contains_rings(rings: &[Vec<DVec2>], p: DVec2) -> bool {
+    rings.iter().filter(|r| contains(r, p)).count() % 2 == 1
+}
+
+/// Signed distance from `p` to the boundary of a set of rings: positive inside.
+fn rings_distance(rings: &[Vec<DVec2>], p: DVec2) -> f64 {
+    let mut d = f64::INFINITY;
+    for r in rings {
+        let n = r.len();
+        for i in 0..n {
+            d = d.min(segment_distance(p, r[i], r[(i + 1) % n]));
+        }
+    }
+    if contains_rings(rings, p) {
+        d
+    } else {
+        -d
+    }
+}
+
+/// Pole of inaccessibility of a polygon with holes: the inside point farthest from the
+/// boundary, and that distance (the radius of the largest inscribed circle), to within
+/// `precision` mm. Mapbox's "polylabel" (V. Agafonkin, 2016): best-first search over square
+/// cells, pruning a cell when its centre distance plus half its diagonal cannot beat the best.
+/// `None` for rings without area.
+pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
+    use std::cmp::Ordering;
+    use std::collections::BinaryHeap;
+    let (lo, hi) = bounds(rings.first()?.iter().copied())?;
+    let size = hi - lo;
+    let cell = size.min_element();
+    if cell.is_nan() || cell <= 0.0 || !cell.is_finite() {
+        return None;
+    }
+    struct Cell {
+        c: DVec2,
+        h: f64,
+        d: f64,
+        max: f64,
+    }
+    impl PartialEq for Cell {
+        fn eq(&self, o: &Self) -> bool {
+            self.max == o.max
+        }
+    }
+    impl Eq for Cell {}
+    impl PartialOrd for Cell {
+        fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+    impl Ord for Cell {
+        fn cmp(&self, o: &Self) -> Ordering {
+            self.max.total_cmp(&o.max)
+        }
+    }
+    let make = |c: DVec2, h: f64| {
+        let d = rings_distance(rings, c);
+        Cell {
+            c,
+            h,
+            d,
+            max: d + h * std::f64::consts::SQRT_2,
+        }
+    };
+    let mut heap = BinaryHeap::new();
+    let h = 0.5 * cell;
+    let mut x = lo.x;
+    while x < hi.x {
+        let mut y = lo.y;
+        while y < hi.y {
+            heap.push(make(DVec2::new(x + h, y + h), h));
+            y += cell;
+        }
+        x += cell;
+    }
+    // Start from the centroid of the outer ring, as polylabel does.
+    let outer = &rings[0];
+    let a = signed_area(outer);
+    let mut best = make(0.5 * (lo + hi), 0.0);
+    if a.abs() > 0.0 {
+        let n = outer.len();
+        let mut c = DVec2::ZERO;
+        for i in 0..n {
+            let (p, q) = (outer[i], outer[(i + 1) % n]);
+            c += (p + q) * p.perp_dot(q);
+        }
+        let centroid = make(c / (6.0 * a), 0.0);
+        if centroid.d > best.d {
+            best = centroid;
+        }
+    }
+    let mut steps = 0usize;
+    while let Some(cell) = heap.pop() {
+        if cell.d > best.d {
+            best = Cell { ..cell };
+        }
+        if cell.max - best.d <= precision || steps > 100_000 {
+            continue;
+        }
+        steps += 1;
+        let h = 0.5 * cell.h;
+        for (dx, dy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+            heap.push(make(cell.c + DVec2::new(dx * h, dy * h), h));
+        }
+    }
+    (best.d > 0.0).then_some((best.c, best.d))
+}
+
+/// The intervals of the line `p + t d` (`d` a unit vector) that lie inside a set of rings, as
+/// sorted `(t0, t1)` pairs (even-odd rule).
+pub fn line_intervals(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<(f64, f64)> {
+    let mut ts = Vec::new();
+    for r in rings {
+        let n = r.len();
+        for i in 0..n {
+            let (a, b) = (r[i], r[(i + 1) % n]);
+            // Half-open in the signed offset from the line, so a vertex on it counts once.
+            let (sa, sb) = (d.perp_dot(a - p), d.perp_dot(b - p));
+            if (sa > 0.0) != (sb > 0.0) {
+                let u = sa / (sa - sb);
+                ts.push((a + (b - a) * u - p).dot(d));
+            }
+        }
+    }
+    ts.sort_by(f64::total_cmp);
+    ts.chunks_exact(2).map(|c| (c[0], c[1])).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn v(x: f64, y: f64) -> DVec2 {
         DVec2::new(x, y)
+    }
+
+    #[test]
+    fn pole_and_line_intervals() {
+        // An L shape: the pole is on the diagonal of the corner square, at distance t from both
+        // outer sides and √2 (10 − t) from the inner corner: t = 10√2 / (1 + √2).
+        let l = vec![vec![
+            v(0.0, 0.0),
+            v(30.0, 0.0),
+            v(30.0, 10.0),
+            v(10.0, 10.0),
+            v(10.0, 40.0),
+            v(0.0, 40.0),
+        ]];
+        let (c, r) = pole(&l, 0.01).unwrap();
+        let t = 10.0 * 2f64.sqrt() / (1.0 + 2f64.sqrt());
+        assert!((r - t).abs() < 0.02, "{r}");
+        assert!(contains_rings(&l, c));
+        // A square with a square hole: the line y = 5 crosses it in two intervals.
+        let ring = vec![
+            vec![v(0.0, 0.0), v(10.0, 0.0), v(10.0, 10.0), v(0.0, 10.0)],
+            vec![v(3.0, 3.0), v(3.0, 7.0), v(7.0, 7.0), v(7.0, 3.0)],
+        ];
+        let iv = line_intervals(&ring, v(-1.0, 5.0), v(1.0, 0.0));
+        assert_eq!(iv, vec![(1.0, 4.0), (8.0, 11.0)]);
+        assert!(!contains_rings(&ring, v(5.0, 5.0)));
+        let (c, r) = pole(&ring, 0.01).unwrap();
+        // In a corner: t from two outer sides, √2 (3 − t) from the hole's corner.
+        let t = 3.0 * 2f64.sqrt() / (1.0 + 2f64.sqrt());
+        assert!((r - t).abs() < 0.02 && contains_rings(&ring, c), "{c} {r}");
     }
 
     #[test]

@@ -150,6 +150,9 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
             for ring in &piece.outline {
                 d.polyline("CUT", &map(ring), true);
             }
+            for n in &piece.notches {
+                d.polyline(if n.cut { "CUT" } else { "MARK" }, &map(&n.stroke), false);
+            }
             for f in &piece.folds {
                 let (a, b) = (place.apply(f.a), place.apply(f.b));
                 let (layer, word) = match f.kind {
@@ -157,6 +160,9 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
                     FoldKind::Mountain => ("BEND_DOWN", "DOWN"),
                 };
                 d.line(layer, a, b);
+                if f.tab {
+                    continue;
+                }
                 let dir = b - a;
                 let mut ang = dir.y.atan2(dir.x).to_degrees();
                 if !(-90.0..=90.0).contains(&ang) {
@@ -172,11 +178,17 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
                 );
             }
             for m in &piece.marks {
-                for s in &m.strokes {
+                for s in &m.text.strokes {
                     d.polyline("MARK", &map(s), false);
                 }
             }
-            for s in &piece.label {
+            for s in piece.seam_line.iter() {
+                d.polyline("MARK", &map(s), true);
+            }
+            for s in piece.grain_line.iter() {
+                d.polyline("MARK", &map(s), false);
+            }
+            for s in &piece.label.strokes {
                 d.polyline("TEXT", &map(s), false);
             }
         }

@@ -162,11 +162,15 @@ pub fn to_device(profile: &Profile, sheet_w: f64, sheet_h: f64, p: DVec2) -> DVe
 
 /// Roles in drawing order, back to front: what is drawn later lies on top.
 /// The SVG layers follow this order too, after the sheet layer.
-pub const DRAW_ORDER: [StrokeRole; 5] = [
+pub const DRAW_ORDER: [StrokeRole; 9] = [
     StrokeRole::Label,
     StrokeRole::Mark,
+    StrokeRole::Grain,
+    StrokeRole::Seam,
     StrokeRole::FoldValley,
     StrokeRole::FoldMountain,
+    StrokeRole::Weed,
+    StrokeRole::Notch,
     StrokeRole::Cut,
 ];
 
@@ -186,7 +190,8 @@ impl RoleStyle {
 }
 
 /// Style of each role: cut black; mountain fold red dash-dot; valley fold blue dashed;
-/// marks green; labels dark green.
+/// marks green; labels dark green; notches black; sewing lines brown dashed; grain lines
+/// purple; weed lines grey.
 pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
     match role {
         StrokeRole::Cut => RoleStyle {
@@ -207,6 +212,22 @@ pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
         },
         StrokeRole::Label => RoleStyle {
             rgb: [0x00, 0x60, 0x00],
+            dash_mm: &[],
+        },
+        StrokeRole::Notch => RoleStyle {
+            rgb: [0x00, 0x00, 0x00],
+            dash_mm: &[],
+        },
+        StrokeRole::Seam => RoleStyle {
+            rgb: [0x80, 0x40, 0x00],
+            dash_mm: &[4.0, 1.5],
+        },
+        StrokeRole::Grain => RoleStyle {
+            rgb: [0x60, 0x00, 0x80],
+            dash_mm: &[],
+        },
+        StrokeRole::Weed => RoleStyle {
+            rgb: [0x90, 0x90, 0x90],
             dash_mm: &[],
         },
     }
@@ -244,6 +265,7 @@ pub(crate) mod fixtures {
             points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
             closed: pts.len() > 2 && pts.first() == pts.last(),
             piece: None,
+            outer: false,
         }
     }
 

@@ -194,6 +194,7 @@ mod tests {
             points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
             closed,
             piece: Some(0),
+            outer: false,
         }
     }
 

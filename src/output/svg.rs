@@ -28,9 +28,9 @@ const SHEET_OUTLINE_MM: f64 = 0.1;
 /// Stroke width per role, mm.
 fn stroke_width_mm(role: StrokeRole) -> f64 {
     match role {
-        StrokeRole::Cut => 0.25,
+        StrokeRole::Cut | StrokeRole::Notch | StrokeRole::Weed => 0.25,
         StrokeRole::FoldMountain | StrokeRole::FoldValley => 0.2,
-        StrokeRole::Mark | StrokeRole::Label => 0.15,
+        StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => 0.15,
     }
 }
 
@@ -180,6 +180,7 @@ mod tests {
             points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
             closed,
             piece,
+            outer: false,
         }
     }
 

@@ -13,6 +13,8 @@
 use glam::DVec2;
 use serde::Serialize;
 
+mod collect;
+
 /// What a stroke is for; decides the SVG layer and, through [`StrokeKind`], the tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -27,23 +29,37 @@ pub enum StrokeRole {
     Mark,
     /// Piece labels.
     Label,
+    /// Seam notches: short slits cut from the outline into the piece (or its allowance).
+    Notch,
+    /// The sewing line of a piece cut with a seam allowance (drawn).
+    Seam,
+    /// Grain-line arrows on fabric pieces (drawn).
+    Grain,
+    /// Weed lines cut through the waste between pieces (vinyl).
+    Weed,
 }
 
 impl StrokeRole {
-    pub const ALL: [StrokeRole; 5] = [
+    pub const ALL: [StrokeRole; 9] = [
         StrokeRole::Cut,
         StrokeRole::FoldMountain,
         StrokeRole::FoldValley,
         StrokeRole::Mark,
         StrokeRole::Label,
+        StrokeRole::Notch,
+        StrokeRole::Seam,
+        StrokeRole::Grain,
+        StrokeRole::Weed,
     ];
 
     /// The tool class that makes this stroke.
     pub fn kind(self) -> StrokeKind {
         match self {
-            StrokeRole::Cut => StrokeKind::Cut,
+            StrokeRole::Cut | StrokeRole::Notch | StrokeRole::Weed => StrokeKind::Cut,
             StrokeRole::FoldMountain | StrokeRole::FoldValley => StrokeKind::Score,
-            StrokeRole::Mark | StrokeRole::Label => StrokeKind::Draw,
+            StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => {
+                StrokeKind::Draw
+            }
         }
     }
 
@@ -55,6 +71,10 @@ impl StrokeRole {
             StrokeRole::FoldValley => "fold-valley",
             StrokeRole::Mark => "mark",
             StrokeRole::Label => "label",
+            StrokeRole::Notch => "notch",
+            StrokeRole::Seam => "seam",
+            StrokeRole::Grain => "grain",
+            StrokeRole::Weed => "weed",
         }
     }
 }
@@ -91,6 +111,8 @@ pub struct Stroke {
     pub closed: bool,
     /// Index of the piece in the layout this stroke belongs to.
     pub piece: Option<usize>,
+    /// The outer contour of its piece (cut last, after everything inside it).
+    pub outer: bool,
 }
 
 impl Stroke {
@@ -130,55 +152,21 @@ pub fn plan(layout: &crate::nest::Layout, name: &str, opts: &ToolpathOptions) ->
         .sheets
         .iter()
         .map(|sheet| {
-            let (mut draw, mut folds, mut holes, mut outers) =
-                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            for &k in &sheet.pieces {
-                let piece = &layout.pieces[k];
-                let at = layout.placements[k];
-                let open = |role, pts: &[DVec2]| Stroke {
-                    role,
-                    points: pts.iter().map(|p| at.apply(*p)).collect(),
-                    closed: false,
-                    piece: Some(k),
+            let mut groups: [Vec<Stroke>; 4] = Default::default();
+            for s in collect::strokes(layout, sheet, opts) {
+                let g = match s.role {
+                    StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => {
+                        0
+                    }
+                    StrokeRole::FoldMountain | StrokeRole::FoldValley | StrokeRole::Notch => 1,
+                    StrokeRole::Cut | StrokeRole::Weed if !s.outer => 2,
+                    StrokeRole::Cut | StrokeRole::Weed => 3,
                 };
-                if !opts.skip_drawing {
-                    for s in &piece.label {
-                        draw.push(open(StrokeRole::Label, s));
-                    }
-                    for m in &piece.marks {
-                        for s in &m.strokes {
-                            draw.push(open(StrokeRole::Mark, s));
-                        }
-                    }
-                }
-                if !opts.skip_folds {
-                    for f in &piece.folds {
-                        let role = match f.kind {
-                            crate::pattern::FoldKind::Mountain => StrokeRole::FoldMountain,
-                            crate::pattern::FoldKind::Valley => StrokeRole::FoldValley,
-                        };
-                        folds.push(open(role, &[f.a, f.b]));
-                    }
-                }
-                for (i, ring) in piece.outline.iter().enumerate() {
-                    let mut points: Vec<DVec2> = ring.iter().map(|p| at.apply(*p)).collect();
-                    points.push(points[0]);
-                    let s = Stroke {
-                        role: StrokeRole::Cut,
-                        points,
-                        closed: true,
-                        piece: Some(k),
-                    };
-                    if i == 0 {
-                        outers.push(s);
-                    } else {
-                        holes.push(s);
-                    }
-                }
+                groups[g].push(s);
             }
             let mut pen = DVec2::ZERO;
             let mut strokes = Vec::new();
-            for group in [draw, folds, holes, outers] {
+            for group in groups {
                 strokes.extend(nearest_neighbour(group, &mut pen));
             }
             SheetJob {
@@ -306,6 +294,7 @@ fn nearest_neighbour(mut strokes: Vec<Stroke>, pen: &mut DVec2) -> Vec<Stroke> {
                 points: Vec::new(),
                 closed: false,
                 piece: None,
+                outer: false,
             },
         );
         if s.closed {
@@ -330,6 +319,7 @@ mod tests {
             points: vec![DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)],
             closed: false,
             piece: None,
+            outer: false,
         }
     }
 
@@ -367,6 +357,7 @@ mod tests {
             .collect(),
             closed: true,
             piece: None,
+            outer: false,
         };
         let mut pen = DVec2::new(11.0, 11.0);
         let out = nearest_neighbour(vec![ring.clone()], &mut pen);

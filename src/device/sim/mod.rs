@@ -833,6 +833,7 @@ pub fn write_outputs(
             points,
             closed: false,
             piece: None,
+            outer: false,
         });
     }
     let sheet = SheetJob {
