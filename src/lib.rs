@@ -2,7 +2,7 @@
 //!
 //! The pipeline runs one way, one stage per module, plain data between them:
 //! a [`spec::Spec`] names the surfaces; [`surface`] makes each a [`surface::Surface`] (3D flat
-//! panels); [`flatten`] lays it into the plane as a [`flatten::Flat`] (islands of faces moved by
+//! panels: imported meshes, Wang–Tang strips between two curves, sheet-metal fittings); [`flatten`] lays it into the plane as a [`flatten::Flat`] (islands of faces moved by
 //! rigid motions); [`pattern`] turns islands into [`pattern::Piece`]s (cut outline, fold lines,
 //! edge ids, labels); [`nest`] places pieces on sheets as a [`nest::Layout`]; [`toolpath`]
 //! orders the strokes of each sheet into a [`toolpath::Job`]; [`output`] encodes a job as HPGL,

@@ -202,6 +202,27 @@ fn strip_fittings_flatten_isometrically_into_one_piece() {
         assert_eq!(m.vertices.len(), bridges + 1, "m + n − 2 triangles");
         check_isometric(&flats[0]);
         assert!(!pieces[0].folds.is_empty(), "{}: bend lines", args[0]);
+        // Exact areas where the surface is known: four planar trapezoids; a cylinder cut by a
+        // plane through its centre line at 200 mm has the area of a 200 mm cylinder.
+        let exact = match args[0] {
+            "rect-to-rect" => {
+                let h = |dx: f64| (dx * dx + 250.0f64 * 250.0).sqrt();
+                Some((
+                    2.0 * 300.0 * h(100.0) + 200.0 * h(50.0) + 200.0 * h(150.0),
+                    1e-9,
+                ))
+            }
+            "pipe-miter" => Some((PI * 150.0 * 200.0, 1e-3)),
+            _ => None,
+        };
+        if let Some((want, tol)) = exact {
+            let got = pieces[0].area;
+            assert!(
+                (got - want).abs() / want < tol,
+                "{}: area {got} want {want}",
+                args[0]
+            );
+        }
     }
 }
 
@@ -410,4 +431,62 @@ fn strip_bad_input_exits_1_naming_the_flag_or_key() {
         "[[surface]]\nkind = \"strip\"\np = { kind = \"circle\", diameter = 0 }\nq = { kind = \"circle\", radius = 50, center = [0, 0, 10] }\n",
     );
     assert_fails_naming(&["cut", &zero, "--dry-run"], "`surface[1].p.radius`");
+}
+
+#[test]
+fn strip_spec_curves_of_every_kind_build_and_flatten() {
+    let dir = scratch("strip-spec-kinds");
+    std::fs::write(
+        dir.join("edge.csv"),
+        "x,y,z\n0,0,0\n100,0,10\n200,0,0\n300,0,-10\n",
+    )
+    .unwrap();
+    let spec_text = r#"
+name = "kinds"
+
+[[surface]]
+kind = "strip"
+name = "wave"
+p = { kind = "csv", path = "edge.csv" }
+q = { kind = "bezier", control = [[0, 60, 0], [150, 80, 40], [300, 60, 0]] }
+method = "godt"
+tolerance = 0.1
+
+[[surface]]
+kind = "strip"
+name = "spline"
+p = [[0, 0, 0], [100, 0, 0], [200, 20, 0]]
+q = { kind = "bspline", control = [[0, 50, 10], [100, 60, 30], [200, 80, 10], [250, 90, 0]] }
+bend_lines = "none"
+
+[[surface]]
+kind = "strip"
+name = "oval"
+p = { kind = "ellipse", center = [0, 0, 0], rx = 120, ry = 80 }
+q = { kind = "rect", center = [0, 0, 100], width = 120, height = 80, corner_radius = 20 }
+method = "gmat"
+
+[sheet]
+width = 1000
+height = 1000
+"#;
+    let path = dir.join("kinds.toml");
+    std::fs::write(&path, spec_text).unwrap();
+    let spec = flatcut::spec::load(&path).unwrap();
+    assert_eq!(spec.surfaces.len(), 3);
+    let (flats, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    assert!(pieces.len() >= 3);
+    for f in &flats {
+        check_isometric(f);
+    }
+    // "none": no folds on the second surface's pieces.
+    assert!(pieces
+        .iter()
+        .filter(|p| p.surface == "spline")
+        .all(|p| p.folds.is_empty()));
+    // The same spec twice gives the same meshes (determinism).
+    let (again, _) = flatcut::cli::pieces(&spec, true).unwrap();
+    for (a, b) in flats.iter().zip(&again) {
+        assert_eq!(a.surface.mesh, b.surface.mesh);
+    }
 }

@@ -162,7 +162,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
 
     if !a.quiet {
         let cut: f64 = layout.pieces.iter().map(|p| p.cut_length()).sum();
-        let fold: f64 = layout.pieces.iter().map(|p| p.fold_length()).sum();
+        let fold: f64 = layout.pieces.iter().map(|p| p.fold_length()).sum::<f64>() + 0.0; // not -0
         println!(
             "{}: {} pieces on {} {} ({:.0} mm cut, {:.0} mm folds), device {}",
             spec.name,

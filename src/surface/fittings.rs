@@ -517,4 +517,28 @@ mod tests {
         let sum: f64 = b.iter().map(|b| b.angle_deg).sum();
         assert!((sum - total).abs() < 1e-9 * total, "{sum} {total}");
     }
+
+    #[test]
+    fn strip_fitting_offset_transitions_are_fully_developable() {
+        // Every ruling locally convex (no warning), seam included, for offset fittings.
+        for f in [
+            Fitting::SquareToRound {
+                width: 400.0,
+                depth: 300.0,
+                diameter: 250.0,
+                height: 300.0,
+                offset_x: 40.0,
+                offset_y: -25.0,
+            },
+            Fitting::Cone {
+                bottom_diameter: 600.0,
+                top_diameter: 200.0,
+                height: 400.0,
+                offset: 150.0,
+            },
+        ] {
+            let s = surface(&f, &FittingOptions::default());
+            assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        }
+    }
 }

@@ -117,6 +117,17 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         st.q.sample(st.tolerance)
             .map_err(|e| err(format!("`q`: {e}")))?;
     let mut s = strip::Strip::new(&p, &q).map_err(|e| err(e.to_string()))?;
+    // The global triangulations keep one byte per bridge (m·n of them).
+    const MAX_BRIDGES: usize = 64_000_000;
+    if s.m().saturating_mul(s.n()) > MAX_BRIDGES {
+        return Err(err(format!(
+            "`p` has {} points and `q` {}: {} candidate bridges is over {MAX_BRIDGES}; raise `tolerance` (now {} mm)",
+            s.m(),
+            s.n(),
+            s.m().saturating_mul(s.n()),
+            st.tolerance
+        )));
+    }
     let steps = s.triangulate(st.method);
     let mut warnings = Vec::new();
     let mt = s.metrics(&steps);

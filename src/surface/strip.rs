@@ -26,7 +26,8 @@
 //!   lexicographic cost on Ω). The graphs are monotone DAGs on the m×n grid, so instead of
 //!   Dijkstra one O(mn) dynamic program in row order finds the same optimum (§8 asks for
 //!   exactly this); tests compare it with a plain Dijkstra and with brute force. Memory: two
-//!   rows of costs and one byte of back pointers per grid node.
+//!   rows of costs and one byte of back pointers per grid node (the surface stage refuses more
+//!   than 64 million nodes and asks for a coarser tolerance).
 //! - LODT + LMBT (§4), kept for comparison: the greedy walk; when neither successor is valid it
 //!   finds the nearest valid bridge `E_{i',j'}` with i' > i and j' > j (fewest steps, then the
 //!   one most balanced between P and Q, then smaller i'), or the ending bridge if there is
@@ -35,9 +36,11 @@
 //! - Orientation and start (the paper takes P and Q as given): open strips are used as given
 //!   except that Q is reversed when that makes the two end bridges shorter in sum. Closed
 //!   strips (both curves closed loops) are oriented alike (Q is reversed when its Newell normal
-//!   points against P's) and start at the shortest bridge `p_i q_j` over all pairs (ties: lowest
-//!   i, then j): that is the seam, the shortest element, where a sheet-metal worker puts the
-//!   seam of an oblique cone. Both loops are rotated to start there and their first point is
+//!   points against P's) and start at the shortest locally convex bridge `p_i q_j` over all
+//!   pairs (ties: lowest i, then j; the shortest bridge of all if none is convex). That is the
+//!   seam: a ruling of the developable, and its shortest element, where a sheet-metal worker
+//!   puts the seam of an oblique cone (a plain shortest bridge can cut across a flat triangle
+//!   of an offset square-to-round, which no ruling does). Both loops are rotated to start there and their first point is
 //!   repeated at the end, so the strip is an open band whose two copies of the seam are cut.
 //! - Faces are wound `p_i p_{i+1} q_j` and `p_i q_{j+1} q_j`: with P below Q and both running
 //!   counter-clockwise seen from +z (as the fittings build them), normals point outward.
@@ -204,15 +207,27 @@ impl Strip {
         if newell(&pp).dot(newell(&qq)) < 0.0 {
             qq.reverse();
         }
-        // Seam: the shortest bridge.
+        // Seam: the shortest locally convex bridge, else the shortest bridge.
+        let ring = Strip {
+            p: pp.iter().chain(pp.first()).copied().collect(),
+            q: qq.iter().chain(qq.first()).copied().collect(),
+            closed: true,
+        };
         let (mut bi, mut bj, mut best) = (0, 0, f64::INFINITY);
+        let (mut ci, mut cj, mut best_convex) = (0, 0, f64::INFINITY);
         for (i, a) in pp.iter().enumerate() {
             for (j, b) in qq.iter().enumerate() {
                 let d = a.distance_squared(*b);
                 if d < best {
                     (bi, bj, best) = (i, j, d);
                 }
+                if d < best_convex && ring.locally_convex(i, j) {
+                    (ci, cj, best_convex) = (i, j, d);
+                }
             }
+        }
+        if best_convex.is_finite() {
+            (bi, bj) = (ci, cj);
         }
         pp.rotate_left(bi);
         qq.rotate_left(bj);
@@ -363,100 +378,195 @@ impl Strip {
         }
     }
 
+    /// Bank vectors to the previous and next point of each vertex of a curve (zero where the
+    /// curve has none), with their cross product.
+    fn banks(pts: &[DVec3], closed: bool) -> Vec<([DVec3; 3], [f64; 2])> {
+        (0..pts.len())
+            .map(|i| {
+                let (a, b) = Self::neighbours(pts.len(), closed, i);
+                let e0 = a.map_or(DVec3::ZERO, |k| pts[k] - pts[i]);
+                let e1 = b.map_or(DVec3::ZERO, |k| pts[k] - pts[i]);
+                ([e0, e1, e0.cross(e1)], [e0.length(), e1.length()])
+            })
+            .collect()
+    }
+
     /// GODT / GMBT / GMAT / GODT+GMBT by dynamic programming on the dual-node graph.
+    ///
+    /// Everything at a node (i, j) comes from the bridge `d = q_j − p_i` and the four bank
+    /// vectors there: the area vectors of the triangles before it (`d × e_p⁻`, `d × e_q⁻`) and
+    /// after it (`e_p⁺ × d`, `e_q⁺ × d`), and the triple products of the convexity test, which
+    /// `d` reduces to `d̂·(e_a × e_b)` (the `d` part of `q_{j±1} − p_i` drops out). This is
+    /// [`Strip::locally_convex`] and [`Strip::energy`] rewritten without repeated work; the
+    /// tests check both against the plain versions through a Dijkstra on the same graph.
     fn global(&self, method: Method) -> Vec<Step> {
+        match method {
+            Method::Godt => self.global_dp::<true, false, false>(),
+            Method::Gmbt => self.global_dp::<false, true, false>(),
+            Method::Gmat => self.global_dp::<false, false, true>(),
+            _ => self.global_dp::<true, true, false>(),
+        }
+    }
+
+    /// [`Strip::global`] for one objective, known at compile time.
+    fn global_dp<const COUNT: bool, const ENERGY: bool, const AREA: bool>(&self) -> Vec<Step> {
         let (m, n) = (self.m(), self.n());
-        let use_count = matches!(method, Method::Godt | Method::GodtGmbt);
-        let use_energy = matches!(method, Method::Gmbt | Method::GodtGmbt);
-        let use_area = method == Method::Gmat;
-        let inf = Cost {
-            count: u32::MAX,
-            value: f64::INFINITY,
-        };
-        let zero = Cost {
-            count: 0,
-            value: 0.0,
-        };
-        // cur[j][s]: cost of reaching (i, j) by a step of kind s.
-        let mut cur = vec![[inf; 2]; n];
-        let mut next = vec![[inf; 2]; n];
-        cur[0] = [zero, zero];
+        let (use_count, use_energy, use_area) = (COUNT, ENERGY, AREA);
+        let pb = Self::banks(&self.p, self.closed);
+        let qb = Self::banks(&self.q, self.closed);
+        const INF: u32 = u32::MAX;
+        // Costs of reaching (i, j) by a P step [0] or a Q step [1]: rows i (cur) and i+1.
+        let mut cc = vec![[INF; 2]; n];
+        let mut cv = vec![[f64::INFINITY; 2]; n];
+        let mut nc = vec![[INF; 2]; n];
+        let mut nv = vec![[f64::INFINITY; 2]; n];
+        cc[0] = [0, 0];
+        cv[0] = [0.0, 0.0];
         let mut back = vec![0u8; m * n];
-        // Triangles of P-steps from row i−1 (prev) and i (this row).
-        let need_tris = use_energy || use_area;
-        let none = (DVec3::ZERO, 0.0);
-        let mut tp_prev = vec![none; n];
-        let mut tp_cur = vec![none; n];
+        // A triangle after one bridge is the triangle before the next: keep the area vectors
+        // (with squared and plain lengths) of the P-step triangles of the previous row and of
+        // the Q-step triangle of the previous column.
+        let mut above = vec![(DVec3::ZERO, 0.0, 0.0, 0.0); n];
+        #[allow(clippy::needless_range_loop)] // i is also a grid coordinate
         for i in 0..m {
-            let mut tq_left = none; // Q-step triangle from (i, j−1)
+            let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
+            let pi = self.p[i];
+            let last_row = i + 1 == m;
+            let mut left = (DVec3::ZERO, 0.0, 0.0, 0.0);
             for j in 0..n {
-                let c = cur[j];
-                if i + 1 == m && j + 1 == n {
+                let last_col = j + 1 == n;
+                if last_row && last_col {
                     break;
                 }
-                let invalid = use_count && !self.is_end(i, j) && !self.locally_convex(i, j);
-                let (tp, tq) = if need_tris {
-                    (
-                        if i + 1 < m { self.tri_p(i, j) } else { none },
-                        if j + 1 < n { self.tri_q(i, j) } else { none },
-                    )
-                } else {
-                    (none, none)
+                let ([eq0, eq1, cq], [lq0, lq1]) = qb[j];
+                let d = self.q[j] - pi;
+                let l2 = d.length_squared();
+                // Area vectors (twice the area) of the triangles around the bridge.
+                // (area vector, its squared length, length, 1 / squared length or 0); the squared
+                // length is kept for symmetry with `fresh`, only the others are read.
+                let fresh = |v: DVec3| {
+                    let q = v.length_squared();
+                    (v, q, q.sqrt(), if q > 0.0 { 1.0 / q } else { 0.0 })
                 };
-                let l2 = self.p[i].distance_squared(self.q[j]);
+                // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
+                let p0 = if i == 0 {
+                    fresh(d.cross(ep0))
+                } else {
+                    above[j]
+                };
+                let q0 = if j == 0 { fresh(d.cross(eq0)) } else { left };
+                let p1 = fresh(ep1.cross(d));
+                let q1 = fresh(eq1.cross(d));
+                above[j] = p1;
+                left = q1;
+                let (np0, nq0, np1, nq1) = (p0.0, q0.0, p1.0, q1.0);
                 let start = i == 0 && j == 0;
-                for (t, tri_t, ok) in [(0usize, tp, i + 1 < m), (1usize, tq, j + 1 < n)] {
-                    if !ok {
+                let len = [p0.2, p1.2, q0.2, q1.2];
+                let inv = [p0.3, p1.3, q0.3, q1.3];
+                let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
+                // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺.
+                let t01 = d.dot(cp);
+                let t23 = d.dot(cq);
+                let t02 = -ep0.dot(nq0);
+                let t03 = ep0.dot(nq1);
+                let t12 = -ep1.dot(nq0);
+                let t13 = ep1.dot(nq1);
+                let tt = [
+                    [0.0, t01, t02, t03],
+                    [-t01, 0.0, t12, t13],
+                    [-t02, -t12, 0.0, t23],
+                    [-t03, -t13, -t23, 0.0],
+                ];
+                let invalid = use_count && !start && {
+                    let l = l2.sqrt();
+                    // len: projected neighbour lengths times l.
+                    let es = [lp0, lp1, lq0, lq1];
+                    let on = [0, 1, 2, 3].map(|k| len[k] > 1e-12 * l * es[k].max(l));
+                    // Branch-free: some vector s has every other one on one side of it.
+                    let mut any = false;
+                    let mut real = 0;
+                    for s in 0..4 {
+                        let (mut pos, mut neg) = (true, true);
+                        for u in 0..4 {
+                            // tt is l² times the 2D cross; len is l times the projected length.
+                            let tol = 1e-9 * len[s] * len[u];
+                            let x = tt[s][u] * l;
+                            let skip = u == s || !on[u];
+                            pos &= skip | (x >= -tol);
+                            neg &= skip | (x <= tol);
+                        }
+                        real += usize::from(on[s]);
+                        any |= on[s] & (pos | neg);
+                    }
+                    !(any || real <= 1)
+                };
+                let inc = u32::from(invalid);
+                let cur_c = cc[j];
+                let cur_v = cv[j];
+                for t in 0..2 {
+                    if (t == 0 && last_row) || (t == 1 && last_col) {
                         continue;
                     }
-                    let mut best = inf;
+                    let k2 = if t == 0 { 1 } else { 3 };
+                    let n2 = if t == 0 { np1 } else { nq1 };
+                    let mut best_c = INF;
+                    let mut best_v = f64::INFINITY;
                     let mut arg = 0u8;
-                    for (s, prev_tri) in [(0usize, tp_prev[j]), (1usize, tq_left)] {
-                        if c[s].count == u32::MAX {
+                    for s in 0..2 {
+                        if cur_c[s] == INF {
                             continue;
                         }
-                        let mut w = c[s];
-                        if invalid {
-                            w.count += 1;
-                        }
+                        let c = cur_c[s] + inc;
+                        let mut v = cur_v[s];
                         if use_energy && !start {
-                            w.value += bend_energy(prev_tri, tri_t, l2);
+                            // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no
+                            // cross product: A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²).
+                            let k1 = 2 * s;
+                            let n1 = if s == 0 { np0 } else { nq0 };
+                            let x = tt[k1][k2];
+                            let s2 = (x * x * l2 * inv[k1] * inv[k2]).min(1.0);
+                            let sn = if n1.dot(n2) >= 0.0 { s2 } else { 2.0 - s2 };
+                            // A degenerate triangle (inv 0) bends nothing.
+                            let live = f64::from(u8::from(inv[k1] > 0.0 && inv[k2] > 0.0));
+                            v += live * 0.5 * (len[k1] + len[k2]) * sn * inv_l2;
                         }
                         if use_area {
-                            w.value += tri_t.1;
+                            v += 0.5 * len[k2];
                         }
-                        if w.better(&best) {
-                            best = w;
+                        if c < best_c || (c == best_c && v < best_v) {
+                            best_c = c;
+                            best_v = v;
                             arg = s as u8;
                         }
                     }
+                    if best_c == INF {
+                        continue;
+                    }
                     let (ti, tj) = if t == 0 { (i + 1, j) } else { (i, j + 1) };
-                    let slot = if t == 0 {
-                        &mut next[tj][0]
+                    let (sc, sv) = if t == 0 {
+                        (&mut nc[tj][0], &mut nv[tj][0])
                     } else {
-                        &mut cur[tj][1]
+                        (&mut cc[tj][1], &mut cv[tj][1])
                     };
-                    if best.better(slot) {
-                        *slot = best;
+                    if best_c < *sc || (best_c == *sc && best_v < *sv) {
+                        *sc = best_c;
+                        *sv = best_v;
                         let b = &mut back[ti * n + tj];
                         *b = (*b & !(1 << t)) | (arg << t);
                     }
                 }
-                tp_cur[j] = tp;
-                tq_left = tq;
             }
-            if i + 1 == m {
+            if last_row {
                 break;
             }
-            std::mem::swap(&mut cur, &mut next);
-            for x in next.iter_mut() {
-                *x = [inf; 2];
-            }
-            std::mem::swap(&mut tp_prev, &mut tp_cur);
+            std::mem::swap(&mut cc, &mut nc);
+            std::mem::swap(&mut cv, &mut nv);
+            nc.iter_mut().for_each(|x| *x = [INF; 2]);
+            nv.iter_mut().for_each(|x| *x = [f64::INFINITY; 2]);
         }
-        // `cur` holds row m−1; pick the better end state.
-        let end = cur[n - 1];
-        let mut s = if end[1].better(&end[0]) { 1 } else { 0 };
+        // `cc`/`cv` hold row m−1; pick the better end state (ties: P).
+        let (ec, ev) = (cc[n - 1], cv[n - 1]);
+        let mut s = usize::from(ec[1] < ec[0] || (ec[1] == ec[0] && ev[1] < ev[0]));
         let mut steps = Vec::with_capacity(m + n - 2);
         let (mut i, mut j) = (m - 1, n - 1);
         while i > 0 || j > 0 {
@@ -670,10 +780,12 @@ impl Strip {
     }
 
     /// The strip moved by `delta` mm against the surface normal (toward the inside, for the
-    /// neutral surface of sheet metal): each boundary vertex slides within its curve's plane
-    /// (the Newell plane of a closed curve; freely for an open one) until it lies on its
-    /// tangent plane moved by `delta`. Tangent planes are area-weighted vertex normals of the
-    /// BBT `steps`; the two copies of a closed strip's seam vertex share theirs.
+    /// neutral surface of sheet metal). Closed curves stay in their (Newell) plane: each bank
+    /// edge moves within it to where the plane of its BBT triangle, moved by `delta`, cuts it,
+    /// and each vertex goes to where its two moved edges meet (a polygon offset with one
+    /// distance per edge, so straight sides stay straight and corners stay sharp); the two
+    /// copies of the seam vertex stay together. Open curves: each vertex moves along its
+    /// area-weighted vertex normal.
     pub fn offset(&self, steps: &[Step], delta: f64) -> Strip {
         if delta == 0.0 {
             return self.clone();
@@ -682,10 +794,17 @@ impl Strip {
         let ring = |i: usize, len: usize| if self.closed && i + 1 == len { 0 } else { i };
         let mut np = vec![DVec3::ZERO; m];
         let mut nq = vec![DVec3::ZERO; n];
+        // Normal of the triangle on each bank edge.
+        let mut edge_p = vec![DVec3::ZERO; m];
+        let mut edge_q = vec![DVec3::ZERO; n];
         let (mut i, mut j) = (0, 0);
         for s in steps {
             let (nn, a) = self.tri_step(i, j, *s);
             let w = nn * a;
+            match s {
+                Step::P => edge_p[i] = nn,
+                Step::Q => edge_q[j] = nn,
+            }
             match s {
                 Step::P => {
                     np[ring(i, m)] += w;
@@ -727,9 +846,14 @@ impl Strip {
                 })
                 .collect()
         };
+        let planar = |pts: &[DVec3], edges: &[DVec3], normals: &[DVec3], len: usize| {
+            plane(pts)
+                .and_then(|big| offset_ring(pts, edges, big, delta))
+                .unwrap_or_else(|| moved(pts, normals, len))
+        };
         Strip {
-            p: moved(&self.p, &np, m),
-            q: moved(&self.q, &nq, n),
+            p: planar(&self.p, &edge_p, &np, m),
+            q: planar(&self.q, &edge_q, &nq, n),
             closed: self.closed,
         }
     }
@@ -748,6 +872,52 @@ impl Strip {
         };
         reach(&self.p).min(reach(&self.q))
     }
+}
+
+/// A closed polyline (last point repeating the first) lying in the plane of normal `big`,
+/// offset in that plane: edge k moves by `delta / cos` toward `−u`, where `u` is its
+/// triangle's normal `edges[k]` projected into the plane; vertices go to where consecutive
+/// moved edges meet (onto the moved edge when the two are parallel). `None` when an edge has no
+/// usable triangle normal.
+fn offset_ring(pts: &[DVec3], edges: &[DVec3], big: DVec3, delta: f64) -> Option<Vec<DVec3>> {
+    use glam::DVec2;
+    let r = pts.len().checked_sub(1)?;
+    if r < 3 {
+        return None;
+    }
+    let (a, b) = big.any_orthonormal_pair();
+    let to2 = |x: DVec3| DVec2::new(x.dot(a), x.dot(b));
+    let mut lines = Vec::with_capacity(r);
+    for k in 0..r {
+        let nn = edges[k].normalize_or_zero();
+        let u = (nn - big * nn.dot(big)).normalize_or_zero();
+        let c = u.dot(nn);
+        if c < 0.05 {
+            return None;
+        }
+        let x = to2(pts[k] - u * (delta / c));
+        let e = to2(pts[k + 1] - pts[k]);
+        if e.length_squared() <= 0.0 {
+            return None;
+        }
+        lines.push((x, e));
+    }
+    let mut out = Vec::with_capacity(pts.len());
+    for k in 0..r {
+        let (x1, e1) = lines[(k + r - 1) % r];
+        let (x2, e2) = lines[k];
+        let det = e1.perp_dot(e2);
+        let v = to2(pts[k]);
+        let p = if det.abs() > 1e-6 * e1.length() * e2.length() {
+            x1 + e1 * ((x2 - x1).perp_dot(e2) / det)
+        } else {
+            x2 + e2 * ((v - x2).dot(e2) / e2.length_squared())
+        };
+        let dv = p - v;
+        out.push(pts[k] + a * dv.x + b * dv.y);
+    }
+    out.push(out[0]);
+    Some(out)
 }
 
 /// Whether two closed loops are the same points up to rotation of the start (either way).
@@ -782,13 +952,15 @@ fn bend_energy(t1: (DVec3, f64), t2: (DVec3, f64), l2: f64) -> f64 {
     (t1.1 + t2.1) * s / l2
 }
 
-/// Path cost: invalid bridges, then energy or area.
+/// Path cost: invalid bridges, then energy or area (the reference Dijkstra of the tests).
+#[cfg(test)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cost {
     count: u32,
     value: f64,
 }
 
+#[cfg(test)]
 impl Cost {
     fn better(&self, o: &Cost) -> bool {
         self.count < o.count || (self.count == o.count && self.value < o.value)
