@@ -71,6 +71,8 @@ pub fn plan_job(
     let tp = ToolpathOptions {
         skip_folds: profile.tool(StrokeKind::Score).is_none(),
         skip_drawing: profile.tool(StrokeKind::Draw).is_none(),
+        per_piece: spec.material.kind == MaterialKind::Fabric,
+        weed: None,
     };
     let job = crate::toolpath::plan(&layout, &spec.name, &tp);
 

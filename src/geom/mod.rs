@@ -2,7 +2,7 @@
 //! their tests ([`polygon`]), and a single-stroke font for labels a pen or knife can draw
 //! ([`font`]). Millimetres and `f64` throughout (glam `DVec2`/`DVec3`).
 
+pub mod boolean;
 pub mod font;
 pub mod mesh;
-pub mod boolean;
 pub mod polygon;
