@@ -282,12 +282,56 @@ impl Profile {
         self.tools.get(kind.name())
     }
 
+    /// Whether the profile has a tool for `kind`.
+    pub fn has(&self, kind: StrokeKind) -> bool {
+        self.tool(kind).is_some()
+    }
+
+    /// What the toolpath stage's machine preparation needs from this profile
+    /// ([`crate::toolpath::knife`]); `margin` is the sheet margin (mm), where the alignment
+    /// precut goes.
+    pub fn machine_options(&self, margin: f64) -> crate::toolpath::knife::MachineOptions {
+        let fold_kind = crate::toolpath::fold_kind(|k| self.has(k));
+        let kinds = [
+            StrokeKind::Cut,
+            StrokeKind::Score,
+            StrokeKind::Perforate,
+            StrokeKind::Draw,
+            StrokeKind::Etch,
+        ];
+        let m = if margin.is_finite() {
+            margin.max(0.0)
+        } else {
+            0.0
+        };
+        crate::toolpath::knife::MachineOptions {
+            fold_kind,
+            perforation: self
+                .tool(StrokeKind::Perforate)
+                .map(|t| t.perforation())
+                .unwrap_or(DEFAULT_PERFORATION),
+            knife_offset: self.knife_offset,
+            swivel_threshold_deg: self.swivel_threshold_deg,
+            knife_kinds: kinds
+                .into_iter()
+                .filter(|k| self.is_drag_knife(*k))
+                .collect(),
+            multi_pass_kinds: kinds
+                .into_iter()
+                .filter(|k| self.tool(*k).is_some_and(|t| t.passes() > 1))
+                .collect(),
+            overcut: self.overcut,
+            // Half way into the margin, far enough right that the trailing tip stays on it.
+            precut_at: glam::DVec2::new(0.5 * m + self.knife_offset, 0.5 * m),
+        }
+    }
+
     /// Whether strokes of `kind` are made by a drag knife whose offset is to be compensated:
     /// the profile has a `knife_offset`, and the kind is cut, score or perforate with a tool
     /// that is not a pen or a laser (G-code: a Z knife; HP-GL: any such tool, the holder
     /// being the knife's).
     pub fn is_drag_knife(&self, kind: StrokeKind) -> bool {
-        if !(self.knife_offset > 0.0) {
+        if self.knife_offset.is_nan() || self.knife_offset <= 0.0 {
             return false;
         }
         if !matches!(

@@ -285,7 +285,9 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
         }
     }
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let kind = stroke.role.kind();
+        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
+            continue;
+        };
         let Some(tool) = profile.tool(kind) else {
             continue;
         };
@@ -519,7 +521,9 @@ mod tests {
             // Every tool-down path is a stroke of the job, in order, within 0.0005 mm.
             let mut expect = Vec::new();
             for s in &job.strokes {
-                let Some(tool) = p.tool(s.role.kind()) else {
+                let Some(tool) =
+                    crate::toolpath::tool_kind(s.role, |k| p.has(k)).and_then(|k| p.tool(k))
+                else {
                     continue;
                 };
                 let closed = s.points.first() == s.points.last();

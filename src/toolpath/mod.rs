@@ -14,6 +14,7 @@ use glam::DVec2;
 use serde::Serialize;
 
 mod collect;
+pub mod knife;
 pub mod order;
 pub mod weed;
 
@@ -78,6 +79,24 @@ impl StrokeRole {
             StrokeRole::Grain => "grain",
             StrokeRole::Weed => "weed",
         }
+    }
+}
+
+/// The tool that makes folds on a device whose tool table has the kinds `has` accepts: the
+/// scoring tool, else the perforating one (folds cut as dashes, see [`knife`]), else the pen;
+/// `None`: the device cannot make folds and they are left out.
+pub fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+    [StrokeKind::Score, StrokeKind::Perforate, StrokeKind::Draw]
+        .into_iter()
+        .find(|k| has(*k))
+}
+
+/// The tool kind that makes a stroke of `role` on a device with the kinds `has` accepts
+/// (folds: [`fold_kind`]; the rest: [`StrokeRole::kind`] if the device has it).
+pub fn tool_kind(role: StrokeRole, has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+    match role.kind() {
+        StrokeKind::Score => fold_kind(has),
+        k => has(k).then_some(k),
     }
 }
 
