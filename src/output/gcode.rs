@@ -407,11 +407,13 @@ mod tests {
 
     #[test]
     fn servo_pen_exact() {
+        // No scoring or perforating tool: the fold is drawn with the pen (`fold_kind`).
         let t = text(&small_job(), &profile(PEN));
         assert_eq!(
             t,
             "G21\nG90\nG94\n\
              M3 S30\nG4 P0.3\nG0 X1 Y1\nM3 S90\nG4 P0.3\nG1 X2 Y1 F2000\nM3 S30\nG4 P0.3\n\
+             G0 X1 Y2\nM3 S90\nG4 P0.3\nG1 X2 Y2\nG1 X2 Y3\nG1 X1 Y2\nM3 S30\nG4 P0.3\n\
              G0 X10 Y10\nM3 S90\nG4 P0.15\nG1 X20 Y10 F3000\nG1 X20 Y20.5\n\
              M3 S30\nG4 P0.15\n\
              M5\nM2\n"
