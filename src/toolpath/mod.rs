@@ -1,14 +1,23 @@
 //! Toolpath stage: turns a nested [`Layout`](crate::nest::Layout) into a [`Job`], the ordered
 //! strokes per sheet, in millimetres, that an output language then encodes.
 //!
-//! Order (issue 2, DESIGN.md "toolpath/"): on each sheet, drawn marks and labels first, then
-//! folds (scored), then cuts, inner contours (holes) before the outline that surrounds them, so
-//! that the material is still held while it is worked on. Inside each group the strokes are
-//! chained by nearest neighbour from the current pen position: an open stroke may be reversed,
-//! a closed contour may start at whichever of its vertices is nearest.
+//! Order (issue 8, DESIGN.md "toolpath/"): drawn marks, labels, sewing and grain lines first,
+//! then folds and notches, then cuts, inner contours (holes) before the outline that surrounds
+//! them, so that the material is still held while it is worked on; weed lines last. With
+//! [`ToolpathOptions::per_piece`] (fabric, or any material that may shift once a piece is cut
+//! free) each piece gets all of that before the next piece starts, pieces taken nearest first;
+//! otherwise the groups span the whole sheet. Inside each group travel is made short by
+//! [`order`] (nearest neighbour, then 2-opt; the collection order is kept if it is shorter).
 //!
-//! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); ties in the
-//! nearest-neighbour search go to the stroke that came first, so the order is deterministic.
+//! The ordered job is the design (what the SVG and PNG show). What a machine's tools need on top
+//! of it — folds as perforation dashes, overcut, drag-knife offset compensation with an
+//! alignment precut — is [`knife::prepare`], applied to the job that is encoded. Which tool makes
+//! a fold is [`fold_kind`]: the scoring tool, else the perforating one, else the pen.
+//! [`weed`] adds weed lines for vinyl.
+//!
+//! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); notches
+//! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
+//! after every piece; everything is deterministic (counts, never clocks, bound the search).
 
 use glam::DVec2;
 use serde::Serialize;
