@@ -26,6 +26,12 @@
 //! [pattern]                # optional table
 //! fold_threshold = 1.0     # degrees, >= 0 and < 180; default 1: joined edges bending more
 //!                          # than this become fold lines
+//! tabs = "one-side"        # glue tabs: "none" | "one-side" | "both"; default: paper one-side
+//! tab_height = 5           # mm > 0; default 5
+//! allowance = 10           # seam allowance, mm >= 0; default: fabric 10, else 0
+//! notches = 50             # notch spacing along seams, mm >= 0 (0: none); default: fabric 50
+//! kerf = 0.2               # cut width, mm >= 0; default 0 (or the device's cut tool `kerf`)
+//! bend_notches = false     # V notches where bend lines meet the outline; default false
 //! ```
 //!
 //! [`load`] reads a spec file; a `.obj` file (any letter case) given instead stands for a
@@ -156,6 +162,14 @@ pub struct SheetSpec {
 pub struct PatternSpec {
     /// Joined edges whose faces bend by more than this many degrees become fold lines.
     pub fold_threshold_deg: f64,
+    /// The rest: `None` leaves the material's default (see `PatternOptions::for_material`).
+    pub tabs: Option<crate::pattern::Tabs>,
+    pub tab_height: Option<f64>,
+    pub allowance: Option<f64>,
+    /// Notch spacing in mm; `Some(0)` for none.
+    pub notches: Option<f64>,
+    pub kerf: Option<f64>,
+    pub bend_notches: Option<bool>,
 }
 
 /// Everything that can be wrong with a spec. Each message is one line starting with the file.
@@ -337,6 +351,12 @@ impl Default for PatternSpec {
     fn default() -> Self {
         PatternSpec {
             fold_threshold_deg: 1.0,
+            tabs: None,
+            tab_height: None,
+            allowance: None,
+            notches: None,
+            kerf: None,
+            bend_notches: None,
         }
     }
 }
@@ -448,6 +468,12 @@ struct RawSheet {
 #[serde(deny_unknown_fields)]
 struct RawPattern {
     fold_threshold: Option<Spanned<Val>>,
+    tabs: Option<Spanned<Val>>,
+    tab_height: Option<Spanned<Val>>,
+    allowance: Option<Spanned<Val>>,
+    notches: Option<Spanned<Val>>,
+    kerf: Option<Spanned<Val>>,
+    bend_notches: Option<Spanned<Val>>,
 }
 
 /// Any TOML value, reduced to what the checks need. Integers and floats both become `Num`.
@@ -968,7 +994,48 @@ impl Ctx<'_> {
                 |v| (0.0..180.0).contains(&v),
             )?
             .map_or(PatternSpec::default().fold_threshold_deg, |(v, _)| v);
-        Ok(PatternSpec { fold_threshold_deg })
+        let tabs = self.choice(
+            &p.tabs,
+            "pattern.tabs",
+            &[
+                ("none", crate::pattern::Tabs::None),
+                ("one-side", crate::pattern::Tabs::OneSide),
+                ("both", crate::pattern::Tabs::Both),
+            ],
+        )?;
+        let mm = |v: &Opt, key: &str, expected: &str, positive: bool| {
+            self.number(
+                v,
+                key,
+                expected,
+                |x| if positive { x > 0.0 } else { x >= 0.0 },
+            )
+            .map(|o| o.map(|(v, _)| v))
+        };
+        Ok(PatternSpec {
+            fold_threshold_deg,
+            tabs,
+            tab_height: mm(
+                &p.tab_height,
+                "pattern.tab_height",
+                "a length in mm, more than 0",
+                true,
+            )?,
+            allowance: mm(
+                &p.allowance,
+                "pattern.allowance",
+                "a length in mm, at least 0",
+                false,
+            )?,
+            notches: mm(
+                &p.notches,
+                "pattern.notches",
+                "a spacing in mm, at least 0 (0: no notches)",
+                false,
+            )?,
+            kerf: mm(&p.kerf, "pattern.kerf", "a width in mm, at least 0", false)?,
+            bend_notches: self.boolean(&p.bend_notches, "pattern.bend_notches")?,
+        })
     }
 }
 
@@ -1089,9 +1156,7 @@ fold_threshold = 1.0
                     margin: 5.0,
                     spacing: 3.0
                 },
-                pattern: PatternSpec {
-                    fold_threshold_deg: 1.0
-                },
+                pattern: PatternSpec::default(),
             }
         );
         assert!(!spec.sheet.is_roll());

@@ -77,6 +77,8 @@ fn cube_hpgl_cuts_and_folds_every_edge_once() {
         "--device",
         "hpgl-pens",
         "--dry-run",
+        "--tabs",
+        "none",
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -95,7 +97,14 @@ fn cube_hpgl_cuts_and_folds_every_edge_once() {
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["totals"]["pieces"], 1);
     assert_eq!(report["pieces"][0]["folds"]["mountain"], 5);
-    assert_eq!(report["pieces"][0]["edge_ids"], 14);
+    // Each seam's id on both of its sides; the seams cover the 1400 mm border once per side.
+    let seams = report["seams"].as_array().unwrap();
+    assert_eq!(report["pieces"][0]["edge_ids"], 2 * seams.len());
+    let both: f64 = seams
+        .iter()
+        .map(|s| s["length_a_mm"].as_f64().unwrap() + s["length_b_mm"].as_f64().unwrap())
+        .sum();
+    assert!((both - 1400.0).abs() < 1e-6, "{both}");
     let folds = report["pieces"][0]["fold_lines"].as_array().unwrap();
     assert_eq!(folds.len(), 5);
     for f in folds {
@@ -284,7 +293,7 @@ fn bad_input_is_exit_1_with_one_line() {
     )
     .unwrap();
     expect_user_error(
-        &["cut", &p("big.toml"), "-o", &out],
+        &["cut", &p("big.toml"), "--tabs", "none", "-o", &out],
         &["big.toml", "400.0 × 300.0 mm", "200.0 × 287.0 mm"],
     );
 

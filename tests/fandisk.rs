@@ -7,19 +7,7 @@ use common::*;
 use flatcut::geom::polygon;
 use glam::DVec2;
 
-const SPEC: &str = r#"
-name = "fandisk"
-[[surface]]
-kind = "mesh"
-path = "fandisk.obj"
-scale = 100
-units = "mm"
-[sheet]
-width = 297
-height = 420
-margin = 5
-spacing = 3
-"#;
+const SPEC: &str = FANDISK_SPEC;
 
 #[test]
 fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {

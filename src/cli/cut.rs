@@ -46,6 +46,8 @@ pub struct CutArgs {
     #[arg(long)]
     pub knife_offset: Option<f64>,
     #[command(flatten)]
+    pub pattern: super::PatternArgs,
+    #[command(flatten)]
     pub link: super::link::LinkArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
@@ -174,6 +176,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     if let Some(m) = a.material {
         spec.material.kind = m;
     }
+    a.pattern.apply(&mut spec)?;
     let device = a
         .device
         .clone()

@@ -15,6 +15,11 @@ pub struct FlattenArgs {
     /// Directory for the pictures and report (default: out/<name>).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Material: paper, fabric or metal (overrides the spec).
+    #[arg(long)]
+    pub material: Option<crate::spec::MaterialKind>,
+    #[command(flatten)]
+    pub pattern: super::PatternArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -37,7 +42,11 @@ pub fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, 
 }
 
 pub fn run(a: &FlattenArgs) -> Result<(), Error> {
-    let spec = crate::spec::load(&a.input)?;
+    let mut spec = crate::spec::load(&a.input)?;
+    if let Some(m) = a.material {
+        spec.material.kind = m;
+    }
+    a.pattern.apply(&mut spec)?;
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
     // One strip wide enough for the widest piece: the pieces, not the sheets, are the result.
     let widest = pieces

@@ -75,6 +75,51 @@ pub fn run(cli: Cli) -> Result<(), Error> {
     }
 }
 
+/// Pattern settings on the command line; they override the spec's `[pattern]` table.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct PatternArgs {
+    /// Glue tabs: none, one-side or both (default: one-side for paper, else none).
+    #[arg(long, value_enum)]
+    pub tabs: Option<crate::pattern::Tabs>,
+    /// Notches along every seam, every MM millimetres (default 50 with the flag; fabric has
+    /// them at 50 mm anyway; 0 turns them off).
+    #[arg(long, value_name = "MM", num_args = 0..=1, default_missing_value = "50")]
+    pub notches: Option<f64>,
+    /// Seam allowance in mm (default: 10 for fabric, else 0).
+    #[arg(long, value_name = "MM")]
+    pub allowance: Option<f64>,
+    /// Width of the cut in mm: cut contours move half of it away from the piece.
+    #[arg(long, value_name = "MM")]
+    pub kerf: Option<f64>,
+    /// V notches in the outline where bend lines meet it (sheet metal).
+    #[arg(long)]
+    pub bend_notches: bool,
+}
+
+impl PatternArgs {
+    /// Puts the flags into the spec (flags win), refusing values that make no sense.
+    pub fn apply(&self, spec: &mut Spec) -> Result<(), Error> {
+        let check = |v: Option<f64>, flag: &str| match v {
+            Some(x) if !(x.is_finite() && x >= 0.0) => Err(Error::Usage(format!(
+                "--{flag} {x}: must be a length in mm, at least 0"
+            ))),
+            _ => Ok(()),
+        };
+        check(self.notches, "notches")?;
+        check(self.allowance, "allowance")?;
+        check(self.kerf, "kerf")?;
+        let p = &mut spec.pattern;
+        p.tabs = self.tabs.or(p.tabs);
+        p.notches = self.notches.or(p.notches);
+        p.allowance = self.allowance.or(p.allowance);
+        p.kerf = self.kerf.or(p.kerf);
+        if self.bend_notches {
+            p.bend_notches = Some(true);
+        }
+        Ok(())
+    }
+}
+
 /// Surfaces → flats → pieces for a spec; prints import warnings to stderr.
 pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
     let mut flats = Vec::new();
@@ -97,10 +142,7 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
         }
         flats.push(crate::flatten::unfold(surface, &UnfoldOptions::default())?);
     }
-    let opts = PatternOptions {
-        fold_threshold_deg: spec.pattern.fold_threshold_deg,
-        ..PatternOptions::default()
-    };
+    let opts = PatternOptions::from_spec(spec);
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
 }

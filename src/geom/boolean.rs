@@ -85,7 +85,7 @@ pub fn offset(shape: &[Vec<DVec2>], d: f64) -> Vec<Shape> {
 
 /// The region within `d` mm of an open polyline (a band of width `2 d`, flat ends).
 pub fn band(path: &[DVec2], d: f64) -> Vec<Shape> {
-    if path.len() < 2 || !(d > 0.0) {
+    if path.len() < 2 || d.is_nan() || d <= 0.0 {
         return Vec::new();
     }
     let raw: Vec<[f64; 2]> = path.iter().map(|p| [p.x, p.y]).collect();

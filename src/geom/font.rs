@@ -7,7 +7,7 @@
 //!
 //! * cap height 6 units: baseline at y = 0, top of capitals and digits at y = 6;
 //! * glyph bodies are about 4 units wide (x = 0..=4) and the usual advance is 5 units, which
-//!   leaves one unit of spacing; `.`, `,`, `:`, `'` and `(`, `)` are narrower, space is 4;
+//!   leaves one unit of spacing; `.`, `,`, `:`, `'`, `°` and `(`, `)` are narrower, space is 4;
 //! * curves are approximated by straight segments with one-unit chamfered corners, which stay
 //!   legible at 3 mm cap height with a 0.3 mm pen and are easy for a knife to follow;
 //! * only `,` and `_` reach below the baseline (down to y = -1).
@@ -100,6 +100,7 @@ fn lookup(c: char) -> Option<Glyph> {
         '_' => g(5, &[&[(0, -1), (4, -1)]]),
         '\'' => g(2, &[&[(1, 6), (0, 4)]]),
         '=' => g(5, &[&[(0, 2), (4, 2)], &[(0, 4), (4, 4)]]),
+        '°' => g(3, &[&[(0, 5), (1, 6), (2, 5), (1, 4), (0, 5)]]),
         _ => return None,
     };
     Some(glyph)

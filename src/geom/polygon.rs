@@ -279,7 +279,7 @@ pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
     let (lo, hi) = bounds(rings.first()?.iter().copied())?;
     let size = hi - lo;
     let cell = size.min_element();
-    if !(cell > 0.0) || !cell.is_finite() {
+    if cell.is_nan() || cell <= 0.0 || !cell.is_finite() {
         return None;
     }
     struct Cell {

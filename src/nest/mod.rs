@@ -239,24 +239,16 @@ mod tests {
     use super::*;
 
     fn square(id: usize, s: f64) -> Piece {
-        Piece {
+        Piece::from_outline(
             id,
-            name: format!("{id}"),
-            surface: "t".into(),
-            faces: vec![],
-            outline: vec![vec![
+            format!("{id}"),
+            vec![
                 DVec2::new(0.0, 0.0),
                 DVec2::new(s, 0.0),
                 DVec2::new(s, s),
                 DVec2::new(0.0, s),
-            ]],
-            outline_edges: vec![vec![0, 1, 2, 3]],
-            folds: vec![],
-            marks: vec![],
-            label: vec![],
-            area: s * s,
-            grain: None,
-        }
+            ],
+        )
     }
 
     fn bbox(l: &Layout, k: usize) -> (DVec2, DVec2) {

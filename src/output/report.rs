@@ -1,6 +1,8 @@
 //! `report.json`: what a run made, for people and for scripts. Pieces (id, name, surface and
 //! its source file, area, cut and fold lengths, every fold line with its kind and bend angle,
-//! sheet and placement), sheets (size, pieces, utilisation),
+//! sheet and placement), seams (`{id, piece_a, piece_b, length_a_mm, length_b_mm, notches}`:
+//! notch positions in mm from side A's start, and `notches_b_mm` from side B's start, which is
+//! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation),
 //! surfaces (source, faces, pieces, repairs made on import) and the files written.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
@@ -42,7 +44,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         .map(|(p, at)| {
             let pts: Vec<_> = p.outline.iter().flatten().map(|q| at.apply(*q)).collect();
             let (lo, hi) = crate::geom::polygon::bounds(pts).unwrap_or_default();
-            let count = |k| p.folds.iter().filter(|f| f.kind == k).count();
+            let count = |k| p.folds.iter().filter(|f| f.kind == k && !f.tab).count();
             json!({
                 "id": p.id,
                 "name": p.name,
@@ -53,13 +55,16 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "cut_length_mm": r6(p.cut_length()),
                 "fold_length_mm": r6(p.fold_length()),
                 "folds": { "mountain": count(FoldKind::Mountain), "valley": count(FoldKind::Valley) },
-                "fold_lines": p.folds.iter().map(|f| json!({
+                "fold_lines": p.folds.iter().filter(|f| !f.tab).map(|f| json!({
                     "kind": f.kind,
                     "angle_deg": r6(f.angle_deg),
                     "length_mm": r6(f.a.distance(f.b)),
                 })).collect::<Vec<_>>(),
+                "tabs": p.seams.iter().filter(|s| s.tab).count(),
+                "border_length_mm": r6(p.border.iter().map(|r| crate::geom::polygon::perimeter(r)).sum()),
                 "contours": p.outline.len(),
                 "edge_ids": p.marks.len(),
+                "notches": p.notches.len(),
                 "sheet": at.sheet + 1,
                 "rotation_deg": r6(at.rotation.to_degrees()),
                 "offset_mm": [r6(at.offset.x), r6(at.offset.y)],
@@ -93,6 +98,36 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             })
         })
         .collect();
+    // Seams: side A and side B of every seam id.
+    let mut seams: Vec<Value> = Vec::new();
+    let sides = || {
+        layout
+            .pieces
+            .iter()
+            .flat_map(|p| p.seams.iter().map(move |s| (p, s)))
+    };
+    for (pa, a) in sides().filter(|(_, s)| s.is_a) {
+        let Some((pb, b)) = sides().find(|(_, s)| s.id == a.id && !s.is_a) else {
+            continue;
+        };
+        seams.push(json!({
+            "id": a.id,
+            "piece_a": pa.id,
+            "piece_b": pb.id,
+            "length_a_mm": r6(a.length),
+            "length_b_mm": r6(b.length),
+            "edges": a.count,
+            "notches": a.notches.iter().map(|&v| r6(v)).collect::<Vec<_>>(),
+            "notches_b_mm": b.notches.iter().map(|&v| r6(v)).collect::<Vec<_>>(),
+            "tab": match (a.tab, b.tab) {
+                (true, true) => "both",
+                (true, false) => "a",
+                (false, true) => "b",
+                (false, false) => "none",
+            },
+        }));
+    }
+    seams.sort_by_key(|s| s["id"].as_u64());
     let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
     json!({
         "name": info.name,
@@ -104,6 +139,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         "spacing_mm": layout.spacing,
         "surfaces": surfaces,
         "pieces": pieces,
+        "seams": seams,
         "sheets": sheets,
         "totals": {
             "pieces": layout.pieces.len(),

@@ -1,42 +1,157 @@
 //! Pattern stage: turns each island of a [`Flat`] into a [`Piece`] a person can cut and
-//! assemble: the cut outline (outer contour and any holes), fold lines where joined faces meet
-//! at a bend above the threshold (mountain or valley, with the angle), the same edge id written
-//! beside both copies of every cut edge, and a label naming the piece.
+//! assemble: the cut outline, fold lines where joined faces meet at a bend above the threshold
+//! (mountain or valley, with the angle), seams with the same id written on both sides and
+//! notches at equal arc lengths ([`marks`]), a label naming the piece and the side that faces
+//! up, a grain line for fabric, bend notes for metal, and the material's finishing: glue tabs
+//! for paper, seam allowance for fabric, kerf compensation ([`allowance`]).
 //!
 //! Conventions: pieces are drawn as seen from the printed side, which is the outside of a
 //! closed mesh; a convex edge therefore folds away from the viewer and is a mountain fold, a
 //! concave edge a valley fold. Text is set in the single-stroke font of [`crate::geom::font`]
-//! so a pen can draw it or a knife score it.
+//! so a pen can draw it or a knife score it. A piece keeps two boundaries: its `border`, the
+//! edges of the surface itself (where seams are matched, where the sewing line runs), and its
+//! `outline`, what is cut (the border with tabs, allowance or kerf added).
 //!
-//! Choices where the issue is silent: edge ids are numbered 1, 2, … over the whole job in the
-//! order of the surfaces and of their mesh edges; an edge id is set along its edge, inside the
-//! face, reading left to right (never upside down), at a height of at most 3 mm, 30 % of the
-//! edge length and 35 % of the face's depth behind the edge; the piece label goes in the
-//! incircle of the piece's largest triangle, at most 8 mm high.
+//! Choices where the issue is silent: materials choose the defaults
+//! ([`PatternOptions::for_material`]): paper gets glue tabs on one side of each seam, fabric a
+//! 10 mm seam allowance, notches every 50 mm and a grain line, metal its bend notes; the plain
+//! [`Default`] adds nothing, for callers that only want the net.
 
 use crate::flatten::Flat;
-use crate::geom::{font, polygon};
+use crate::geom::polygon;
+use crate::spec::MaterialKind;
 use glam::DVec2;
 use serde::Serialize;
+
+pub mod allowance;
+pub mod marks;
+
+pub use marks::{SeamSide, Text};
+
+/// Where glue tabs go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Tabs {
+    /// No tabs.
+    #[default]
+    None,
+    /// On one side of each seam: the side where the tab comes out larger.
+    OneSide,
+    /// On both sides of each seam.
+    Both,
+}
+
+impl Tabs {
+    pub fn name(self) -> &'static str {
+        match self {
+            Tabs::None => "none",
+            Tabs::OneSide => "one-side",
+            Tabs::Both => "both",
+        }
+    }
+}
 
 /// Options of the pattern stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatternOptions {
     /// Joined edges bending by more than this (degrees) become fold lines.
     pub fold_threshold_deg: f64,
-    /// Largest height of edge ids (mm).
+    /// Largest height of seam ids and bend notes (mm).
     pub max_mark_height: f64,
     /// Largest height of piece labels (mm).
     pub max_label_height: f64,
+    /// The material: decides the label's "side up" wording and how notches are made (slits
+    /// cut into fabric, ticks drawn on paper and metal).
+    pub material: MaterialKind,
+    /// Glue tabs.
+    pub tabs: Tabs,
+    /// Height of a glue tab (mm); smaller where the seam is short or there is no room.
+    pub tab_height: f64,
+    /// Seam allowance added around the border (mm); 0 for none.
+    pub allowance: f64,
+    /// Notches along every seam every this many mm; `None` for none.
+    pub notches: Option<f64>,
+    /// Width of the cut (mm): every cut contour moves half of it away from the piece.
+    pub kerf: f64,
+    /// Write each bend line's angle and direction beside it.
+    pub bend_notes: bool,
+    /// Small V notches in the outline where bend lines meet it.
+    pub bend_notches: bool,
+    /// Draw a grain-line arrow (and keep the grain along the roll when nesting).
+    pub grain: bool,
 }
 
 impl Default for PatternOptions {
+    /// The bare net: folds, seam ids and labels, nothing added to the outline.
     fn default() -> Self {
         PatternOptions {
             fold_threshold_deg: 1.0,
             max_mark_height: 3.0,
             max_label_height: 8.0,
+            material: MaterialKind::Paper,
+            tabs: Tabs::None,
+            tab_height: 5.0,
+            allowance: 0.0,
+            notches: None,
+            kerf: 0.0,
+            bend_notes: false,
+            bend_notches: false,
+            grain: false,
         }
+    }
+}
+
+impl PatternOptions {
+    /// Defaults of a material: paper gets glue tabs on one side of each seam; fabric a 10 mm
+    /// seam allowance, notches every 50 mm and a grain line; metal its bend notes.
+    pub fn for_material(kind: MaterialKind) -> Self {
+        let bare = PatternOptions {
+            material: kind,
+            ..PatternOptions::default()
+        };
+        match kind {
+            MaterialKind::Paper => PatternOptions {
+                tabs: Tabs::OneSide,
+                ..bare
+            },
+            MaterialKind::Fabric => PatternOptions {
+                allowance: 10.0,
+                notches: Some(50.0),
+                grain: true,
+                ..bare
+            },
+            MaterialKind::Metal => PatternOptions {
+                bend_notes: true,
+                ..bare
+            },
+        }
+    }
+}
+
+impl PatternOptions {
+    /// The material's defaults with the spec's `[pattern]` settings on top.
+    pub fn from_spec(spec: &crate::spec::Spec) -> Self {
+        let p = &spec.pattern;
+        let mut o = PatternOptions::for_material(spec.material.kind);
+        o.fold_threshold_deg = p.fold_threshold_deg;
+        if let Some(t) = p.tabs {
+            o.tabs = t;
+        }
+        if let Some(h) = p.tab_height {
+            o.tab_height = h;
+        }
+        if let Some(a) = p.allowance {
+            o.allowance = a;
+        }
+        if let Some(n) = p.notches {
+            o.notches = (n > 0.0).then_some(n);
+        }
+        if let Some(k) = p.kerf {
+            o.kerf = k;
+        }
+        if let Some(b) = p.bend_notches {
+            o.bend_notches = b;
+        }
+        o
     }
 }
 
@@ -58,20 +173,33 @@ pub struct Fold {
     pub angle_deg: f64,
     /// Mesh edge it comes from.
     pub edge: usize,
+    /// The fold of a glue tab (along a seam), not of the surface.
+    pub tab: bool,
 }
 
-/// The id of a cut edge written beside one of its two copies.
+/// The id of a seam written beside one of its two sides.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeMark {
-    /// The number written (the same on both copies).
+    /// The seam id (the same on both sides).
     pub id: usize,
-    /// Mesh edge.
+    /// Mesh edge of the border segment it is written along.
     pub edge: usize,
-    /// This copy of the edge on the piece.
+    /// That segment on the piece.
     pub a: DVec2,
     pub b: DVec2,
-    /// Pen strokes of the number.
-    pub strokes: Vec<Vec<DVec2>>,
+    pub text: Text,
+}
+
+/// A notch: where two seam sides must meet when joined.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Notch {
+    /// Seam id.
+    pub seam: usize,
+    /// The point on the border.
+    pub at: DVec2,
+    /// The stroke: a slit cut into the piece or its allowance (`cut`), else a drawn tick.
+    pub stroke: Vec<DVec2>,
+    pub cut: bool,
 }
 
 /// One flat piece, in its own frame (mm).
@@ -86,15 +214,29 @@ pub struct Piece {
     /// Mesh faces it is made of.
     pub faces: Vec<usize>,
     /// Closed cut contours without the repeated first point: the outer contour first
-    /// (counter-clockwise), then holes (clockwise).
+    /// (counter-clockwise), then holes (clockwise). The border plus tabs, allowance and kerf.
     pub outline: Vec<Vec<DVec2>>,
-    /// Mesh edge of each outline segment (segment `k` runs from point `k` to `k + 1`).
-    pub outline_edges: Vec<Vec<usize>>,
+    /// The piece's edges on the surface, as `outline` (outer first, counter-clockwise).
+    pub border: Vec<Vec<DVec2>>,
+    /// Mesh edge of each border segment (segment `k` runs from point `k` to `k + 1`).
+    pub border_edges: Vec<Vec<usize>>,
+    /// Mesh face each border segment belongs to.
+    pub border_faces: Vec<Vec<usize>>,
     pub folds: Vec<Fold>,
+    /// Seam ids.
     pub marks: Vec<EdgeMark>,
-    /// Pen strokes of the label.
-    pub label: Vec<Vec<DVec2>>,
-    /// Area in mm² (equal in 3D and flat: the unfolding is isometric).
+    /// The piece's side of every seam it has.
+    pub seams: Vec<SeamSide>,
+    pub notches: Vec<Notch>,
+    /// Bend notes (metal): angle and direction beside each bend line.
+    pub notes: Vec<Text>,
+    /// The sewing line, drawn, when the outline carries a seam allowance.
+    pub seam_line: Vec<Vec<DVec2>>,
+    /// The grain-line arrow (fabric).
+    pub grain_line: Vec<Vec<DVec2>>,
+    /// Name, id and which side faces up.
+    pub label: Text,
+    /// Area in mm² of the surface it covers (equal in 3D and flat: the unfolding is isometric).
     pub area: f64,
     /// Direction of the grain line in the piece's frame (radians from +x), for materials with
     /// a grain (fabric). The nest stage keeps it parallel to the roll (sheet y axis), either way.
@@ -102,27 +244,53 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// A piece that is only a cut outline (counter-clockwise ring): no folds, seams or text.
+    /// For tests and for nesting shapes that come from elsewhere (ESICUP instances).
+    pub fn from_outline(id: usize, name: String, ring: Vec<DVec2>) -> Piece {
+        let n = ring.len();
+        Piece {
+            id,
+            name,
+            surface: String::new(),
+            faces: Vec::new(),
+            area: polygon::signed_area(&ring).abs(),
+            outline: vec![ring.clone()],
+            border: vec![ring],
+            border_edges: vec![(0..n).collect()],
+            border_faces: vec![vec![0; n]],
+            folds: Vec::new(),
+            marks: Vec::new(),
+            seams: Vec::new(),
+            notches: Vec::new(),
+            notes: Vec::new(),
+            seam_line: Vec::new(),
+            grain_line: Vec::new(),
+            label: Text::default(),
+            grain: None,
+        }
+    }
+
     /// Total length of the cut contours (mm).
     pub fn cut_length(&self) -> f64 {
         self.outline.iter().map(|l| polygon::perimeter(l)).sum()
     }
-    /// Total length of the fold lines (mm).
+    /// Total length of the fold lines, tab folds included (mm).
     pub fn fold_length(&self) -> f64 {
         self.folds.iter().map(|f| f.a.distance(f.b)).sum()
     }
-    /// Every point of the piece's geometry (outline, folds, marks, label).
+    /// Every point of the piece's geometry (outline, folds, marks, label, ...).
     pub fn points(&self) -> impl Iterator<Item = DVec2> + '_ {
         self.outline
             .iter()
             .flatten()
             .copied()
             .chain(self.folds.iter().flat_map(|f| [f.a, f.b]))
-            .chain(
-                self.marks
-                    .iter()
-                    .flat_map(|m| m.strokes.iter().flatten().copied()),
-            )
-            .chain(self.label.iter().flatten().copied())
+            .chain(self.marks.iter().flat_map(|m| m.text.points()))
+            .chain(self.notes.iter().flat_map(|t| t.points()))
+            .chain(self.notches.iter().flat_map(|n| n.stroke.iter().copied()))
+            .chain(self.seam_line.iter().flatten().copied())
+            .chain(self.grain_line.iter().flatten().copied())
+            .chain(self.label.points())
     }
 }
 
@@ -133,13 +301,13 @@ pub enum PatternError {
     Outline { surface: String, piece: String },
 }
 
-/// Build the pieces of every flattened surface, numbering pieces and edge ids across the job.
+/// Build the pieces of every flattened surface, numbering pieces and seams across the job.
 pub fn build(flats: &[Flat], opts: &PatternOptions) -> Result<Vec<Piece>, PatternError> {
-    let mut pieces = Vec::new();
-    let mut next_edge_id = 1;
+    let mut pieces: Vec<Piece> = Vec::new();
+    let mut next_seam = 1;
     let multi = flats.len() > 1;
     for flat in flats {
-        let ids = edge_ids(flat, &mut next_edge_id);
+        let first = pieces.len();
         for (k, faces) in flat.islands.iter().enumerate() {
             let id = pieces.len() + 1;
             let name = if multi {
@@ -147,37 +315,22 @@ pub fn build(flats: &[Flat], opts: &PatternOptions) -> Result<Vec<Piece>, Patter
             } else {
                 format!("{}", k + 1)
             };
-            pieces.push(piece(flat, faces, &ids, id, name, opts)?);
+            pieces.push(net(flat, faces, id, name, opts)?);
         }
+        let mine = &mut pieces[first..];
+        marks::seams(flat, mine, &mut next_seam, opts);
+        for p in mine.iter_mut() {
+            marks::finish(flat, p, opts);
+        }
+        allowance::apply(flat, mine, opts);
     }
     Ok(pieces)
 }
 
-/// Number the cut edges that have two copies.
-fn edge_ids(flat: &Flat, next: &mut usize) -> Vec<Option<usize>> {
-    flat.topology
-        .edges
-        .iter()
-        .enumerate()
-        .map(|(e, edge)| {
-            if edge.uses.len() == 2 && !flat.joined[e] {
-                *next += 1;
-                Some(*next - 1)
-            } else {
-                None
-            }
-        })
-        .collect()
-}
-
-fn is_boundary(flat: &Flat, f: usize, i: usize) -> bool {
-    !flat.joined[flat.topology.face_edges[f][i]]
-}
-
-fn piece(
+/// The bare piece of an island: border, folds, area.
+fn net(
     flat: &Flat,
     faces: &[usize],
-    ids: &[Option<usize>],
     id: usize,
     name: String,
     opts: &PatternOptions,
@@ -193,18 +346,19 @@ fn piece(
     // joined edges.
     let mut visited: std::collections::HashSet<(usize, usize)> = Default::default();
     let total_corners: usize = faces.iter().map(|&f| mesh.faces[f].verts.len()).sum();
-    let mut loops: Vec<(Vec<DVec2>, Vec<usize>)> = Vec::new();
+    let mut loops: Vec<(Vec<DVec2>, Vec<usize>, Vec<usize>)> = Vec::new();
     for &f0 in faces {
         for i0 in 0..mesh.faces[f0].verts.len() {
             if !is_boundary(flat, f0, i0) || visited.contains(&(f0, i0)) {
                 continue;
             }
-            let (mut pts, mut edges) = (Vec::new(), Vec::new());
+            let (mut pts, mut edges, mut owners) = (Vec::new(), Vec::new(), Vec::new());
             let (mut f, mut i) = (f0, i0);
             loop {
                 visited.insert((f, i));
                 pts.push(flat.face_2d[f][i]);
                 edges.push(topo.face_edges[f][i]);
+                owners.push(f);
                 // Next boundary half-edge around the end vertex.
                 let mut steps = 0;
                 let (mut g, mut j) = (f, (i + 1) % mesh.faces[f].verts.len());
@@ -230,7 +384,7 @@ fn piece(
                     return Err(fail());
                 }
             }
-            loops.push((pts, edges));
+            loops.push((pts, edges, owners));
         }
     }
     if loops.is_empty() {
@@ -243,127 +397,55 @@ fn piece(
         })
         .unwrap_or(0);
     loops.swap(0, outer);
-    let (outline, outline_edges): (Vec<_>, Vec<_>) = loops.into_iter().unzip();
+    let mut border = Vec::new();
+    let mut border_edges = Vec::new();
+    let mut border_faces = Vec::new();
+    for (pts, edges, owners) in loops {
+        border.push(pts);
+        border_edges.push(edges);
+        border_faces.push(owners);
+    }
 
-    // Folds and edge ids.
+    // Folds.
     let threshold = opts.fold_threshold_deg.to_radians();
     let mut folds = Vec::new();
-    let mut marks = Vec::new();
     for &f in faces {
         for (i, &e) in topo.face_edges[f].iter().enumerate() {
-            let (a, b) = flat.corner_edge(f, i);
-            if flat.joined[e] {
-                // Each fold once: from the face listed first on the edge.
-                let d = flat.dihedral[e];
-                if topo.edges[e].uses[0] == (f, i) && d.abs() > threshold {
-                    folds.push(Fold {
-                        a,
-                        b,
-                        kind: if d > 0.0 {
-                            FoldKind::Mountain
-                        } else {
-                            FoldKind::Valley
-                        },
-                        angle_deg: d.abs().to_degrees(),
-                        edge: e,
-                    });
-                }
-            } else if let Some(n) = ids[e] {
-                let depth = 2.0 * mesh.face_area(f) / a.distance(b).max(f64::MIN_POSITIVE);
-                marks.push(EdgeMark {
-                    id: n,
-                    edge: e,
+            // Each fold once: from the face listed first on the edge.
+            let d = flat.dihedral[e];
+            if flat.joined[e] && topo.edges[e].uses[0] == (f, i) && d.abs() > threshold {
+                let (a, b) = flat.corner_edge(f, i);
+                folds.push(Fold {
                     a,
                     b,
-                    strokes: edge_text(&n.to_string(), a, b, depth, opts.max_mark_height),
+                    kind: if d > 0.0 {
+                        FoldKind::Mountain
+                    } else {
+                        FoldKind::Valley
+                    },
+                    angle_deg: d.abs().to_degrees(),
+                    edge: e,
+                    tab: false,
                 });
             }
         }
     }
-
-    let label = piece_label(flat, faces, &name, opts.max_label_height);
     let area = faces.iter().map(|&f| mesh.face_area(f)).sum();
     Ok(Piece {
-        id,
-        name,
         surface: flat.surface.name.clone(),
         faces: faces.to_vec(),
-        outline,
-        outline_edges,
+        outline: border.clone(),
+        border,
+        border_edges,
+        border_faces,
         folds,
-        marks,
-        label,
         area,
-        grain: None,
+        ..Piece::from_outline(id, name, Vec::new())
     })
 }
 
-/// Strokes of `text` set along the edge `a → b` (interior on its left), inside the face.
-fn edge_text(text: &str, a: DVec2, b: DVec2, depth: f64, max_h: f64) -> Vec<Vec<DVec2>> {
-    let len = a.distance(b);
-    if len <= 0.0 {
-        return Vec::new();
-    }
-    let d = (b - a) / len;
-    let inward = d.perp();
-    let mut h = max_h.min(0.3 * len).min(0.35 * depth);
-    let w1 = font::text_width(text, 1.0);
-    if w1 * h > 0.8 * len {
-        h = 0.8 * len / w1;
-    }
-    if h.is_nan() || h <= 0.0 {
-        return Vec::new();
-    }
-    let w = w1 * h;
-    let gap = 0.25 * h;
-    // Read left to right: run along +x (or +y for vertical edges).
-    let upright = d.x > 1e-9 || (d.x.abs() <= 1e-9 && d.y > 0.0);
-    let (r, base) = if upright {
-        (d, 0.5 * (a + b) - d * (0.5 * w) + inward * gap)
-    } else {
-        (-d, 0.5 * (a + b) + d * (0.5 * w) + inward * (gap + h))
-    };
-    let up = r.perp();
-    let (strokes, _) = font::text_strokes(text, h);
-    strokes
-        .into_iter()
-        .map(|s| s.into_iter().map(|p| base + r * p.x + up * p.y).collect())
-        .collect()
-}
-
-/// The piece name, centred in the incircle of the piece's largest triangle.
-fn piece_label(flat: &Flat, faces: &[usize], text: &str, max_h: f64) -> Vec<Vec<DVec2>> {
-    let mut best: Option<(f64, DVec2)> = None; // (inradius, incenter)
-    for &f in faces {
-        let p = &flat.face_2d[f];
-        for t in polygon::triangulate(p) {
-            let (a, b, c) = (p[t[0]], p[t[1]], p[t[2]]);
-            let (la, lb, lc) = (b.distance(c), c.distance(a), a.distance(b));
-            let per = la + lb + lc;
-            if per <= 0.0 {
-                continue;
-            }
-            let area = polygon::signed_area(&[a, b, c]).abs();
-            let r = 2.0 * area / per;
-            if best.is_none_or(|(br, _)| r > br) {
-                best = Some((r, (a * la + b * lb + c * lc) / per));
-            }
-        }
-    }
-    let Some((r, center)) = best else {
-        return Vec::new();
-    };
-    let k = font::text_width(text, 1.0);
-    let h = (1.6 * r / (k * k + 1.0).sqrt()).min(max_h);
-    if h.is_nan() || h <= 0.0 {
-        return Vec::new();
-    }
-    let (strokes, w) = font::text_strokes(text, h);
-    let origin = center - DVec2::new(0.5 * w, 0.5 * h);
-    strokes
-        .into_iter()
-        .map(|s| s.into_iter().map(|p| p + origin).collect())
-        .collect()
+fn is_boundary(flat: &Flat, f: usize, i: usize) -> bool {
+    !flat.joined[flat.topology.face_edges[f][i]]
 }
 
 #[cfg(test)]
@@ -382,28 +464,43 @@ mod tests {
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];
         assert_eq!(p.outline.len(), 1);
-        assert_eq!(p.outline[0].len(), 14);
-        assert!((p.cut_length() - 1400.0).abs() < 1e-9);
+        assert_eq!(p.border[0].len(), 14);
+        // The cut outline is the border without its two straight-through vertices.
+        assert_eq!(p.outline[0].len(), 12);
+        assert!((p.cut_length() - 1400.0).abs() < 1e-6);
         assert!((p.fold_length() - 500.0).abs() < 1e-9);
         assert!(p.folds.iter().all(|f| f.kind == FoldKind::Mountain));
         assert!(p.folds.iter().all(|f| (f.angle_deg - 90.0).abs() < 1e-9));
         assert!((p.area - 60000.0).abs() < 1e-6);
         assert!(polygon::signed_area(&p.outline[0]) > 0.0);
         assert!(polygon::is_simple_ring(&p.outline[0]));
-        // Seven cut edges, each id written twice, inside the piece.
-        assert_eq!(p.marks.len(), 14);
-        for id in 1..=7 {
+        // Seven cut edges in seams: every seam has two sides on this piece, of equal length,
+        // together covering the 1400 mm of border once; each id written twice, inside.
+        let n = p.seams.len() / 2;
+        assert!(
+            (1..=7).contains(&n) && p.seams.len() == 2 * n,
+            "{}",
+            p.seams.len()
+        );
+        let total: f64 = p.seams.iter().map(|s| s.length).sum();
+        assert!((total - 1400.0).abs() < 1e-9);
+        assert_eq!(p.marks.len(), 2 * n);
+        for id in 1..=n {
+            let sides: Vec<_> = p.seams.iter().filter(|s| s.id == id).collect();
+            assert_eq!(sides.len(), 2);
+            assert!((sides[0].length - sides[1].length).abs() < 1e-9);
+            assert_eq!(sides[0].is_a, !sides[1].is_a);
             assert_eq!(p.marks.iter().filter(|m| m.id == id).count(), 2);
         }
         for m in &p.marks {
-            assert!(!m.strokes.is_empty());
-            for q in m.strokes.iter().flatten() {
-                assert!(polygon::contains(&p.outline[0], *q), "mark {} at {q}", m.id);
+            assert!(!m.text.is_empty());
+            for q in m.text.points() {
+                assert!(polygon::contains(&p.outline[0], q), "mark {} at {q}", m.id);
             }
         }
         assert!(!p.label.is_empty());
-        for q in p.label.iter().flatten() {
-            assert!(polygon::contains(&p.outline[0], *q));
+        for q in p.label.points() {
+            assert!(polygon::contains(&p.outline[0], q));
         }
     }
 }

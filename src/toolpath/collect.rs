@@ -7,7 +7,8 @@
 //! half a turn about its own centre when the placement would put it upside down.
 
 use super::{Stroke, StrokeRole, ToolpathOptions};
-use crate::nest::{Layout, Sheet};
+use crate::nest::{Layout, Placement, Sheet};
+use crate::pattern::Text;
 use glam::DVec2;
 
 /// All strokes of a sheet, piece by piece, in sheet millimetres.
@@ -16,24 +17,48 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
     for &k in &sheet.pieces {
         let piece = &layout.pieces[k];
         let at = layout.placements[k];
-        let mut open = |role, pts: &[DVec2]| {
+        // `place`: the points are in the piece's frame (else already on the sheet).
+        let mut open = |role, pts: &[DVec2], place: bool| {
             out.push(Stroke {
                 role,
-                points: pts.iter().map(|p| at.apply(*p)).collect(),
+                points: if place {
+                    pts.iter().map(|p| at.apply(*p)).collect()
+                } else {
+                    pts.to_vec()
+                },
                 closed: false,
                 piece: Some(k),
                 outer: false,
             })
         };
         if !opts.skip_drawing {
-            for s in &piece.label {
-                open(StrokeRole::Label, s);
-            }
-            for m in &piece.marks {
-                for s in &m.strokes {
-                    open(StrokeRole::Mark, s);
+            for t in std::iter::once(&piece.label)
+                .chain(piece.marks.iter().map(|m| &m.text))
+                .chain(&piece.notes)
+            {
+                let role = if t.dir.is_none() {
+                    StrokeRole::Label
+                } else {
+                    StrokeRole::Mark
+                };
+                for pts in upright(t, &at) {
+                    open(role, &pts, false);
                 }
             }
+            for ring in &piece.seam_line {
+                let mut pts = ring.clone();
+                pts.extend(ring.first().copied());
+                open(StrokeRole::Seam, &pts, true);
+            }
+            for s in &piece.grain_line {
+                open(StrokeRole::Grain, s, true);
+            }
+            for n in piece.notches.iter().filter(|n| !n.cut) {
+                open(StrokeRole::Mark, &n.stroke, true);
+            }
+        }
+        for n in piece.notches.iter().filter(|n| n.cut) {
+            open(StrokeRole::Notch, &n.stroke, true);
         }
         if !opts.skip_folds {
             for f in &piece.folds {
@@ -41,7 +66,7 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
                     crate::pattern::FoldKind::Mountain => StrokeRole::FoldMountain,
                     crate::pattern::FoldKind::Valley => StrokeRole::FoldValley,
                 };
-                open(role, &[f.a, f.b]);
+                open(role, &[f.a, f.b], true);
             }
         }
         for (i, ring) in piece.outline.iter().enumerate() {
@@ -57,4 +82,46 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
         }
     }
     out
+}
+
+/// The strokes of a text on the sheet, reading upright: a label keeps its own orientation
+/// (only its centre moves with the piece); text set along an edge turns with the piece, and
+/// half a turn more about its centre when it would read right to left or downwards. On a
+/// mirrored piece the text is set again in its (symmetric) box so that it never reads
+/// mirrored. The box is centred where the piece puts it, so the text stays where it was.
+fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
+    let Some((lo, hi)) = crate::geom::polygon::bounds(t.points()) else {
+        return Vec::new();
+    };
+    let c = 0.5 * (lo + hi);
+    let cs = at.apply(c);
+    let (r, up) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
+        Some(r) => (r, r.perp()),
+    };
+    // The box's axes on the sheet.
+    let (mut e1, mut e2) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
+        Some(_) => (
+            (at.apply(c + r) - cs).normalize_or_zero(),
+            (at.apply(c + up) - cs).normalize_or_zero(),
+        ),
+    };
+    if e1.perp_dot(e2) < 0.0 {
+        e1 = -e1;
+    }
+    if e1.x < -1e-9 || (e1.x.abs() <= 1e-9 && e1.y < 0.0) {
+        (e1, e2) = (-e1, -e2);
+    }
+    t.strokes
+        .iter()
+        .map(|s| {
+            s.iter()
+                .map(|q| {
+                    let d = *q - c;
+                    cs + e1 * d.dot(r) + e2 * d.dot(up)
+                })
+                .collect()
+        })
+        .collect()
 }

@@ -39,3 +39,29 @@ pub fn shared_data(rel: &str) -> PathBuf {
         .join("../shared/data")
         .join(rel)
 }
+
+/// The acceptance mesh `fandisk.obj` as a spec: scaled to about 300 mm, on A3 portrait.
+pub const FANDISK_SPEC: &str = r#"
+name = "fandisk"
+[[surface]]
+kind = "mesh"
+path = "fandisk.obj"
+scale = 100
+units = "mm"
+[sheet]
+width = 297
+height = 420
+margin = 5
+spacing = 3
+"#;
+
+/// Writes [`FANDISK_SPEC`], pointing at the shared mesh, into `dir`; returns its path.
+pub fn fandisk_spec(dir: &Path) -> PathBuf {
+    let path = dir.join("fandisk.toml");
+    let text = FANDISK_SPEC.replace(
+        "fandisk.obj",
+        &shared_data("meshes/fandisk.obj").to_string_lossy(),
+    );
+    std::fs::write(&path, text).expect("write fandisk spec");
+    path
+}

@@ -1,0 +1,502 @@
+//! Marks that tell a person which edge goes where and which way up a piece goes: seams with
+//! the same id on both sides, notches at equal arc lengths, piece labels, grain lines and bend
+//! notes (issue 8, item 1).
+//!
+//! **Seams.** A seam is a chain of consecutive border segments of one piece whose copies are
+//! consecutive, in reverse order, on the border of another piece (or of the same piece): one
+//! 3D edge chain cut into two piece boundaries. Chains are found by walking each border ring
+//! and linking segment `k − 1` to `k` when their twins are `j` and `j − 1` on the same ring; a
+//! chain never runs into its own other side (the two copies of an edge at a leaf of the cut
+//! tree are adjacent on the border and make a one-segment seam). A ring that is one chain all
+//! round starts at its segment 0. Seams are numbered 1, 2, … over the whole job, in the order
+//! of pieces, rings and segments; the first piece met is side A.
+//!
+//! **Notches** go at equal arc lengths from side A's start, which is side B's end: every
+//! `spacing` mm (on side B at the same fraction of the same mesh edge), plus a second notch 3 mm (at most a tenth of the seam) after the first one,
+//! so that the pattern of notches is not symmetric and the pieces cannot be joined reversed.
+//! A seam shorter than 1¼ spacings gets its pair at a third of its length; one shorter than
+//! 5 mm gets none.
+//!
+//! **Text.** The seam id is written along the longest segment of each side, inside the face
+//! (as the edge ids before it: at most 3 mm, 30 % of the segment, 35 % of the face's depth).
+//! The label (name, then `#id` and which side faces up) is centred on the pole of
+//! inaccessibility of the border and sized so that its whole block fits in 90 % of the
+//! inscribed circle there: it stays inside the piece in any orientation, which lets the
+//! toolpath stage turn it upright on the sheet whatever rotation the nest chose.
+//!
+//! **Grain line** (fabric): along the long side of the piece's minimum-area rectangle, the
+//! longest chord in that direction that keeps clear of the label, 70 % of it, with arrowheads
+//! at both ends. **Bend notes** (metal): `90° UP` (valley) or `90° DOWN` (mountain) beside each
+//! bend line: which way the flange goes with the marked side up.
+
+use super::{EdgeMark, FoldKind, Notch, PatternOptions, Piece};
+use crate::flatten::Flat;
+use crate::geom::{font, polygon};
+use crate::spec::MaterialKind;
+use glam::DVec2;
+use std::collections::HashMap;
+
+/// Single-stroke text placed on a piece.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Text {
+    pub strokes: Vec<Vec<DVec2>>,
+    /// Reading direction (unit) of text set along an edge; `None` for text that may be turned
+    /// freely about its centre (the label).
+    pub dir: Option<DVec2>,
+}
+
+impl Text {
+    pub fn points(&self) -> impl Iterator<Item = DVec2> + '_ {
+        self.strokes.iter().flatten().copied()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.strokes.is_empty()
+    }
+}
+
+/// One piece's side of a seam.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeamSide {
+    /// Seam id, the same on both sides and in report.json.
+    pub id: usize,
+    /// Side A (the first met) or B.
+    pub is_a: bool,
+    /// Id of the piece on the other side.
+    pub partner: usize,
+    /// Border ring and first segment of the chain, and its number of segments.
+    pub ring: usize,
+    pub first: usize,
+    pub count: usize,
+    /// The chain on this piece, `count + 1` points in border order.
+    pub points: Vec<DVec2>,
+    /// Its length (mm): the sum of its mesh edges' lengths, as laid flat on their faces.
+    pub length: f64,
+    /// Notch positions as arc lengths from this side's first point (mm).
+    pub notches: Vec<f64>,
+    /// A glue tab was put on this side.
+    pub tab: bool,
+}
+
+/// Finds the seams of one flat's pieces, writes their ids and places their notches.
+pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts: &PatternOptions) {
+    // Where each cut mesh edge lies on the borders: (piece, ring, segment).
+    type Loc = (usize, usize, usize);
+    let mut at: HashMap<usize, Vec<Loc>> = HashMap::new();
+    for (pi, p) in pieces.iter().enumerate() {
+        for (r, ring) in p.border_edges.iter().enumerate() {
+            for (k, &e) in ring.iter().enumerate() {
+                at.entry(e).or_default().push((pi, r, k));
+            }
+        }
+    }
+    let twin = |l: Loc| -> Option<Loc> {
+        let e = pieces[l.0].border_edges[l.1][l.2];
+        let locs = at.get(&e)?;
+        if locs.len() != 2 {
+            return None;
+        }
+        locs.iter().copied().find(|&o| o != l)
+    };
+    let len_of = |pi: usize, r: usize| pieces[pi].border_edges[r].len();
+    // Segment k continues the chain of k − 1.
+    let linked = |l: Loc| -> bool {
+        let n = len_of(l.0, l.1);
+        let prev = (l.0, l.1, (l.2 + n - 1) % n);
+        match (twin(prev), twin(l)) {
+            (Some(tp), Some(tk)) => {
+                let m = len_of(tp.0, tp.1);
+                tk.0 == tp.0 && tk.1 == tp.1 && tk.2 == (tp.2 + m - 1) % m && tk != prev
+            }
+            _ => false,
+        }
+    };
+
+    let mut done: std::collections::HashSet<Loc> = Default::default();
+    let mut found: Vec<(Loc, usize, Loc)> = Vec::new(); // (A start, count, B start)
+    for (pi, piece) in pieces.iter().enumerate() {
+        for r in 0..piece.border_edges.len() {
+            let n = len_of(pi, r);
+            // Chain starts: segments with a twin not linked to their predecessor; a ring
+            // linked all round starts at 0.
+            let mut starts: Vec<usize> = (0..n)
+                .filter(|&k| twin((pi, r, k)).is_some() && !linked((pi, r, k)))
+                .collect();
+            if starts.is_empty() && n > 0 && twin((pi, r, 0)).is_some() {
+                starts.push(0);
+            }
+            for k0 in starts {
+                if done.contains(&(pi, r, k0)) {
+                    continue;
+                }
+                let mut other: std::collections::HashSet<Loc> = Default::default();
+                let mut count = 0;
+                let mut k = k0;
+                let mut b_start = (0, 0, 0);
+                loop {
+                    let l = (pi, r, k);
+                    let Some(t) = twin(l) else { break };
+                    if done.contains(&l) || other.contains(&l) || (count > 0 && !linked(l)) {
+                        break;
+                    }
+                    done.insert(l);
+                    done.insert(t);
+                    other.insert(t);
+                    b_start = t;
+                    count += 1;
+                    k = (k + 1) % n;
+                    if k == k0 {
+                        break;
+                    }
+                }
+                if count > 0 {
+                    found.push(((pi, r, k0), count, b_start));
+                }
+            }
+        }
+    }
+
+    for (a, count, b) in found {
+        let id = *next_id;
+        *next_id += 1;
+        let side = |l: Loc, is_a: bool, partner: usize| {
+            let ring = &pieces[l.0].border[l.1];
+            let n = ring.len();
+            let points: Vec<DVec2> = (0..=count).map(|i| ring[(l.2 + i) % n]).collect();
+            // Each segment measured on its own face (the next border point belongs to the
+            // next face, placed within the unfolding's tolerance): the 3D edge length.
+            let length = (0..count)
+                .map(|i| {
+                    let j = (l.2 + i) % n;
+                    let f = pieces[l.0].border_faces[l.1][j];
+                    let c = &flat.face_2d[f];
+                    match c.iter().position(|q| *q == ring[j]) {
+                        Some(k) => c[k].distance(c[(k + 1) % c.len()]),
+                        None => ring[j].distance(ring[(j + 1) % n]),
+                    }
+                })
+                .sum();
+            SeamSide {
+                id,
+                is_a,
+                partner,
+                ring: l.1,
+                first: l.2,
+                count,
+                points,
+                length,
+                notches: Vec::new(),
+                tab: false,
+            }
+        };
+        let mut sa = side(a, true, pieces[b.0].id);
+        let mut sb = side(b, false, pieces[a.0].id);
+        if let Some(spacing) = opts.notches {
+            let at_a = notch_positions(sa.length, spacing);
+            // Side B runs the chain backwards, segment for segment (each segment is one mesh
+            // edge); a notch goes at the same fraction of the same edge on both sides, which
+            // holds even where the two flat copies differ by the unfolding's tolerance.
+            sb.notches = at_a
+                .iter()
+                .rev()
+                .map(|&s| {
+                    let (k, t) = segment_at(&sa.points, s);
+                    arc_at(&sb.points, count - 1 - k, 1.0 - t)
+                })
+                .collect();
+            sa.notches = at_a;
+        }
+        for (l, s) in [(a, sa), (b, sb)] {
+            let p = &mut pieces[l.0];
+            if let Some(m) = id_mark(flat, p, &s) {
+                p.marks.push(m);
+            }
+            p.seams.push(s);
+        }
+    }
+}
+
+/// Arc lengths of the notches along a seam of length `len` from side A's start.
+pub fn notch_positions(len: f64, spacing: f64) -> Vec<f64> {
+    if len.is_nan() || len < 5.0 || spacing.is_nan() || spacing <= 0.0 {
+        return Vec::new();
+    }
+    let mut at: Vec<f64> = Vec::new();
+    let mut s = spacing;
+    while s < len - 0.25 * spacing {
+        at.push(s);
+        s += spacing;
+    }
+    if at.is_empty() {
+        at.push(len / 3.0);
+    }
+    let extra = at[0] + 3f64.min(0.1 * len);
+    at.insert(1, extra);
+    at
+}
+
+/// The seam id written along the longest segment of a side.
+fn id_mark(flat: &Flat, p: &Piece, s: &SeamSide) -> Option<EdgeMark> {
+    let n = p.border[s.ring].len();
+    let k = (0..s.count).map(|i| (s.first + i) % n).max_by(|&i, &j| {
+        let ring = &p.border[s.ring];
+        let li = ring[i].distance(ring[(i + 1) % n]);
+        let lj = ring[j].distance(ring[(j + 1) % n]);
+        li.total_cmp(&lj).then(j.cmp(&i))
+    })?;
+    let (a, b) = (p.border[s.ring][k], p.border[s.ring][(k + 1) % n]);
+    let f = p.border_faces[s.ring][k];
+    let depth = 2.0 * flat.surface.mesh.face_area(f) / a.distance(b).max(f64::MIN_POSITIVE);
+    Some(EdgeMark {
+        id: s.id,
+        edge: p.border_edges[s.ring][k],
+        a,
+        b,
+        text: edge_text(&s.id.to_string(), a, b, depth, 3.0),
+    })
+}
+
+/// Label, grain line, bend notes and notch strokes of a piece whose seams are known.
+pub(super) fn finish(flat: &Flat, p: &mut Piece, opts: &PatternOptions) {
+    let side = match opts.material {
+        MaterialKind::Fabric => "RIGHT SIDE UP",
+        _ => "OUTSIDE UP",
+    };
+    let (label, label_r) = label(p, side, opts.max_label_height);
+    p.label = label;
+    if opts.grain {
+        let (dir, strokes) = grain_line(p, label_r);
+        p.grain = Some(dir.y.atan2(dir.x));
+        p.grain_line = strokes;
+    }
+    if opts.bend_notes {
+        let mesh = &flat.surface.mesh;
+        let topo = &flat.topology;
+        for f in p.folds.iter().filter(|f| !f.tab) {
+            let (face, _) = topo.edges[f.edge].uses[0];
+            let depth = 2.0 * mesh.face_area(face) / f.a.distance(f.b).max(f64::MIN_POSITIVE);
+            let way = match f.kind {
+                FoldKind::Mountain => "DOWN",
+                FoldKind::Valley => "UP",
+            };
+            let text = format!("{:.0}° {way}", f.angle_deg);
+            let t = edge_text(&text, f.a, f.b, depth, opts.max_mark_height);
+            if !t.is_empty() {
+                p.notes.push(t);
+            }
+        }
+    }
+}
+
+/// Notch strokes, once the outline is final: a slit from the cut line into the piece on
+/// fabric (`allowance` mm outside the border), a tick drawn inward from the border otherwise.
+pub(super) fn notch_strokes(p: &mut Piece, opts: &PatternOptions) {
+    let cut = opts.material == MaterialKind::Fabric;
+    let mut notches = Vec::new();
+    for s in &p.seams {
+        for &at in &s.notches {
+            let Some((q, dir)) = point_at(&s.points, at) else {
+                continue;
+            };
+            let inward = dir.perp();
+            let stroke = if cut && opts.allowance > 0.0 {
+                let a = opts.allowance;
+                let depth = 3f64.min(0.5 * a);
+                vec![q - inward * a, q - inward * (a - depth)]
+            } else if cut {
+                vec![q, q + inward * 2.0]
+            } else {
+                vec![q, q + inward * 2.5]
+            };
+            notches.push(Notch {
+                seam: s.id,
+                at: q,
+                stroke,
+                cut,
+            });
+        }
+    }
+    p.notches = notches;
+}
+
+/// Segment index and fraction along it of arc length `s` on a polyline.
+pub fn segment_at(points: &[DVec2], s: f64) -> (usize, f64) {
+    let mut left = s;
+    let n = points.len().saturating_sub(1);
+    for (k, w) in points.windows(2).enumerate() {
+        let l = w[0].distance(w[1]);
+        if left <= l || k + 1 == n {
+            return (
+                k,
+                if l > 0.0 {
+                    (left / l).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+            );
+        }
+        left -= l;
+    }
+    (0, 0.0)
+}
+
+/// Arc length of the point at fraction `t` of segment `k` of a polyline.
+pub fn arc_at(points: &[DVec2], k: usize, t: f64) -> f64 {
+    let before: f64 = points.windows(2).take(k).map(|w| w[0].distance(w[1])).sum();
+    let l = points.get(k + 1).map_or(0.0, |b| points[k].distance(*b));
+    before + t * l
+}
+
+/// The point at arc length `s` along a polyline and the direction of its segment there.
+pub fn point_at(points: &[DVec2], s: f64) -> Option<(DVec2, DVec2)> {
+    let mut left = s;
+    let n = points.len();
+    for (i, w) in points.windows(2).enumerate() {
+        let l = w[0].distance(w[1]);
+        if l <= 0.0 {
+            continue;
+        }
+        if left <= l || i + 2 == n {
+            let t = (left / l).clamp(0.0, 1.0);
+            return Some((w[0].lerp(w[1], t), (w[1] - w[0]) / l));
+        }
+        left -= l;
+    }
+    None
+}
+
+/// Strokes of `text` set along the edge `a → b` (interior on its left), inside the face.
+pub fn edge_text(text: &str, a: DVec2, b: DVec2, depth: f64, max_h: f64) -> Text {
+    let len = a.distance(b);
+    if len <= 0.0 {
+        return Text::default();
+    }
+    let d = (b - a) / len;
+    let inward = d.perp();
+    let mut h = max_h.min(0.3 * len).min(0.35 * depth);
+    let w1 = font::text_width(text, 1.0);
+    if w1 * h > 0.8 * len {
+        h = 0.8 * len / w1;
+    }
+    if h.is_nan() || h <= 0.0 {
+        return Text::default();
+    }
+    let w = w1 * h;
+    let gap = 0.25 * h;
+    // Read left to right: run along +x (or +y for vertical edges).
+    let upright = d.x > 1e-9 || (d.x.abs() <= 1e-9 && d.y > 0.0);
+    let (r, base) = if upright {
+        (d, 0.5 * (a + b) - d * (0.5 * w) + inward * gap)
+    } else {
+        (-d, 0.5 * (a + b) + d * (0.5 * w) + inward * (gap + h))
+    };
+    let up = r.perp();
+    let (strokes, _) = font::text_strokes(text, h);
+    Text {
+        strokes: strokes
+            .into_iter()
+            .map(|s| s.into_iter().map(|p| base + r * p.x + up * p.y).collect())
+            .collect(),
+        dir: Some(r),
+    }
+}
+
+/// The label: `name` over `#id side`, centred on the border's pole of inaccessibility. Returns
+/// it and the radius of the circle it fits in (0 when there is no room).
+fn label(p: &Piece, side: &str, max_h: f64) -> (Text, f64) {
+    let Some((center, r)) = polygon::pole(&p.border, 0.05 * max_h.max(0.1)) else {
+        return (Text::default(), 0.0);
+    };
+    let line1 = p.name.clone();
+    let line2 = format!("#{} {side}", p.id);
+    let block = |h: f64| {
+        let w = font::text_width(&line1, h).max(font::text_width(&line2, 0.6 * h));
+        (w, 2.0 * h)
+    };
+    // Two lines when they can be at least 1.5 mm high, else the name alone.
+    let (w1, _) = block(1.0);
+    let h2 = (1.8 * r / (w1 * w1 + 4.0).sqrt()).min(max_h);
+    let mut strokes = Vec::new();
+    if h2 >= 1.5 {
+        // Line 1 (h) sits on the centre, 0.4 h above line 2 (0.6 h): a block 2 h high.
+        let (w, hh) = block(h2);
+        let (s1, wa) = font::text_strokes(&line1, h2);
+        let (s2, wb) = font::text_strokes(&line2, 0.6 * h2);
+        let o1 = center + DVec2::new(-0.5 * wa, 0.0);
+        let o2 = center + DVec2::new(-0.5 * wb, -h2);
+        strokes.extend(
+            s1.into_iter()
+                .map(|s| s.into_iter().map(|q| q + o1).collect()),
+        );
+        strokes.extend(
+            s2.into_iter()
+                .map(|s| s.into_iter().map(|q| q + o2).collect()),
+        );
+        return (Text { strokes, dir: None }, 0.5 * (w * w + hh * hh).sqrt());
+    }
+    let k = font::text_width(&line1, 1.0);
+    let h = (1.8 * r / (k * k + 1.0).sqrt()).min(max_h);
+    if h.is_nan() || h <= 0.0 {
+        return (Text::default(), 0.0);
+    }
+    let (s1, w) = font::text_strokes(&line1, h);
+    let o = center - DVec2::new(0.5 * w, 0.5 * h);
+    strokes.extend(
+        s1.into_iter()
+            .map(|s| s.into_iter().map(|q| q + o).collect()),
+    );
+    (Text { strokes, dir: None }, 0.5 * (w * w + h * h).sqrt())
+}
+
+/// Grain direction (unit) and the arrow: the longest chord along it that keeps `label_r + 2`
+/// mm from the label's centre, 70 % of it, arrowheads at both ends.
+fn grain_line(p: &Piece, label_r: f64) -> (DVec2, Vec<Vec<DVec2>>) {
+    let pts: Vec<DVec2> = p.border.first().cloned().unwrap_or_default();
+    let angle = polygon::min_area_rect_angle(&pts);
+    // min_area_rect_angle turns the piece so that its long side lies along x: the long side
+    // is along the direction that rotation maps onto +x.
+    let dir = DVec2::from_angle(-angle);
+    let Some((center, _)) = polygon::pole(&p.border, 0.5) else {
+        return (dir, Vec::new());
+    };
+    let Some((lo, hi)) = polygon::bounds(pts.iter().copied()) else {
+        return (dir, Vec::new());
+    };
+    let extent = (hi - lo).length();
+    let normal = dir.perp();
+    let clear = label_r + 2.0;
+    let mut best: Option<(f64, f64, f64)> = None; // (length, start, offset)
+    for i in 0..=80 {
+        let off = (i as f64 / 80.0 - 0.5) * extent;
+        let origin = center + normal * off;
+        for (t0, t1) in polygon::line_intervals(&p.border, origin, dir) {
+            // Keep clear of the label: cut the interval where it passes within `clear`.
+            let mut parts = vec![(t0, t1)];
+            if off.abs() < clear {
+                let half = (clear * clear - off * off).sqrt();
+                parts = vec![(t0, t1.min(-half)), (t0.max(half), t1)];
+            }
+            for (a, b) in parts {
+                if b - a > best.map_or(0.0, |x| x.0) {
+                    best = Some((b - a, a, off));
+                }
+            }
+        }
+    }
+    let Some((len, t0, off)) = best else {
+        return (dir, Vec::new());
+    };
+    let l = 0.7 * len;
+    if l < 10.0 {
+        return (dir, Vec::new());
+    }
+    let origin = center + normal * off;
+    let a = origin + dir * (t0 + 0.15 * len);
+    let b = a + dir * l;
+    let head = 4f64.min(0.15 * l);
+    let wing = |tip: DVec2, back: DVec2| {
+        let r1 = DVec2::from_angle(0.45).rotate(back);
+        let r2 = DVec2::from_angle(-0.45).rotate(back);
+        vec![tip + r1 * head, tip, tip + r2 * head]
+    };
+    (dir, vec![vec![a, b], wing(a, dir), wing(b, -dir)])
+}
