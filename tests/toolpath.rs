@@ -57,6 +57,23 @@ fn fandisk_travel_at_least_30_percent_shorter_than_stroke_order() {
             100.0 * (1.0 - after / before)
         );
         assert!(n > 1000, "{n} strokes");
+        if !per_piece {
+            // What 2-opt adds to nearest neighbour, on all the strokes of the first sheet as
+            // one group.
+            use flatcut::toolpath::order;
+            let all = flatcut::toolpath::unordered(&layout, &layout.sheets[0], &tp);
+            let mut pen = glam::DVec2::ZERO;
+            let greedy = flatcut::toolpath::travel(&order::order_with(all.clone(), &mut pen, 0));
+            let t = std::time::Instant::now();
+            let full = flatcut::toolpath::travel(&order::order(all, &mut pen));
+            eprintln!(
+                "one group: nearest neighbour {greedy:.0} mm, with 2-opt {full:.0} mm \
+                 ({:.1} % less), {:?}",
+                100.0 * (1.0 - full / greedy),
+                t.elapsed()
+            );
+            assert!(full < greedy);
+        }
         assert!(after <= 0.7 * before, "{after} vs {before}");
         // Determinism.
         assert_eq!(flatcut::toolpath::plan(&layout, "fandisk", &tp), job);

@@ -41,13 +41,19 @@ pub const EPS: f64 = 1e-9;
 /// Order `strokes` for short pen-up travel from `pen`; `pen` ends at the last stroke's end.
 /// Returns the original order (untouched) when the optimised one is not shorter.
 pub fn order(strokes: Vec<Stroke>, pen: &mut DVec2) -> Vec<Stroke> {
+    order_with(strokes, pen, ROUNDS)
+}
+
+/// [`order`] with at most `rounds` rounds of 2-opt and entry re-picking (0: nearest neighbour
+/// alone), for comparisons.
+pub fn order_with(strokes: Vec<Stroke>, pen: &mut DVec2, rounds: usize) -> Vec<Stroke> {
     if strokes.is_empty() {
         return strokes;
     }
     let start = *pen;
     let original = travel_from(start, &strokes);
     let mut nodes = nearest_neighbour(&strokes, start);
-    for _ in 0..ROUNDS {
+    for _ in 0..rounds {
         let before = nodes_travel(&strokes, &nodes, start);
         two_opt(&strokes, &mut nodes, start);
         repick_entries(&strokes, &mut nodes, start);
