@@ -211,3 +211,53 @@ impl Recorder {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn drag() -> Recorder {
+        let p = crate::device::profile::find("sim-dragknife").unwrap();
+        Recorder::for_profile(&p)
+    }
+
+    /// The tip trails the holder by the offset (10 plotter units) and cuts inside a corner the
+    /// holder turns sharply; a straight run stays two points.
+    #[test]
+    fn the_blade_tip_trails_the_holder() {
+        let mut r = drag();
+        let (a, b, c) = (
+            DVec2::new(0.0, 0.0),
+            DVec2::new(400.0, 0.0),
+            DVec2::new(400.0, 400.0),
+        );
+        r.down("cut", a);
+        r.travel_to(a, b, Some("cut"));
+        let p = &r.paths[0].points;
+        assert_eq!(p.len(), 2, "{p:?}");
+        assert_eq!(p[0], [-10.0, 0.0]);
+        assert!((p[1][0] - 390.0).abs() < 1e-9 && p[1][1].abs() < 1e-9);
+        r.travel_to(b, c, Some("cut"));
+        let p = &r.paths[0].points;
+        let end = DVec2::from(*p.last().unwrap());
+        // Back on the holder's line, 10 units behind it.
+        assert!(end.distance(DVec2::new(400.0, 390.0)) < 0.01, "{end}");
+        // The corner is cut round, inside: no tip point comes nearer the corner than 2 units.
+        let nearest = p
+            .iter()
+            .map(|q| DVec2::from(*q).distance(b))
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest > 2.0, "{nearest}");
+        // Lifted, the blade moves with the holder and keeps its direction.
+        r.up();
+        r.travel_to(c, DVec2::new(0.0, 800.0), None);
+        r.down("cut", DVec2::new(0.0, 800.0));
+        let start = DVec2::from(r.paths[1].points[0]);
+        assert!(start.distance(DVec2::new(0.0, 790.0)) < 0.01, "{start}");
+        // A recorder for a machine without an offset records the holder.
+        let mut plain = Recorder::for_profile(&crate::device::profile::find("sim").unwrap());
+        plain.down("cut", a);
+        plain.travel_to(a, b, Some("cut"));
+        assert_eq!(plain.paths[0].points, vec![[0.0, 0.0], [400.0, 0.0]]);
+    }
+}
