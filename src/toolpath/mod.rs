@@ -261,21 +261,7 @@ pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
             let d = groups
                 .iter()
                 .find(|g| !g.is_empty())
-                .map(|g| {
-                    g.iter()
-                        .flat_map(|s| {
-                            if s.closed {
-                                s.points.as_slice()
-                            } else {
-                                &s.points[..s.points.len().min(1)]
-                            }
-                            .iter()
-                            .chain(s.points.last().filter(|_| !s.closed))
-                        })
-                        .map(|p| pen.distance(*p))
-                        .fold(f64::INFINITY, f64::min)
-                })
-                .unwrap_or(f64::INFINITY);
+                .map_or(f64::INFINITY, |g| nearest_entry(g, pen));
             if d < best.0 {
                 best = (d, i);
             }
@@ -291,7 +277,110 @@ pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
     out
 }
 
+/// Distance from `pen` to the nearest point a stroke of `group` can start at (an end of an open
+/// stroke, any vertex of a closed one).
+fn nearest_entry(group: &[Stroke], pen: DVec2) -> f64 {
+    let mut best = f64::INFINITY;
+    for s in group {
+        let ends = [s.points.first(), s.points.last()];
+        let points: Box<dyn Iterator<Item = &DVec2>> = if s.closed {
+            Box::new(s.points.iter())
+        } else {
+            Box::new(ends.into_iter().flatten())
+        };
+        for p in points {
+            best = best.min(pen.distance(*p));
+        }
+    }
+    best
+}
+
 /// Pen-up travel of a sequence of strokes, starting from the origin.
 pub fn travel(strokes: &[Stroke]) -> f64 {
     order::travel_from(DVec2::ZERO, strokes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn s(role: StrokeRole, piece: usize, pts: &[(f64, f64)], outer: bool) -> Stroke {
+        let closed = pts.first() == pts.last() && pts.len() > 2;
+        Stroke {
+            role,
+            points: pts.iter().map(|p| DVec2::new(p.0, p.1)).collect(),
+            closed,
+            piece: Some(piece),
+            outer,
+        }
+    }
+
+    fn square(piece: usize, x: f64, size: f64, outer: bool) -> Stroke {
+        s(
+            StrokeRole::Cut,
+            piece,
+            &[
+                (x, 0.0),
+                (x + size, 0.0),
+                (x + size, size),
+                (x, size),
+                (x, 0.0),
+            ],
+            outer,
+        )
+    }
+
+    /// Draw, fold, hole, outline; per piece or across the sheet.
+    #[test]
+    fn groups_and_per_piece_order() {
+        let strokes = vec![
+            square(0, 0.0, 50.0, true),
+            square(1, 100.0, 50.0, true),
+            square(1, 110.0, 10.0, false),
+            s(StrokeRole::Label, 1, &[(120.0, 30.0), (130.0, 30.0)], false),
+            s(
+                StrokeRole::FoldValley,
+                0,
+                &[(0.0, 25.0), (50.0, 25.0)],
+                false,
+            ),
+            s(StrokeRole::Label, 0, &[(20.0, 30.0), (30.0, 30.0)], false),
+            s(StrokeRole::Weed, 0, &[(60.0, 0.0), (60.0, 50.0)], false).with_piece(None),
+        ];
+        let key = |v: &[Stroke]| -> Vec<(StrokeRole, Option<usize>, bool)> {
+            v.iter().map(|s| (s.role, s.piece, s.outer)).collect()
+        };
+        use StrokeRole::*;
+        assert_eq!(
+            key(&order_sheet(strokes.clone(), false)),
+            vec![
+                (Label, Some(0), false),
+                (Label, Some(1), false),
+                (FoldValley, Some(0), false),
+                (Cut, Some(1), false),
+                (Cut, Some(1), true),
+                (Cut, Some(0), true),
+                (Weed, None, false),
+            ]
+        );
+        assert_eq!(
+            key(&order_sheet(strokes, true)),
+            vec![
+                (Label, Some(0), false),
+                (FoldValley, Some(0), false),
+                (Cut, Some(0), true),
+                (Label, Some(1), false),
+                (Cut, Some(1), false),
+                (Cut, Some(1), true),
+                (Weed, None, false),
+            ]
+        );
+    }
+
+    impl Stroke {
+        fn with_piece(mut self, piece: Option<usize>) -> Stroke {
+            self.piece = piece;
+            self
+        }
+    }
 }
