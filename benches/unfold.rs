@@ -17,6 +17,7 @@ fn fandisk() -> Surface {
         source: path,
         mesh,
         warnings,
+        bends: None,
     }
 }
 

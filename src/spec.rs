@@ -6,7 +6,7 @@
 //! device = "hpgl-pens"     # optional device profile name
 //!
 //! [[surface]]              # one or more
-//! kind = "mesh"            # required; only "mesh" for now (later: "strip", "fitting", ...)
+//! kind = "mesh"            # required: "mesh" or "strip"
 //! path = "cube.obj"        # required for mesh; relative to the spec file's directory
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
@@ -65,6 +65,29 @@
 //!   mesh cannot be read), or 0 for a spec made from a mesh file by [`Spec::from_mesh`].
 //! - Surface paths are resolved against the spec file's directory as written (no
 //!   canonicalising, no `~` expansion); an absolute path stays as it is.
+//!
+//! # Strips (issue 4)
+//!
+//! A `kind = "strip"` surface is a developable strip between two boundary curves (see
+//! `surface::strip`), with keys `p` and `q` (required), `method` ("godt+gmbt" default,
+//! "godt", "gmbt", "gmat", "local"), `bend_lines` ("all" default, "none", or a spacing in mm)
+//! and `tolerance` (chordal, mm, default 0.05), besides `name`. A curve is an inline list of
+//! points (`p = [[0, 0, 0], [100, 0, 0]]`, open) or a table with a `kind`:
+//!
+//! ```toml
+//! p = { kind = "points", points = [[0, 0], [100, 0, 5]], closed = false }
+//! p = { kind = "csv", path = "edge.csv", closed = true }   # relative to the spec's folder
+//! p = { kind = "circle", center = [0, 0, 0], radius = 100 }  # or diameter = 200
+//! p = { kind = "ellipse", center = [0, 0, 150], rx = 80, ry = 50 }
+//! p = { kind = "rect", center = [0, 0, 0], width = 400, height = 300, corner_radius = 0 }
+//! p = { kind = "bezier", control = [[0, 0, 0], [50, 80, 0], [100, 0, 20]] }
+//! p = { kind = "bspline", control = [...], degree = 3, closed = false }
+//! ```
+//!
+//! Points have 2 or 3 coordinates (z = 0 when left out). A curve's keys are checked when the
+//! spec is read (errors name `surface[k].p.radius` and the line of `p`), the curves are
+//! sampled there too, and `q` equal to `p` is an error. A strip in a spec is developed as
+//! given; the neutral-surface shift of sheet metal is the `fitting` command's.
 
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
@@ -108,6 +131,22 @@ pub struct SurfaceSpec {
     pub name: String,
     /// 1-based line of this entry's `path` value in the spec; 0 when there is no spec file.
     pub line: usize,
+    /// The curves and settings of a [`SurfaceKind::Strip`]; `None` for other kinds.
+    pub strip: Option<StripSpec>,
+}
+
+/// A strip between two boundary curves (`kind = "strip"`, or built by `flatcut fitting`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StripSpec {
+    pub p: crate::geom::curve::Curve,
+    pub q: crate::geom::curve::Curve,
+    pub method: crate::surface::strip::Method,
+    pub bend_lines: crate::surface::strip::BendLines,
+    /// Chordal tolerance for sampling the curves (mm).
+    pub tolerance: f64,
+    /// How far (mm) the developed surface lies inside the given one: (1 − K)·t for a metal
+    /// blank given by its outside, 0 to develop the given surface.
+    pub neutral_offset: f64,
 }
 
 /// How a surface is made.
@@ -116,6 +155,8 @@ pub enum SurfaceKind {
     /// A polyhedral mesh file (OBJ) whose faces are flat panels.
     #[default]
     Mesh,
+    /// A developable strip between two boundary curves.
+    Strip,
 }
 
 /// Length units of a surface's source coordinates.
@@ -217,11 +258,13 @@ fn pick<T: Copy>(s: &str, table: &[(&str, T)]) -> Result<T, String> {
 }
 
 impl SurfaceKind {
-    const NAMES: [(&'static str, SurfaceKind); 1] = [("mesh", SurfaceKind::Mesh)];
+    const NAMES: [(&'static str, SurfaceKind); 2] =
+        [("mesh", SurfaceKind::Mesh), ("strip", SurfaceKind::Strip)];
 
     pub fn as_str(self) -> &'static str {
         match self {
             SurfaceKind::Mesh => "mesh",
+            SurfaceKind::Strip => "strip",
         }
     }
 }
@@ -385,6 +428,7 @@ impl Spec {
                 units: Units::Mm,
                 name,
                 line: 0,
+                strip: None,
             }],
             material: Material::default(),
             sheet: SheetSpec::default(),
@@ -445,6 +489,11 @@ struct RawSurface {
     scale: Option<Spanned<Val>>,
     units: Option<Spanned<Val>>,
     name: Option<Spanned<Val>>,
+    p: Option<Spanned<toml::Value>>,
+    q: Option<Spanned<toml::Value>>,
+    method: Option<Spanned<Val>>,
+    bend_lines: Option<Spanned<Val>>,
+    tolerance: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -856,11 +905,12 @@ impl Ctx<'_> {
                         &kind_key,
                         format!(
                             "missing: each [[surface]] needs a `kind`, {}",
-                            one_of(&["mesh"])
+                            one_of(&["mesh", "strip"])
                         ),
                     )
                 })?;
             match kind {
+                SurfaceKind::Strip => out.push(self.strip_surface(s, &key, header_line, dir)?),
                 SurfaceKind::Mesh => {
                     let path_key = format!("{key}.path");
                     let rel = self.string(
@@ -902,6 +952,7 @@ impl Ctx<'_> {
                         units,
                         name,
                         line,
+                        strip: None,
                     });
                 }
             }
@@ -1039,6 +1090,337 @@ impl Ctx<'_> {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Strips (issue 4): `kind = "strip"` with curves `p` and `q`
+// ---------------------------------------------------------------------------------------------
+
+impl Ctx<'_> {
+    /// One `kind = "strip"` entry.
+    fn strip_surface(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        header_line: usize,
+        dir: &Path,
+    ) -> Result<SurfaceSpec, SpecError> {
+        use crate::surface::strip::{BendLines, Method};
+        for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
+            if let Some(v) = v {
+                return Err(self.invalid(
+                    self.line(v.span()),
+                    &format!("{key}.{k}"),
+                    "is for mesh surfaces; a strip takes the curves `p` and `q`".to_string(),
+                ));
+            }
+        }
+        let tolerance = self
+            .number(
+                &s.tolerance,
+                &format!("{key}.tolerance"),
+                MM_POSITIVE,
+                |v| v > 0.0,
+            )?
+            .map_or(crate::geom::curve::DEFAULT_TOLERANCE, |(v, _)| v);
+        let method = self
+            .choice(&s.method, &format!("{key}.method"), &Method::NAMES)?
+            .unwrap_or_default();
+        let bend_lines = match &s.bend_lines {
+            None => BendLines::All,
+            Some(v) => match v.get_ref() {
+                Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => BendLines::All,
+                Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => BendLines::None,
+                Val::Num(x) if x.is_finite() && *x > 0.0 => BendLines::Spacing(*x),
+                _ => {
+                    return Err(self.expected(
+                        v,
+                        &format!("{key}.bend_lines"),
+                        "\"all\", \"none\" or a positive spacing in millimetres",
+                    ))
+                }
+            },
+        };
+        let mut curves = Vec::new();
+        for (name, v) in [("p", &s.p), ("q", &s.q)] {
+            let ck = format!("{key}.{name}");
+            let v = v.as_ref().ok_or_else(|| {
+                self.invalid(
+                    header_line,
+                    &ck,
+                    "missing: a strip needs two boundary curves `p` and `q`".to_string(),
+                )
+            })?;
+            let line = self.line(v.span());
+            let c = self.curve(v.get_ref(), &ck, line, dir)?;
+            let sampled = c.sample(tolerance).map_err(|e| {
+                use crate::geom::curve::CurveError as E;
+                let sub = match &e {
+                    E::NotPositive { what, .. } => format!("{ck}.{what}"),
+                    E::CornerRadius { .. } => format!("{ck}.corner_radius"),
+                    _ => ck.clone(),
+                };
+                self.invalid(line, &sub, e.to_string())
+            })?;
+            curves.push((c, sampled, line));
+        }
+        let (qc, qs, q_line) = curves
+            .pop()
+            .ok_or_else(|| self.invalid(header_line, key, "no q".into()))?;
+        let (pc, ps, p_line) = curves
+            .pop()
+            .ok_or_else(|| self.invalid(header_line, key, "no p".into()))?;
+        if let Err(e) = crate::surface::strip::Strip::new(&ps, &qs) {
+            return Err(self.invalid(q_line, &format!("{key}.q"), e.to_string()));
+        }
+        let name = self
+            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .unwrap_or_else(|| format!("strip{}", key.trim_start_matches("surface")));
+        Ok(SurfaceSpec {
+            kind: SurfaceKind::Strip,
+            path: self.path.to_path_buf(),
+            scale: 1.0,
+            units: Units::Mm,
+            name,
+            line: p_line,
+            strip: Some(StripSpec {
+                p: pc,
+                q: qc,
+                method,
+                bend_lines,
+                tolerance,
+                neutral_offset: 0.0,
+            }),
+        })
+    }
+
+    /// A curve: an inline list of points, or a table with a `kind` (see the module doc).
+    fn curve(
+        &self,
+        v: &toml::Value,
+        key: &str,
+        line: usize,
+        dir: &Path,
+    ) -> Result<crate::geom::curve::Curve, SpecError> {
+        use crate::geom::curve::Curve;
+        use toml::Value;
+        let bad = |k: &str, msg: String| self.invalid(line, k, msg);
+        let t = match v {
+            Value::Array(items) => {
+                return Ok(Curve::Points {
+                    points: self.points(items, key, line)?,
+                    closed: false,
+                })
+            }
+            Value::Table(t) => t,
+            other => {
+                return Err(bad(
+                    key,
+                    format!(
+                        "must be a list of points [[x, y, z], ...] or a table with `kind`, got {}",
+                        other.type_str()
+                    ),
+                ))
+            }
+        };
+        const KINDS: [&str; 7] = [
+            "points", "csv", "circle", "ellipse", "rect", "bezier", "bspline",
+        ];
+        let kind = match t.get("kind") {
+            None if t.contains_key("points") => "points".to_string(),
+            None => {
+                return Err(bad(
+                    &format!("{key}.kind"),
+                    format!("missing: a curve table needs `kind`, {}", one_of(&KINDS)),
+                ))
+            }
+            Some(Value::String(k)) if KINDS.iter().any(|x| x.eq_ignore_ascii_case(k.trim())) => {
+                k.trim().to_ascii_lowercase()
+            }
+            Some(other) => {
+                return Err(bad(
+                    &format!("{key}.kind"),
+                    format!("must be {}, got {other}", one_of(&KINDS)),
+                ))
+            }
+        };
+        let allowed: &[&str] = match kind.as_str() {
+            "points" => &["points", "closed"],
+            "csv" => &["path", "closed"],
+            "circle" => &["center", "radius", "diameter"],
+            "ellipse" => &["center", "rx", "ry"],
+            "rect" => &["center", "width", "height", "corner_radius"],
+            "bezier" => &["control"],
+            _ => &["control", "degree", "closed"],
+        };
+        for k in t.keys() {
+            if k != "kind" && !allowed.contains(&k.as_str()) {
+                return Err(bad(
+                    &format!("{key}.{k}"),
+                    format!(
+                        "unknown key for a {kind} curve; expected {}",
+                        one_of(allowed)
+                    ),
+                ));
+            }
+        }
+        let num = |k: &str| -> Result<Option<f64>, SpecError> {
+            match t.get(k) {
+                None => Ok(None),
+                Some(Value::Integer(i)) => Ok(Some(*i as f64)),
+                Some(Value::Float(f)) if f.is_finite() => Ok(Some(*f)),
+                Some(other) => Err(bad(
+                    &format!("{key}.{k}"),
+                    format!("must be a finite number, got {other}"),
+                )),
+            }
+        };
+        let need = |k: &str| -> Result<f64, SpecError> {
+            num(k)?.ok_or_else(|| {
+                bad(
+                    &format!("{key}.{k}"),
+                    format!("missing: a {kind} curve needs `{k}`"),
+                )
+            })
+        };
+        let closed = match t.get("closed") {
+            None => false,
+            Some(Value::Boolean(b)) => *b,
+            Some(other) => {
+                return Err(bad(
+                    &format!("{key}.closed"),
+                    format!("must be true or false, got {other}"),
+                ))
+            }
+        };
+        let center = match t.get("center") {
+            None => glam::DVec3::ZERO,
+            Some(Value::Array(a)) => self.point(a, &format!("{key}.center"), line)?,
+            Some(other) => {
+                return Err(bad(
+                    &format!("{key}.center"),
+                    format!("must be [x, y] or [x, y, z], got {other}"),
+                ))
+            }
+        };
+        let list = |k: &str| -> Result<Vec<glam::DVec3>, SpecError> {
+            match t.get(k) {
+                Some(Value::Array(items)) => self.points(items, &format!("{key}.{k}"), line),
+                Some(other) => Err(bad(
+                    &format!("{key}.{k}"),
+                    format!("must be a list of points [[x, y, z], ...], got {other}"),
+                )),
+                None => Err(bad(
+                    &format!("{key}.{k}"),
+                    format!("missing: a {kind} curve needs `{k}`"),
+                )),
+            }
+        };
+        Ok(match kind.as_str() {
+            "points" => Curve::Points {
+                points: list("points")?,
+                closed,
+            },
+            "csv" => match t.get("path") {
+                Some(Value::String(p)) if !p.trim().is_empty() => Curve::Csv {
+                    path: dir.join(p),
+                    closed,
+                },
+                _ => return Err(bad(
+                    &format!("{key}.path"),
+                    "must be a non-empty string naming a CSV file, relative to the spec's folder"
+                        .into(),
+                )),
+            },
+            "circle" => {
+                let radius = match (num("radius")?, num("diameter")?) {
+                    (Some(r), None) => r,
+                    (None, Some(d)) => 0.5 * d,
+                    _ => {
+                        return Err(bad(
+                            &format!("{key}.radius"),
+                            "a circle needs exactly one of `radius` and `diameter`".into(),
+                        ))
+                    }
+                };
+                Curve::Circle { center, radius }
+            }
+            "ellipse" => Curve::Ellipse {
+                center,
+                rx: need("rx")?,
+                ry: need("ry")?,
+            },
+            "rect" => Curve::Rect {
+                center,
+                width: need("width")?,
+                height: need("height")?,
+                corner_radius: num("corner_radius")?.unwrap_or(0.0),
+            },
+            "bezier" => Curve::Bezier {
+                control: list("control")?,
+            },
+            _ => {
+                let degree = match num("degree")? {
+                    None => 3,
+                    Some(d) if (1.0..=10.0).contains(&d) && d.fract() == 0.0 => d as usize,
+                    Some(d) => {
+                        return Err(bad(
+                            &format!("{key}.degree"),
+                            format!("must be a whole number from 1 to 10, got {d}"),
+                        ))
+                    }
+                };
+                Curve::BSpline {
+                    control: list("control")?,
+                    degree,
+                    closed,
+                }
+            }
+        })
+    }
+
+    fn points(
+        &self,
+        items: &[toml::Value],
+        key: &str,
+        line: usize,
+    ) -> Result<Vec<glam::DVec3>, SpecError> {
+        items
+            .iter()
+            .enumerate()
+            .map(|(k, it)| match it {
+                toml::Value::Array(a) => self.point(a, &format!("{key}[{}]", k + 1), line),
+                other => Err(self.invalid(
+                    line,
+                    &format!("{key}[{}]", k + 1),
+                    format!("must be a point [x, y] or [x, y, z], got {other}"),
+                )),
+            })
+            .collect()
+    }
+
+    fn point(&self, a: &[toml::Value], key: &str, line: usize) -> Result<glam::DVec3, SpecError> {
+        let v: Option<Vec<f64>> = a
+            .iter()
+            .map(|x| match x {
+                toml::Value::Integer(i) => Some(*i as f64),
+                toml::Value::Float(f) if f.is_finite() => Some(*f),
+                _ => None,
+            })
+            .collect();
+        match v {
+            Some(v) if v.len() == 2 || v.len() == 3 => Ok(glam::DVec3::new(
+                v[0],
+                v[1],
+                v.get(2).copied().unwrap_or(0.0),
+            )),
+            _ => Err(self.invalid(
+                line,
+                key,
+                "must be a point of 2 or 3 finite numbers, [x, y] or [x, y, z]".to_string(),
+            )),
+        }
+    }
+}
+
 /// Joins a multi-line message into one line.
 fn one_line(s: &str) -> String {
     s.lines()
@@ -1145,6 +1527,7 @@ fold_threshold = 1.0
                     units: Units::Mm,
                     name: "box".into(),
                     line: 6,
+                    strip: None,
                 }],
                 material: Material {
                     kind: MaterialKind::Paper,
@@ -1239,6 +1622,7 @@ fold_threshold = 179.5
                 units: Units::Mm,
                 name: "lamp".into(),
                 line: 3,
+                strip: None,
             }]
         );
         assert_eq!(
@@ -1512,9 +1896,9 @@ fold_threshold = 179.5
 
     #[test]
     fn bad_surface_kind_lists_allowed() {
-        let (line, key, message) = invalid("[[surface]]\nkind = \"strip\"\npath = \"a.obj\"\n");
+        let (line, key, message) = invalid("[[surface]]\nkind = \"nurbs\"\npath = \"a.obj\"\n");
         assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
-        assert_eq!(message, "must be one of mesh, got \"strip\"");
+        assert_eq!(message, "must be one of mesh, strip, got \"nurbs\"");
     }
 
     #[test]
@@ -1615,6 +1999,7 @@ fold_threshold = 179.5
                     units: Units::Mm,
                     name: "Cube".into(),
                     line: 0,
+                    strip: None,
                 }]
             );
             assert_eq!(

@@ -1,7 +1,8 @@
 //! `flatcut cut SPEC|OBJ`: the whole pipeline. Reads the spec (or a bare OBJ with defaults),
 //! applies the device profile and the flags (flags win), unfolds, nests, orders the strokes and
 //! writes into `-o DIR`: the program for the device (`<name>.plt`, or `<name>-<k>.plt` per sheet
-//! when there are several), `<name>.svg`, `<name>-<k>.png` per sheet and `report.json`, each
+//! when there are several), `<name>.svg`, `<name>-<k>.png` per sheet, `<name>.dxf` (or
+//! `<name>-<k>.dxf`) per sheet and `report.json`, each
 //! written whole or not at all. Then, unless `--dry-run`, the program is streamed to the
 //! device: the simulated cutter for `sim` (the default) or with `--simulate`, else the serial
 //! port given by `--port` (see [`super::link`]). The files are written before anything is
@@ -176,6 +177,12 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     if let Some(m) = a.material {
         spec.material.kind = m;
     }
+    run_spec(spec, a)
+}
+
+/// The rest of `cut` for a spec already in hand (`cut` reads it from a file, `fitting` builds
+/// it from its flags): the pattern flags on top, plan, write the files, send.
+pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     a.pattern.apply(&mut spec)?;
     let device = a
         .device
@@ -221,6 +228,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         programs.push((name, bytes));
     }
     files.extend(super::flatten::write_pictures(&dir, &spec.name, &job)?);
+    files.extend(write_dxf(&dir, &spec.name, &layout)?);
     files.push("report.json".into());
     let info = RunInfo {
         name: spec.name.clone(),
@@ -275,4 +283,27 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.
+pub fn write_dxf(
+    dir: &Path,
+    name: &str,
+    layout: &crate::nest::Layout,
+) -> Result<Vec<String>, Error> {
+    let n = layout.sheets.len();
+    let mut files = Vec::new();
+    for i in 0..n {
+        let file = if n == 1 {
+            format!("{name}.dxf")
+        } else {
+            format!("{name}-{}.dxf", i + 1)
+        };
+        write_atomic(
+            &dir.join(&file),
+            crate::output::dxf::render(layout, i).as_bytes(),
+        )?;
+        files.push(file);
+    }
+    Ok(files)
 }

@@ -4,6 +4,7 @@
 
 pub mod check;
 pub mod cut;
+pub mod fitting;
 pub mod flatten;
 pub mod link;
 pub mod ports;
@@ -23,6 +24,8 @@ Examples:
   flatcut cut lamp.obj --device hpgl-pens --dry-run   a bare OBJ with defaults (paper, A4, 5 mm margin)
   flatcut cut box.toml --material fabric -o out       flags override the spec file
   flatcut flatten patterns/house.toml -o out/house    pieces only, as SVG and PNG
+  flatcut fitting cone --bottom-diameter 300 --top-diameter 160 --height 200 --thickness 2 --dry-run
+  flatcut fitting square-to-round --width 400 --depth 300 --diameter 250 --height 300 --bend-lines 50
   flatcut check model.obj                             faces, edges, boundary loops, angle defect
   flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
   flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
@@ -44,6 +47,10 @@ pub enum Command {
     /// Unfold, nest and write the cut program (and pictures, report) for a spec or an OBJ.
     #[command(after_help = EXAMPLES)]
     Cut(cut::CutArgs),
+    /// Develop a sheet-metal fitting (cone, square-to-round, rect-to-rect, pipe-miter,
+    /// lampshade) from shop dimensions in mm and cut it like `cut` does.
+    #[command(after_help = EXAMPLES)]
+    Fitting(Box<fitting::FittingArgs>),
     /// Unfold and write the pieces (SVG, PNG, report) without nesting on sheets.
     #[command(after_help = EXAMPLES)]
     Flatten(flatten::FlattenArgs),
@@ -66,6 +73,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Cut(a) => cut::run(&a),
+        Command::Fitting(a) => fitting::run(&a),
         Command::Flatten(a) => flatten::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Send(a) => send::run(&a),

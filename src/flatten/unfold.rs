@@ -418,6 +418,7 @@ pub(crate) mod tests {
             source: PathBuf::from("t.obj"),
             mesh,
             warnings: Vec::new(),
+            bends: None,
         }
     }
 

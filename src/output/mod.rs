@@ -1,6 +1,7 @@
 //! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
 //! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
-//! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]).
+//! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
+//! the nested layout for CAD/CAM ([`dxf`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
@@ -18,6 +19,7 @@ use crate::device::{Language, Profile};
 use crate::toolpath::{SheetJob, StrokeRole};
 use glam::DVec2;
 
+pub mod dxf;
 pub mod gcode;
 pub mod hpgl;
 pub mod png;

@@ -17,6 +17,8 @@
 //! 10 mm seam allowance, notches every 50 mm and a grain line, metal its bend notes; the plain
 //! [`Default`] adds nothing, for callers that only want the net.
 
+pub mod bends;
+
 use crate::flatten::Flat;
 use crate::geom::polygon;
 use crate::spec::MaterialKind;
@@ -406,14 +408,16 @@ fn net(
         border_faces.push(owners);
     }
 
-    // Folds.
-    let threshold = opts.fold_threshold_deg.to_radians();
+    // Folds: edges whose bend passes the threshold, or the bend lines the surface names.
+    let fold_at = bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
     let mut folds = Vec::new();
     for &f in faces {
         for (i, &e) in topo.face_edges[f].iter().enumerate() {
             // Each fold once: from the face listed first on the edge.
-            let d = flat.dihedral[e];
-            if flat.joined[e] && topo.edges[e].uses[0] == (f, i) && d.abs() > threshold {
+            if !flat.joined[e] || topo.edges[e].uses[0] != (f, i) {
+                continue;
+            }
+            if let Some(d) = fold_at[e] {
                 let (a, b) = flat.corner_edge(f, i);
                 folds.push(Fold {
                     a,

@@ -2,11 +2,14 @@
 //! own file; all of them produce a [`Surface`]: a polygon mesh in millimetres whose faces are
 //! flat panels, with its name and the file it came from.
 //!
-//! For now the only source is a polyhedral mesh ([`obj`]); strips, fittings, boundary and
-//! geodesic developables will add files here (see shared/seeds/README.md).
+//! Sources: a polyhedral mesh ([`obj`]), a developable strip between two boundary curves
+//! ([`strip`], Wang–Tang) and the sheet-metal fittings built on strips ([`fittings`]); boundary
+//! and geodesic developables will add files here (see shared/seeds/README.md).
 
+pub mod fittings;
 pub mod obj;
 pub mod solids;
+pub mod strip;
 
 use crate::geom::mesh::Mesh;
 use crate::spec::{SurfaceKind, SurfaceSpec};
@@ -24,6 +27,18 @@ pub struct Surface {
     pub mesh: Mesh,
     /// Repairs made on import, one line each, for the user to read.
     pub warnings: Vec<String>,
+    /// Which edges are bend (or score) lines, when the source decides it (strips: the chosen
+    /// rulings, with their angles); `None` leaves it to the pattern stage's angle threshold.
+    pub bends: Option<Vec<Bend>>,
+}
+
+/// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
+/// bend angle it stands for, in degrees, positive for a mountain (convex seen from the printed
+/// side). With rulings picked at a spacing, the angle is the sum over the rulings it replaces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bend {
+    pub verts: [usize; 2],
+    pub angle_deg: f64,
 }
 
 /// Everything that can be wrong with a surface source. Each message is one line that names the
@@ -59,6 +74,8 @@ pub enum SurfaceError {
         count: usize,
         lines: String,
     },
+    #[error("surface `{surface}`: {message}")]
+    Strip { surface: String, message: String },
     #[error("{}{}: the mesh is not orientable (a Möbius-like band): its faces cannot all be wound the same way", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     NonOrientable { path: PathBuf, line: Option<usize> },
 }
@@ -75,7 +92,57 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
                 source: spec.path.clone(),
                 mesh,
                 warnings,
+                bends: None,
             })
         }
+        SurfaceKind::Strip => build_strip(spec),
     }
+}
+
+/// A [`strip`] surface: sample both curves, triangulate, move to the neutral surface, pick the
+/// bend lines.
+fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
+    let err = |message: String| SurfaceError::Strip {
+        surface: spec.name.clone(),
+        message,
+    };
+    let st = spec
+        .strip
+        .as_ref()
+        .ok_or_else(|| err("a strip needs `p` and `q`".into()))?;
+    let p =
+        st.p.sample(st.tolerance)
+            .map_err(|e| err(format!("`p`: {e}")))?;
+    let q =
+        st.q.sample(st.tolerance)
+            .map_err(|e| err(format!("`q`: {e}")))?;
+    let mut s = strip::Strip::new(&p, &q).map_err(|e| err(e.to_string()))?;
+    let steps = s.triangulate(st.method);
+    let mut warnings = Vec::new();
+    let mt = s.metrics(&steps);
+    if mt.convex < mt.interior && st.method != strip::Method::Gmat {
+        warnings.push(format!(
+            "surface `{}`: {} of {} rulings are not locally convex: the blank will need some stretching there",
+            spec.name,
+            mt.interior - mt.convex,
+            mt.interior
+        ));
+    }
+    if st.neutral_offset > 0.0 {
+        let reach = s.inner_reach();
+        if st.neutral_offset >= reach {
+            return Err(err(format!(
+                "the neutral surface lies {:.3} mm inside, more than the curves allow ({reach:.3} mm from their centre): the thickness is larger than a radius",
+                st.neutral_offset
+            )));
+        }
+        s = s.offset(&steps, st.neutral_offset);
+    }
+    Ok(Surface {
+        name: spec.name.clone(),
+        source: spec.path.clone(),
+        mesh: s.mesh(&steps),
+        warnings,
+        bends: Some(s.bends(&steps, st.bend_lines)),
+    })
 }

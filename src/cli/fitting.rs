@@ -1,0 +1,268 @@
+//! `flatcut fitting KIND`: a sheet-metal fitting from shop dimensions in millimetres (see
+//! [`crate::surface::fittings`]), developed as a strip and sent through the same pipeline as
+//! `cut` ([`super::cut::run_spec`]): the same device, `--dry-run` and `-o` handling, the same
+//! files (program, SVG, PNG, DXF, report).
+//!
+//! Choices: the material is metal unless `--material` says otherwise; the thickness defaults to
+//! 0 (develop the given surface), K to 0.4; the sheet is 2500 × 1250 mm (a common steel sheet)
+//! unless `--sheet-width` / `--sheet-height` say otherwise, with a 10 mm margin; the job is
+//! named after the kind (`cone`, `square-to-round`, …) unless `--name` is given; the device,
+//! as for `cut`, defaults to `sim`.
+
+use super::cut::{run_spec, CutArgs};
+use crate::spec::{
+    Material, MaterialKind, PatternSpec, SheetSpec, Spec, SurfaceKind, SurfaceSpec, Units,
+};
+use crate::surface::fittings::{Fitting, FittingOptions};
+use crate::surface::strip::BendLines;
+use crate::Error;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// Kinds of fitting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FittingKind {
+    /// Frustum between two circles (`--offset` for an offset hopper cone).
+    Cone,
+    /// Rectangle to circle transition.
+    SquareToRound,
+    /// Rectangle to rectangle transition.
+    RectToRect,
+    /// One segment of a mitred pipe elbow.
+    PipeMiter,
+    /// Between two circles, or ellipses with `--bottom-depth` / `--top-depth`.
+    Lampshade,
+}
+
+#[derive(Debug, Args)]
+pub struct FittingArgs {
+    /// What to make.
+    pub kind: FittingKind,
+    /// Cone, lampshade: bottom diameter (mm; the x axis of an ellipse).
+    #[arg(long, allow_negative_numbers = true)]
+    pub bottom_diameter: Option<f64>,
+    /// Cone, lampshade: top diameter (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub top_diameter: Option<f64>,
+    /// Lampshade: bottom ellipse's y axis (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub bottom_depth: Option<f64>,
+    /// Lampshade: top ellipse's y axis; rect-to-rect: top rectangle depth (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub top_depth: Option<f64>,
+    /// Height between the two ends (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub height: Option<f64>,
+    /// Cone: the top's centre moved along x (mm), for an offset cone.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub offset: f64,
+    /// Square-to-round, rect-to-rect: rectangle width along x (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub width: Option<f64>,
+    /// Square-to-round, rect-to-rect: rectangle depth along y (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub depth: Option<f64>,
+    /// Square-to-round, pipe-miter: diameter of the round end or the pipe (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub diameter: Option<f64>,
+    /// Rect-to-rect: top rectangle width (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub top_width: Option<f64>,
+    /// Square-to-round, rect-to-rect: top moved along x (mm).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub offset_x: f64,
+    /// Square-to-round, rect-to-rect: top moved along y (mm).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub offset_y: f64,
+    /// Pipe-miter: centre-line length (mm).
+    #[arg(long, allow_negative_numbers = true)]
+    pub length: Option<f64>,
+    /// Pipe-miter: cut angle from square (degrees; 45 for a two-piece 90° elbow).
+    #[arg(long, allow_negative_numbers = true)]
+    pub angle: Option<f64>,
+    /// Sheet thickness (mm); 0 develops the given surface, more develops the neutral surface.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub thickness: f64,
+    /// Neutral surface position from the inside face, as a fraction of the thickness.
+    #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
+    pub k_factor: f64,
+    /// Bend lines: all, none, or a spacing in mm (rulings about that far apart, each with the
+    /// angle accumulated since the previous one).
+    #[arg(long, default_value = "all", value_parser = parse_bend_lines)]
+    pub bend_lines: BendLines,
+    /// Chordal tolerance of the curves (mm).
+    #[arg(long, default_value_t = crate::geom::curve::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    /// Sheet width (mm).
+    #[arg(long, default_value_t = 2500.0)]
+    pub sheet_width: f64,
+    /// Sheet height (mm).
+    #[arg(long, default_value_t = 1250.0)]
+    pub sheet_height: f64,
+    /// Job name (file names, labels); default: the kind.
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Directory for the program, pictures, DXF and report (default: out/<name>).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Device profile (default `sim`).
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Material: metal (default), paper or fabric.
+    #[arg(long)]
+    pub material: Option<MaterialKind>,
+    /// Write the program and pictures but send nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+    #[command(flatten)]
+    pub link: super::link::LinkArgs,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `all`, `none` or a positive number of millimetres.
+pub fn parse_bend_lines(s: &str) -> Result<BendLines, String> {
+    match s.trim().to_ascii_lowercase().as_str() {
+        "all" => Ok(BendLines::All),
+        "none" => Ok(BendLines::None),
+        t => match t.parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(BendLines::Spacing(v)),
+            _ => Err(format!(
+                "expected all, none or a spacing in mm more than 0, got {s:?}"
+            )),
+        },
+    }
+}
+
+fn need(v: Option<f64>, flag: &str, kind: &str) -> Result<f64, Error> {
+    v.ok_or_else(|| Error::Usage(format!("--{flag}: missing: a {kind} needs it")))
+}
+
+/// The fitting the flags describe.
+pub fn fitting(a: &FittingArgs) -> Result<Fitting, Error> {
+    let k = match a.kind {
+        FittingKind::Cone => "cone",
+        FittingKind::SquareToRound => "square-to-round",
+        FittingKind::RectToRect => "rect-to-rect",
+        FittingKind::PipeMiter => "pipe-miter",
+        FittingKind::Lampshade => "lampshade",
+    };
+    Ok(match a.kind {
+        FittingKind::Cone => Fitting::Cone {
+            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)?,
+            top_diameter: need(a.top_diameter, "top-diameter", k)?,
+            height: need(a.height, "height", k)?,
+            offset: a.offset,
+        },
+        FittingKind::SquareToRound => Fitting::SquareToRound {
+            width: need(a.width, "width", k)?,
+            depth: need(a.depth, "depth", k)?,
+            diameter: need(a.diameter, "diameter", k)?,
+            height: need(a.height, "height", k)?,
+            offset_x: a.offset_x,
+            offset_y: a.offset_y,
+        },
+        FittingKind::RectToRect => Fitting::RectToRect {
+            width: need(a.width, "width", k)?,
+            depth: need(a.depth, "depth", k)?,
+            top_width: need(a.top_width, "top-width", k)?,
+            top_depth: need(a.top_depth, "top-depth", k)?,
+            height: need(a.height, "height", k)?,
+            offset_x: a.offset_x,
+            offset_y: a.offset_y,
+        },
+        FittingKind::PipeMiter => Fitting::PipeMiter {
+            diameter: need(a.diameter, "diameter", k)?,
+            length: need(a.length, "length", k)?,
+            angle_deg: need(a.angle, "angle", k)?,
+        },
+        FittingKind::Lampshade => Fitting::Lampshade {
+            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)?,
+            bottom_depth: a.bottom_depth,
+            top_diameter: need(a.top_diameter, "top-diameter", k)?,
+            top_depth: a.top_depth,
+            height: need(a.height, "height", k)?,
+        },
+    })
+}
+
+/// The spec `fitting` cuts: one strip surface, metal, one big sheet.
+pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
+    let f = fitting(a)?;
+    let opts = FittingOptions {
+        thickness: a.thickness,
+        k_factor: a.k_factor,
+        bend_lines: a.bend_lines,
+        tolerance: a.tolerance,
+    };
+    if !(a.tolerance.is_finite() && a.tolerance > 0.0) {
+        return Err(Error::Usage(format!(
+            "--tolerance: must be more than 0 mm, got {}",
+            a.tolerance
+        )));
+    }
+    for (flag, v) in [
+        ("sheet-width", a.sheet_width),
+        ("sheet-height", a.sheet_height),
+    ] {
+        if !(v.is_finite() && v > 20.0) {
+            return Err(Error::Usage(format!(
+                "--{flag}: must be more than twice the 10 mm margin, got {v}"
+            )));
+        }
+    }
+    let strip = f
+        .strip_spec(&opts)
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    let name = a.name.clone().unwrap_or_else(|| f.kind().to_string());
+    if name.trim().is_empty() {
+        return Err(Error::Usage("--name: must not be empty".into()));
+    }
+    let path = PathBuf::from(format!("fitting {}", f.kind()));
+    let kind = a.material.unwrap_or(MaterialKind::Metal);
+    Ok(Spec {
+        name: name.clone(),
+        path: path.clone(),
+        device: None,
+        surfaces: vec![SurfaceSpec {
+            kind: SurfaceKind::Strip,
+            path,
+            scale: 1.0,
+            units: Units::Mm,
+            name,
+            line: 0,
+            strip: Some(strip),
+        }],
+        material: Material {
+            kind,
+            thickness: if a.thickness > 0.0 {
+                a.thickness
+            } else {
+                kind.default_thickness()
+            },
+        },
+        sheet: SheetSpec {
+            width: a.sheet_width,
+            height: Some(a.sheet_height),
+            margin: 10.0,
+            spacing: 5.0,
+        },
+        pattern: PatternSpec::default(),
+    })
+}
+
+pub fn run(a: &FittingArgs) -> Result<(), Error> {
+    let spec = spec(a)?;
+    let cut = CutArgs {
+        input: spec.path.clone(),
+        output: a.output.clone(),
+        device: a.device.clone(),
+        material: None,
+        pattern: Default::default(),
+        dry_run: a.dry_run,
+        link: a.link.clone(),
+        quiet: a.quiet,
+    };
+    run_spec(spec, &cut)
+}
