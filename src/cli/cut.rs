@@ -32,6 +32,20 @@ pub struct CutArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    #[command(flatten)]
+    pub toolpath: ToolpathArgs,
+    #[command(flatten)]
+    pub pattern: super::PatternArgs,
+    #[command(flatten)]
+    pub link: super::link::LinkArgs,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Flags of the toolpath stage (ordering, folds, weeding, drag knife).
+#[derive(Debug, Clone, Default, Args)]
+pub struct ToolpathArgs {
     /// How folds are made: score, perforate (dashes), draw or none (default: score if the
     /// device has a scoring tool, else perforate, else draw).
     #[arg(long, value_enum)]
@@ -46,13 +60,6 @@ pub struct CutArgs {
     /// compensation).
     #[arg(long)]
     pub knife_offset: Option<f64>,
-    #[command(flatten)]
-    pub pattern: super::PatternArgs,
-    #[command(flatten)]
-    pub link: super::link::LinkArgs,
-    /// Print nothing but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
 }
 
 /// `--folds`: the tool that makes folds.
@@ -190,7 +197,8 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
     let mut profile = crate::device::profile::find(&device)?;
-    apply_flags(&mut profile, a.folds, a.knife_offset)?;
+    let t = &a.toolpath;
+    apply_flags(&mut profile, t.folds, t.knife_offset)?;
     if !a.dry_run && !super::link::simulated(&profile, &a.link) && a.link.port.is_none() {
         return Err(Error::Usage(format!(
             "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
@@ -198,13 +206,13 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         )));
     }
     let (flats, layout, job) = plan_job_with(&spec, &profile, a.quiet, |tp| {
-        if let Some(p) = a.per_piece {
+        if let Some(p) = t.per_piece {
             tp.per_piece = p;
         }
-        if a.folds == Some(FoldChoice::None) {
+        if t.folds == Some(FoldChoice::None) {
             tp.skip_folds = true;
         }
-        if a.weed {
+        if t.weed {
             tp.weed = Some(crate::toolpath::weed::WeedOptions::default());
         }
     })?;

@@ -260,6 +260,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         device: a.device.clone(),
         material: None,
         pattern: Default::default(),
+        toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),
         quiet: a.quiet,
