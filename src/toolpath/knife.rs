@@ -3,8 +3,9 @@
 //! precut. [`prepare`] turns the ordered [`Job`] (what the pictures show) into the job the
 //! output stage encodes (what the machine's holder does); the order is kept.
 //!
-//! **Drag knife** (after Inkcut's blade-offset filter, inkcut/device/filters: the holder runs
-//! ahead of the cut by the offset, and turns about the corner): the blade tip trails the
+//! **Drag knife** (the scheme of Inkcut's blade-offset option — the holder runs ahead of the
+//! cut by the offset and turns about the corner —; Inkcut's source was not at hand, so the
+//! details below are flatcut's): the blade tip trails the
 //! holder's axis by `offset` mm and moves only along the line from tip to holder (a tractrix;
 //! the simulated cutter models exactly that, `device::sim::record`). To cut a segment `a → b`
 //! with the blade already pointing along its direction `d`, the holder runs `a + r·d → b + r·d`
