@@ -440,7 +440,6 @@ fn sim_name(p: &Profile, kind: &str) -> String {
 
 #[test]
 fn every_bundled_profile_cuts_the_house_through_the_simulator() {
-    use flatcut::toolpath::StrokeKind;
     let spec = flatcut::spec::load(&manifest("patterns/house.toml")).unwrap();
     for (file, _) in profile::BUNDLED {
         let name = file.trim_end_matches(".toml");
@@ -466,10 +465,15 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
         assert!(rep["tool_down_at_end"].is_null(), "{name}");
         assert!(out.join("sim.png").is_file(), "{name}");
 
-        // What the job asked for, in device units, per tool, with passes.
-        let (_, _, job) = flatcut::cli::cut::plan_job(&spec, &p, true).unwrap();
+        // What the job asked for, in device units, per tool, with passes: the machine's job
+        // (overcut, drag-knife holder path and precut included).
+        let (_, _, design) = flatcut::cli::cut::plan_job(&spec, &p, true).unwrap();
+        let job = flatcut::cli::cut::machine_job(&design, &p, &spec);
         assert_eq!(job.sheets.len(), 1);
         let sheet = &job.sheets[0];
+        // With a drag knife the simulator records the trailing blade tip: what the design
+        // asked for, not the holder's path. The precut comes first.
+        let precut = usize::from(sheet.strokes.len() == design.sheets[0].strokes.len() + 1);
         let hpgl = p.language == flatcut::device::Language::Hpgl;
         let round = |v: f64| {
             if hpgl {
@@ -478,19 +482,31 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
                 (v * 1000.0).round() / 1000.0
             }
         };
-        let mut expected: Vec<(String, Vec<[f64; 2]>)> = Vec::new();
-        for s in &sheet.strokes {
-            let kind: StrokeKind = s.role.kind();
+        let dev = |q: glam::DVec2| {
+            let d = flatcut::output::to_device(&p, sheet.width, sheet.height, q);
+            [round(d.x), round(d.y)]
+        };
+        // (tool, points, drag knife: the design's points instead)
+        type Pts = Vec<[f64; 2]>;
+        let mut expected: Vec<(String, Pts, Option<Pts>)> = Vec::new();
+        for (i, s) in sheet.strokes.iter().enumerate() {
+            let Some(kind) = flatcut::toolpath::tool_kind(s.role, |k| p.has(k)) else {
+                continue;
+            };
             let Some(tool) = p.tool(kind) else { continue };
-            let mut pts: Vec<[f64; 2]> = s
-                .points
-                .iter()
-                .map(|q| {
-                    let d = flatcut::output::to_device(&p, sheet.width, sheet.height, *q);
-                    [round(d.x), round(d.y)]
-                })
-                .collect();
+            let mut pts: Vec<[f64; 2]> = s.points.iter().map(|q| dev(*q)).collect();
             pts.dedup();
+            let tip: Option<Vec<[f64; 2]>> = p.is_drag_knife(kind).then(|| {
+                if i < precut {
+                    pts.clone()
+                } else {
+                    design.sheets[0].strokes[i - precut]
+                        .points
+                        .iter()
+                        .map(|q| dev(*q))
+                        .collect()
+                }
+            });
             let passes = tool.passes.unwrap_or(1) as usize;
             let tool_name = sim_name(&p, kind.name());
             if pts.len() > 1 && pts.first() == pts.last() {
@@ -498,17 +514,17 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
                 for _ in 1..passes {
                     all.extend_from_slice(&pts[1..]);
                 }
-                expected.push((tool_name, all));
+                expected.push((tool_name, all, tip));
             } else {
                 for _ in 0..passes {
-                    expected.push((tool_name.clone(), pts.clone()));
+                    expected.push((tool_name.clone(), pts.clone(), tip.clone()));
                 }
             }
         }
         let got = rep["paths"].as_array().unwrap();
         assert_eq!(got.len(), expected.len(), "{name}: path count");
         let tol = if hpgl { 1.0 } else { 0.002 };
-        for (k, (g, (tool, pts))) in got.iter().zip(&expected).enumerate() {
+        for (k, (g, (tool, pts, tip))) in got.iter().zip(&expected).enumerate() {
             assert_eq!(g["tool"].as_str().unwrap(), tool, "{name}: path {k}");
             let gp: Vec<[f64; 2]> = g["points"]
                 .as_array()
@@ -516,6 +532,33 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
                 .iter()
                 .map(|q| [q[0].as_f64().unwrap(), q[1].as_f64().unwrap()])
                 .collect();
+            if let Some(tip) = tip {
+                // The blade tip stays within 0.06 mm of the line the design asked for (the
+                // precut: within the offset of the holder's line, the blade aligning on it).
+                let upm = p.units_per_mm;
+                let slack = if k == 0 && precut == 1 {
+                    p.knife_offset
+                } else {
+                    0.0
+                };
+                let line: Vec<glam::DVec2> = tip.iter().map(|q| glam::DVec2::from(*q)).collect();
+                for a in &gp {
+                    let a = glam::DVec2::from(*a);
+                    let d = if line.len() == 1 {
+                        a.distance(line[0])
+                    } else {
+                        line.windows(2)
+                            .map(|w| flatcut::geom::polygon::segment_distance(a, w[0], w[1]))
+                            .fold(f64::INFINITY, f64::min)
+                    };
+                    assert!(
+                        d <= (0.06 + slack) * upm + tol,
+                        "{name}: path {k}: blade tip {a} is {} mm off the design",
+                        d / upm
+                    );
+                }
+                continue;
+            }
             assert_eq!(gp.len(), pts.len(), "{name}: path {k} points");
             for (a, b) in gp.iter().zip(pts) {
                 assert!(

@@ -33,6 +33,8 @@ pub struct CutArgs {
     #[arg(long)]
     pub dry_run: bool,
     #[command(flatten)]
+    pub toolpath: ToolpathArgs,
+    #[command(flatten)]
     pub pattern: super::PatternArgs,
     #[command(flatten)]
     pub link: super::link::LinkArgs,
@@ -41,6 +43,83 @@ pub struct CutArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// Flags of the toolpath stage (ordering, folds, weeding, drag knife).
+#[derive(Debug, Clone, Default, Args)]
+pub struct ToolpathArgs {
+    /// How folds are made: score, perforate (dashes), draw or none (default: score if the
+    /// device has a scoring tool, else perforate, else draw).
+    #[arg(long, value_enum)]
+    pub folds: Option<FoldChoice>,
+    /// Finish each piece before the next (default: on for fabric, which may shift).
+    #[arg(long, num_args = 0..=1, default_missing_value = "true")]
+    pub per_piece: Option<bool>,
+    /// Cut weed lines (vinyl): a border round the used area and lines through the waste.
+    #[arg(long)]
+    pub weed: bool,
+    /// Drag-knife blade offset in mm (overrides the profile's `knife_offset`; 0: no
+    /// compensation).
+    #[arg(long)]
+    pub knife_offset: Option<f64>,
+}
+
+/// `--folds`: the tool that makes folds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FoldChoice {
+    Score,
+    Perforate,
+    Draw,
+    None,
+}
+
+/// Make the profile's tool table say how folds are made: the tools that would be picked before
+/// the chosen one are taken out of this job's copy of the profile (folds take the scoring tool,
+/// else the perforating one, else the pen; nothing else uses the first two). A knife offset
+/// given on the command line replaces the profile's.
+pub fn apply_flags(
+    profile: &mut crate::device::Profile,
+    folds: Option<FoldChoice>,
+    knife_offset: Option<f64>,
+) -> Result<(), Error> {
+    if let Some(v) = knife_offset {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::Usage(format!(
+                "--knife-offset must be 0 (off) or a length in mm, got {v}"
+            )));
+        }
+        profile.knife_offset = v;
+    }
+    let (kind, drop): (StrokeKind, &[&str]) = match folds {
+        // `none` leaves the folds out of the job (`ToolpathOptions::skip_folds`).
+        None | Some(FoldChoice::None) => return Ok(()),
+        Some(FoldChoice::Score) => (StrokeKind::Score, &[]),
+        Some(FoldChoice::Perforate) => (StrokeKind::Perforate, &["score"]),
+        Some(FoldChoice::Draw) => (StrokeKind::Draw, &["score", "perforate"]),
+    };
+    if !profile.has(kind) {
+        return Err(Error::Usage(format!(
+            "--folds {}: device `{}` has no {} tool (its tools: {})",
+            kind.name(),
+            profile.name,
+            kind.name(),
+            profile.tools.keys().cloned().collect::<Vec<_>>().join(", ")
+        )));
+    }
+    for k in drop {
+        profile.tools.remove(*k);
+    }
+    Ok(())
+}
+
+/// The job as the device makes it: folds as the profile's tools make them (perforation
+/// dashes), overcut, drag-knife compensation with its alignment precut in the sheet margin.
+pub fn machine_job(
+    job: &crate::toolpath::Job,
+    profile: &crate::device::Profile,
+    spec: &crate::spec::Spec,
+) -> crate::toolpath::Job {
+    crate::toolpath::knife::prepare(job, &profile.machine_options(spec.sheet.margin))
 }
 
 /// Default output directory for a job name.
@@ -63,15 +142,17 @@ pub fn plan_job(
     ),
     Error,
 > {
-    plan_job_with(spec, profile, &Default::default(), quiet)
+    plan_job_with(spec, profile, &Default::default(), quiet, |_| {})
 }
 
-/// [`plan_job`] with the nesting search flags (`--nest-time`, `--seed`, `--threads`).
+/// [`plan_job`] with the nesting search flags (`--nest-time`, `--seed`, `--threads`) and the
+/// toolpath options adjusted by `adjust` (flags).
 pub fn plan_job_with(
     spec: &crate::spec::Spec,
     profile: &crate::device::Profile,
     search: &super::nest::SearchArgs,
     quiet: bool,
+    adjust: impl FnOnce(&mut ToolpathOptions),
 ) -> Result<
     (
         Vec<crate::flatten::Flat>,
@@ -93,10 +174,13 @@ pub fn plan_job_with(
         file: spec.path.clone(),
         source: Box::new(e.into()),
     })?;
-    let tp = ToolpathOptions {
-        skip_folds: profile.tool(StrokeKind::Score).is_none(),
-        skip_drawing: profile.tool(StrokeKind::Draw).is_none(),
+    let mut tp = ToolpathOptions {
+        skip_folds: crate::toolpath::fold_kind(|k| profile.has(k)).is_none(),
+        skip_drawing: !profile.has(StrokeKind::Draw),
+        per_piece: spec.material.kind == MaterialKind::Fabric,
+        weed: None,
     };
+    adjust(&mut tp);
     let job = crate::toolpath::plan(&layout, &spec.name, &tp);
 
     Ok((flats, layout, job))
@@ -119,14 +203,27 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         .clone()
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
-    let profile = crate::device::profile::find(&device)?;
+    let mut profile = crate::device::profile::find(&device)?;
+    let t = &a.toolpath;
+    apply_flags(&mut profile, t.folds, t.knife_offset)?;
     if !a.dry_run && !super::link::simulated(&profile, &a.link) && a.link.port.is_none() {
         return Err(Error::Usage(format!(
             "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
             profile.name
         )));
     }
-    let (flats, layout, job) = plan_job_with(&spec, &profile, &a.search, a.quiet)?;
+    let (flats, layout, job) = plan_job_with(&spec, &profile, &a.search, a.quiet, |tp| {
+        if let Some(p) = t.per_piece {
+            tp.per_piece = p;
+        }
+        if t.folds == Some(FoldChoice::None) {
+            tp.skip_folds = true;
+        }
+        if t.weed {
+            tp.weed = Some(crate::toolpath::weed::WeedOptions::default());
+        }
+    })?;
+    let machine = machine_job(&job, &profile, &spec);
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;
@@ -134,7 +231,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     let mut programs = Vec::new();
     let ext = profile.language.extension();
     let n = job.sheets.len();
-    for (i, sheet) in job.sheets.iter().enumerate() {
+    for (i, sheet) in machine.sheets.iter().enumerate() {
         let name = if n == 1 {
             format!("{}.{ext}", spec.name)
         } else {

@@ -261,6 +261,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         material: None,
         pattern: Default::default(),
         search: Default::default(),
+        toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),
         quiet: a.quiet,

@@ -50,9 +50,11 @@ pub fn cancel_flag() -> Arc<AtomicBool> {
     .clone()
 }
 
-/// Whether this run goes to a simulated cutter.
+/// Whether this run goes to a simulated cutter (the bundled simulator profiles, `sim` and
+/// `sim-dragknife`, go there unless a port is given).
 pub fn simulated(profile: &Profile, link: &LinkArgs) -> bool {
-    link.simulate || (profile.name == "sim" && link.port.is_none())
+    link.simulate
+        || (matches!(profile.name.as_str(), "sim" | "sim-dragknife") && link.port.is_none())
 }
 
 /// Send each program (name, bytes) in turn; returns the lines to print.

@@ -22,6 +22,10 @@ use std::path::{Path, PathBuf};
 pub const BUNDLED: &[(&str, &str)] = &[
     ("sim.toml", include_str!("../../devices/sim.toml")),
     (
+        "sim-dragknife.toml",
+        include_str!("../../devices/sim-dragknife.toml"),
+    ),
+    (
         "hpgl-pens.toml",
         include_str!("../../devices/hpgl-pens.toml"),
     ),
@@ -111,12 +115,24 @@ pub struct Tool {
     pub servo_up: Option<f64>,
     /// Seconds to wait after a servo move (`G4 P`).
     pub dwell: Option<f64>,
+    /// Perforate tool: `[cut_mm, skip_mm]`, the length of each cut dash and of the gap after it
+    /// (default [`DEFAULT_PERFORATION`]).
+    pub perforation: Option<[f64; 2]>,
 }
+
+/// Dashes of a perforated fold when the perforate tool does not say: 3 mm cut, 1 mm uncut
+/// (flatcut's choice: paper folds cleanly along it and still holds while it is handled).
+pub const DEFAULT_PERFORATION: [f64; 2] = [3.0, 1.0];
 
 impl Tool {
     /// Times each stroke is made.
     pub fn passes(&self) -> u32 {
         self.passes.unwrap_or(1)
+    }
+
+    /// `[cut_mm, skip_mm]` of a perforation made with this tool.
+    pub fn perforation(&self) -> [f64; 2] {
+        self.perforation.unwrap_or(DEFAULT_PERFORATION)
     }
 }
 
@@ -231,6 +247,17 @@ pub struct Profile {
     pub max_power: Option<f64>,
     #[serde(default)]
     pub tools: BTreeMap<String, Tool>,
+    /// Drag knife: distance (mm) from the holder's axis to the blade tip, which trails it; the
+    /// toolpath stage compensates it (`toolpath::knife`). 0 (default): no compensation.
+    #[serde(default)]
+    pub knife_offset: f64,
+    /// Drag knife: corners that turn more than this (degrees) get a swivel arc (default 10).
+    #[serde(default = "default_swivel")]
+    pub swivel_threshold_deg: f64,
+    /// Knife: closed contours are cut this much (mm) past their start so that they come free
+    /// (default 0).
+    #[serde(default)]
+    pub overcut: f64,
     /// Commands sent before and after the job, verbatim.
     #[serde(default)]
     pub init: Vec<String>,
@@ -245,10 +272,79 @@ fn default_buffer() -> usize {
     256
 }
 
+fn default_swivel() -> f64 {
+    10.0
+}
+
 impl Profile {
     /// The tool for a kind of stroke, if the machine has one.
     pub fn tool(&self, kind: StrokeKind) -> Option<&Tool> {
         self.tools.get(kind.name())
+    }
+
+    /// Whether the profile has a tool for `kind`.
+    pub fn has(&self, kind: StrokeKind) -> bool {
+        self.tool(kind).is_some()
+    }
+
+    /// What the toolpath stage's machine preparation needs from this profile
+    /// ([`crate::toolpath::knife`]); `margin` is the sheet margin (mm), where the alignment
+    /// precut goes.
+    pub fn machine_options(&self, margin: f64) -> crate::toolpath::knife::MachineOptions {
+        let fold_kind = crate::toolpath::fold_kind(|k| self.has(k));
+        let kinds = [
+            StrokeKind::Cut,
+            StrokeKind::Score,
+            StrokeKind::Perforate,
+            StrokeKind::Draw,
+            StrokeKind::Etch,
+        ];
+        let m = if margin.is_finite() {
+            margin.max(0.0)
+        } else {
+            0.0
+        };
+        crate::toolpath::knife::MachineOptions {
+            fold_kind,
+            perforation: self
+                .tool(StrokeKind::Perforate)
+                .map(|t| t.perforation())
+                .unwrap_or(DEFAULT_PERFORATION),
+            knife_offset: self.knife_offset,
+            swivel_threshold_deg: self.swivel_threshold_deg,
+            knife_kinds: kinds
+                .into_iter()
+                .filter(|k| self.is_drag_knife(*k))
+                .collect(),
+            multi_pass_kinds: kinds
+                .into_iter()
+                .filter(|k| self.tool(*k).is_some_and(|t| t.passes() > 1))
+                .collect(),
+            overcut: self.overcut,
+            // Half way into the margin, far enough right that the trailing tip stays on it.
+            precut_at: glam::DVec2::new(0.5 * m + self.knife_offset, 0.5 * m),
+        }
+    }
+
+    /// Whether strokes of `kind` are made by a drag knife whose offset is to be compensated:
+    /// the profile has a `knife_offset`, and the kind is cut, score or perforate with a tool
+    /// that is not a pen or a laser (G-code: a Z knife; HP-GL: any such tool, the holder
+    /// being the knife's).
+    pub fn is_drag_knife(&self, kind: StrokeKind) -> bool {
+        if self.knife_offset.is_nan() || self.knife_offset <= 0.0 {
+            return false;
+        }
+        if !matches!(
+            kind,
+            StrokeKind::Cut | StrokeKind::Score | StrokeKind::Perforate
+        ) {
+            return false;
+        }
+        match (self.tool(kind), self.language) {
+            (Some(_), Language::Hpgl) => true,
+            (Some(t), Language::Gcode) => t.z_down.is_some(),
+            (None, _) => false,
+        }
     }
 }
 
@@ -383,6 +479,25 @@ fn check(p: &Profile) -> Result<(), Problem> {
     if p.buffer == 0 {
         return Err(problem("", "buffer", "must be at least 1 byte"));
     }
+    for (key, v) in [("knife_offset", p.knife_offset), ("overcut", p.overcut)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(problem(
+                "",
+                key,
+                format!("must be 0 (off) or a length in mm, got {v}"),
+            ));
+        }
+    }
+    if !(p.swivel_threshold_deg.is_finite() && (0.0..=180.0).contains(&p.swivel_threshold_deg)) {
+        return Err(problem(
+            "",
+            "swivel_threshold_deg",
+            format!(
+                "must be an angle from 0 to 180 degrees, got {}",
+                p.swivel_threshold_deg
+            ),
+        ));
+    }
     let s = &p.serial;
     if s.baud == 0 {
         return Err(problem("serial", "baud", "must be more than 0"));
@@ -459,6 +574,22 @@ fn check_tool(table: &str, t: &Tool, max_power: Option<f64>, gcode: bool) -> Res
     }
     if t.passes == Some(0) {
         return err("passes", "must be at least 1".into());
+    }
+    if let Some([cut, skip]) = t.perforation {
+        if !(cut.is_finite() && cut > 0.0 && skip.is_finite() && skip > 0.0) {
+            return err(
+                "perforation",
+                format!(
+                    "must be [cut_mm, skip_mm] with both lengths positive, got [{cut}, {skip}]"
+                ),
+            );
+        }
+        if !table.ends_with(".perforate") {
+            return err(
+                "perforation",
+                "is for the perforate tool only (`[tools.perforate]`)".into(),
+            );
+        }
     }
     if let Some(d) = t.dwell.filter(|&d| d < 0.0) {
         return err("dwell", format!("must be 0 or more seconds, got {d}"));
@@ -727,6 +858,7 @@ mod tests {
         let names: Vec<String> = all().unwrap().into_iter().map(|p| p.name).collect();
         for name in [
             "sim",
+            "sim-dragknife",
             "hpgl-pens",
             "roland-gx24",
             "graphtec-ce6000",
@@ -870,6 +1002,77 @@ mod tests {
         assert!(e.contains("line 8: `tools.glue` is not a tool kind"), "{e}");
         let e = error(&format!("{HPGL}[tools.draw]\npen=3\n"));
         assert!(e.contains("`tools.cut` is missing"), "{e}");
+    }
+
+    #[test]
+    fn knife_keys_are_checked() {
+        for name in [
+            "roland-gx24",
+            "graphtec-ce6000",
+            "uscutter-mh",
+            "grbl-dragknife",
+        ] {
+            let p = bundled(name);
+            assert_eq!(p.knife_offset, 0.25, "{name}");
+            assert_eq!(p.overcut, 1.0, "{name}");
+            assert!(p.is_drag_knife(StrokeKind::Cut), "{name}");
+            assert!(!p.is_drag_knife(StrokeKind::Draw), "{name}");
+        }
+        // `sim` is unchanged: no offset, no overcut; `sim-dragknife` is `sim` with them.
+        let sim = bundled("sim");
+        assert_eq!((sim.knife_offset, sim.overcut), (0.0, 0.0));
+        assert_eq!(sim.swivel_threshold_deg, 10.0);
+        assert!(!sim.is_drag_knife(StrokeKind::Cut));
+        let drag = bundled("sim-dragknife");
+        assert_eq!(drag.knife_offset, 0.25);
+        assert_eq!(drag.tools, sim.tools);
+        assert_eq!(drag.serial, sim.serial);
+        // Pens and lasers are not knives.
+        assert!(!bundled("grbl-laser").is_drag_knife(StrokeKind::Cut));
+        assert!(!bundled("hpgl-pens").is_drag_knife(StrokeKind::Cut));
+
+        let e = error(&format!("{HPGL}knife_offset=-0.25\n[tools.cut]\npen=1\n"));
+        assert!(
+            e.starts_with("x.toml: line 6: `knife_offset` must be 0 (off) or a length"),
+            "{e}"
+        );
+        let e = error(&format!("{HPGL}knife_offset=nan\n[tools.cut]\npen=1\n"));
+        assert!(e.contains("line 6: `knife_offset` must be"), "{e}");
+        let e = error(&format!("{HPGL}overcut=-1\n[tools.cut]\npen=1\n"));
+        assert!(e.contains("line 6: `overcut` must be"), "{e}");
+        let e = error(&format!(
+            "{HPGL}swivel_threshold_deg=200\n[tools.cut]\npen=1\n"
+        ));
+        assert!(
+            e.contains("line 6: `swivel_threshold_deg` must be an angle"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{HPGL}[tools.cut]\npen=1\n[tools.perforate]\npen=1\nperforation=[0, 1]\n"
+        ));
+        assert!(
+            e.starts_with(
+                "x.toml: line 10: `tools.perforate.perforation` must be [cut_mm, skip_mm]"
+            ),
+            "{e}"
+        );
+        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nperforation=[3, 1]\n"));
+        assert!(
+            e.contains("line 8: `tools.cut.perforation` is for the perforate tool"),
+            "{e}"
+        );
+        let ok = parse(
+            &format!(
+                "{HPGL}[tools.cut]\npen=1\n[tools.perforate]\npen=1\nperforation=[2.5, 0.5]\n"
+            ),
+            "x.toml",
+        )
+        .unwrap();
+        assert_eq!(
+            ok.tool(StrokeKind::Perforate).unwrap().perforation(),
+            [2.5, 0.5]
+        );
+        assert_eq!(Tool::default().perforation(), DEFAULT_PERFORATION);
     }
 
     #[test]

@@ -285,7 +285,9 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
         }
     }
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let kind = stroke.role.kind();
+        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
+            continue;
+        };
         let Some(tool) = profile.tool(kind) else {
             continue;
         };
@@ -405,11 +407,13 @@ mod tests {
 
     #[test]
     fn servo_pen_exact() {
+        // No scoring or perforating tool: the fold is drawn with the pen (`fold_kind`).
         let t = text(&small_job(), &profile(PEN));
         assert_eq!(
             t,
             "G21\nG90\nG94\n\
              M3 S30\nG4 P0.3\nG0 X1 Y1\nM3 S90\nG4 P0.3\nG1 X2 Y1 F2000\nM3 S30\nG4 P0.3\n\
+             G0 X1 Y2\nM3 S90\nG4 P0.3\nG1 X2 Y2\nG1 X2 Y3\nG1 X1 Y2\nM3 S30\nG4 P0.3\n\
              G0 X10 Y10\nM3 S90\nG4 P0.15\nG1 X20 Y10 F3000\nG1 X20 Y20.5\n\
              M3 S30\nG4 P0.15\n\
              M5\nM2\n"
@@ -519,7 +523,9 @@ mod tests {
             // Every tool-down path is a stroke of the job, in order, within 0.0005 mm.
             let mut expect = Vec::new();
             for s in &job.strokes {
-                let Some(tool) = p.tool(s.role.kind()) else {
+                let Some(tool) =
+                    crate::toolpath::tool_kind(s.role, |k| p.has(k)).and_then(|k| p.tool(k))
+                else {
                     continue;
                 };
                 let closed = s.points.first() == s.points.last();

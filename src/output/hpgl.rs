@@ -183,7 +183,9 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
     let mut speed: Option<String> = None;
     let mut force: Option<String> = None;
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let kind = stroke.role.kind();
+        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
+            continue;
+        };
         let Some(tool) = profile.tool(kind) else {
             continue;
         };

@@ -1,19 +1,31 @@
 //! Toolpath stage: turns a nested [`Layout`](crate::nest::Layout) into a [`Job`], the ordered
 //! strokes per sheet, in millimetres, that an output language then encodes.
 //!
-//! Order (issue 2, DESIGN.md "toolpath/"): on each sheet, drawn marks and labels first, then
-//! folds (scored), then cuts, inner contours (holes) before the outline that surrounds them, so
-//! that the material is still held while it is worked on. Inside each group the strokes are
-//! chained by nearest neighbour from the current pen position: an open stroke may be reversed,
-//! a closed contour may start at whichever of its vertices is nearest.
+//! Order (issue 8, DESIGN.md "toolpath/"): drawn marks, labels, sewing and grain lines first,
+//! then folds and notches, then cuts, inner contours (holes) before the outline that surrounds
+//! them, so that the material is still held while it is worked on; weed lines last. With
+//! [`ToolpathOptions::per_piece`] (fabric, or any material that may shift once a piece is cut
+//! free) each piece gets all of that before the next piece starts, pieces taken nearest first;
+//! otherwise the groups span the whole sheet. Inside each group travel is made short by
+//! [`order`] (nearest neighbour, then 2-opt; the collection order is kept if it is shorter).
 //!
-//! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); ties in the
-//! nearest-neighbour search go to the stroke that came first, so the order is deterministic.
+//! The ordered job is the design (what the SVG and PNG show). What a machine's tools need on top
+//! of it — folds as perforation dashes, overcut, drag-knife offset compensation with an
+//! alignment precut — is [`knife::prepare`], applied to the job that is encoded. Which tool makes
+//! a fold is [`fold_kind`]: the scoring tool, else the perforating one, else the pen.
+//! [`weed`] adds weed lines for vinyl.
+//!
+//! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); notches
+//! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
+//! after every piece; everything is deterministic (counts, never clocks, bound the search).
 
 use glam::DVec2;
 use serde::Serialize;
 
 mod collect;
+pub mod knife;
+pub mod order;
+pub mod weed;
 
 /// What a stroke is for; decides the SVG layer and, through [`StrokeKind`], the tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -79,6 +91,24 @@ impl StrokeRole {
     }
 }
 
+/// The tool that makes folds on a device whose tool table has the kinds `has` accepts: the
+/// scoring tool, else the perforating one (folds cut as dashes, see [`knife`]), else the pen;
+/// `None`: the device cannot make folds and they are left out.
+pub fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+    [StrokeKind::Score, StrokeKind::Perforate, StrokeKind::Draw]
+        .into_iter()
+        .find(|k| has(*k))
+}
+
+/// The tool kind that makes a stroke of `role` on a device with the kinds `has` accepts
+/// (folds: [`fold_kind`]; the rest: [`StrokeRole::kind`] if the device has it).
+pub fn tool_kind(role: StrokeRole, has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+    match role.kind() {
+        StrokeKind::Score => fold_kind(has),
+        k => has(k).then_some(k),
+    }
+}
+
 /// Tool classes of a device's tool table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -140,10 +170,28 @@ pub struct Job {
 /// Options of the toolpath stage.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ToolpathOptions {
-    /// Leave fold lines out (a device without a scoring tool).
+    /// Leave fold lines out (a device with no tool to make them).
     pub skip_folds: bool,
     /// Leave marks and labels out (a device without a pen).
     pub skip_drawing: bool,
+    /// Finish each piece (its drawing, folds, holes, outline) before starting the next, for
+    /// material that may shift once a piece is free (fabric). Otherwise every piece's drawing
+    /// comes first, then every fold, then every hole, then every outline.
+    pub per_piece: bool,
+    /// Weed lines for vinyl (see [`weed`]); `None`: none.
+    pub weed: Option<weed::WeedOptions>,
+}
+
+/// Order group of a stroke inside a piece (or a sheet): drawing, then folds and notches, then
+/// holes, then outer contours, then weed lines.
+fn group_of(s: &Stroke) -> usize {
+    match s.role {
+        StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => 0,
+        StrokeRole::FoldMountain | StrokeRole::FoldValley | StrokeRole::Notch => 1,
+        StrokeRole::Weed => 4,
+        StrokeRole::Cut if !s.outer => 2,
+        StrokeRole::Cut => 3,
+    }
 }
 
 /// Order the strokes of every sheet of a layout.
@@ -152,27 +200,14 @@ pub fn plan(layout: &crate::nest::Layout, name: &str, opts: &ToolpathOptions) ->
         .sheets
         .iter()
         .map(|sheet| {
-            let mut groups: [Vec<Stroke>; 4] = Default::default();
-            for s in collect::strokes(layout, sheet, opts) {
-                let g = match s.role {
-                    StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => {
-                        0
-                    }
-                    StrokeRole::FoldMountain | StrokeRole::FoldValley | StrokeRole::Notch => 1,
-                    StrokeRole::Cut | StrokeRole::Weed if !s.outer => 2,
-                    StrokeRole::Cut | StrokeRole::Weed => 3,
-                };
-                groups[g].push(s);
-            }
-            let mut pen = DVec2::ZERO;
-            let mut strokes = Vec::new();
-            for group in groups {
-                strokes.extend(nearest_neighbour(group, &mut pen));
+            let mut all = collect::strokes(layout, sheet, opts);
+            if let Some(w) = &opts.weed {
+                all.extend(weed::lines(layout, sheet, w));
             }
             SheetJob {
                 width: sheet.width,
                 height: sheet.height,
-                strokes,
+                strokes: order_sheet(all, opts.per_piece),
             }
         })
         .collect();
@@ -182,187 +217,170 @@ pub fn plan(layout: &crate::nest::Layout, name: &str, opts: &ToolpathOptions) ->
     }
 }
 
-/// Pen-up travel of a sequence of strokes, starting from the origin.
-pub fn travel(strokes: &[Stroke]) -> f64 {
-    let mut pen = DVec2::ZERO;
-    let mut total = 0.0;
-    for s in strokes {
-        if let (Some(first), Some(last)) = (s.points.first(), s.points.last()) {
-            total += pen.distance(*first);
-            pen = *last;
-        }
-    }
-    total
+/// The strokes of one sheet in collection order (piece by piece, as [`plan`] gathers them
+/// before ordering): the baseline that travel figures are compared with.
+pub fn unordered(
+    layout: &crate::nest::Layout,
+    sheet: &crate::nest::Sheet,
+    opts: &ToolpathOptions,
+) -> Vec<Stroke> {
+    collect::strokes(layout, sheet, opts)
 }
 
-/// Chain strokes by nearest neighbour from `pen`, reversing open strokes and rotating closed
-/// ones to start at the nearest vertex. A uniform grid over the entry points keeps it near
-/// O(n log n) for the thousands of short strokes of edge ids.
-fn nearest_neighbour(mut strokes: Vec<Stroke>, pen: &mut DVec2) -> Vec<Stroke> {
-    let n = strokes.len();
-    if n == 0 {
-        return strokes;
+/// Order one sheet's strokes: by group (see [`group_of`]), piece by piece when `per_piece`,
+/// and inside each group for short travel ([`order::order`]). The pen starts at the origin.
+pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
+    let mut pen = DVec2::ZERO;
+    let mut out = Vec::with_capacity(strokes.len());
+    if !per_piece {
+        let mut groups: [Vec<Stroke>; 5] = Default::default();
+        for s in strokes {
+            groups[group_of(&s)].push(s);
+        }
+        for group in groups {
+            out.extend(order::order(group, &mut pen));
+        }
+        return out;
     }
-    // Entry points: both ends of an open stroke, every vertex of a closed one.
-    let mut entries: Vec<(DVec2, usize, usize)> = Vec::new();
-    for (k, s) in strokes.iter().enumerate() {
-        if s.closed {
-            let m = s.points.len().saturating_sub(1).max(1);
-            for (i, p) in s.points.iter().take(m).enumerate() {
-                entries.push((*p, k, i));
-            }
-        } else if let Some(last) = s.points.len().checked_sub(1) {
-            entries.push((s.points[0], k, 0));
-            if last > 0 {
-                entries.push((s.points[last], k, last));
-            }
+    // Per piece: the strokes of each piece in groups; strokes of no piece (weed lines) last.
+    let mut pieces: std::collections::BTreeMap<usize, [Vec<Stroke>; 5]> = Default::default();
+    let mut loose: [Vec<Stroke>; 5] = Default::default();
+    for s in strokes {
+        let g = group_of(&s);
+        match s.piece {
+            Some(k) if g < 4 => pieces.entry(k).or_default()[g].push(s),
+            _ => loose[g].push(s),
         }
     }
-    let Some((lo, hi)) = crate::geom::polygon::bounds(entries.iter().map(|e| e.0)) else {
-        return strokes;
-    };
-    let extent = (hi - lo).max_element().max(1e-9);
-    let cell = extent / (entries.len() as f64).sqrt().max(1.0);
-    let key = |p: DVec2| {
-        (
-            ((p.x - lo.x) / cell).floor() as i64,
-            ((p.y - lo.y) / cell).floor() as i64,
-        )
-    };
-    let cells_x = ((hi.x - lo.x) / cell).floor() as i64;
-    let cells_y = ((hi.y - lo.y) / cell).floor() as i64;
-    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
-    for (i, e) in entries.iter().enumerate() {
-        grid.entry(key(e.0)).or_default().push(i);
-    }
-    let mut used = vec![false; n];
-    let mut order = Vec::with_capacity(n);
-    for _ in 0..n {
-        let c = key(*pen);
-        let mut best: Option<(f64, usize, usize)> = None; // (distance, stroke, vertex)
-        let max_r =
-            (c.0.abs().max((c.0 - cells_x).abs())).max(c.1.abs().max((c.1 - cells_y).abs())) + 1;
-        for r in 0..=max_r {
-            if let Some((d, _, _)) = best {
-                // Every point in ring r is at least (r - 1) cells away.
-                if d < (r - 1) as f64 * cell {
-                    break;
-                }
-            }
-            for x in c.0 - r..=c.0 + r {
-                for y in c.1 - r..=c.1 + r {
-                    if (x - c.0).abs() != r && (y - c.1).abs() != r {
-                        continue;
-                    }
-                    for &i in grid.get(&(x, y)).map(|v| v.as_slice()).unwrap_or(&[]) {
-                        let (p, k, v) = entries[i];
-                        if used[k] {
-                            continue;
-                        }
-                        let d = pen.distance(p);
-                        let better = match best {
-                            None => true,
-                            Some((bd, bk, bv)) => (d, k, v) < (bd, bk, bv),
-                        };
-                        if better {
-                            best = Some((d, k, v));
-                        }
-                    }
-                }
+    let mut pieces: Vec<[Vec<Stroke>; 5]> = pieces.into_values().collect();
+    // Pieces one after the other, the next being the one whose first group comes nearest the
+    // pen (ties: the lower piece index).
+    while !pieces.is_empty() {
+        let mut best = (f64::INFINITY, 0);
+        for (i, groups) in pieces.iter().enumerate() {
+            let d = groups
+                .iter()
+                .find(|g| !g.is_empty())
+                .map_or(f64::INFINITY, |g| nearest_entry(g, pen));
+            if d < best.0 {
+                best = (d, i);
             }
         }
-        let Some((_, k, v)) = best else {
-            break;
-        };
-        used[k] = true;
-        order.push((k, v));
-        let s = &strokes[k];
-        *pen = if s.closed {
-            s.points[v]
-        } else if v == 0 {
-            *s.points.last().unwrap_or(pen)
-        } else {
-            s.points[0]
-        };
-    }
-    let mut out = Vec::with_capacity(n);
-    for (k, v) in order {
-        let mut s = std::mem::replace(
-            &mut strokes[k],
-            Stroke {
-                role: StrokeRole::Cut,
-                points: Vec::new(),
-                closed: false,
-                piece: None,
-                outer: false,
-            },
-        );
-        if s.closed {
-            s.points.pop();
-            s.points.rotate_left(v);
-            s.points.push(s.points[0]);
-        } else if v != 0 {
-            s.points.reverse();
+        let groups = pieces.remove(best.1);
+        for group in groups {
+            out.extend(order::order(group, &mut pen));
         }
-        out.push(s);
+    }
+    for group in loose {
+        out.extend(order::order(group, &mut pen));
     }
     out
+}
+
+/// Distance from `pen` to the nearest point a stroke of `group` can start at (an end of an open
+/// stroke, any vertex of a closed one).
+fn nearest_entry(group: &[Stroke], pen: DVec2) -> f64 {
+    let mut best = f64::INFINITY;
+    for s in group {
+        let ends = [s.points.first(), s.points.last()];
+        let points: Box<dyn Iterator<Item = &DVec2>> = if s.closed {
+            Box::new(s.points.iter())
+        } else {
+            Box::new(ends.into_iter().flatten())
+        };
+        for p in points {
+            best = best.min(pen.distance(*p));
+        }
+    }
+    best
+}
+
+/// Pen-up travel of a sequence of strokes, starting from the origin.
+pub fn travel(strokes: &[Stroke]) -> f64 {
+    order::travel_from(DVec2::ZERO, strokes)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn open(a: (f64, f64), b: (f64, f64)) -> Stroke {
+    fn s(role: StrokeRole, piece: usize, pts: &[(f64, f64)], outer: bool) -> Stroke {
+        let closed = pts.first() == pts.last() && pts.len() > 2;
         Stroke {
-            role: StrokeRole::Mark,
-            points: vec![DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)],
-            closed: false,
-            piece: None,
-            outer: false,
+            role,
+            points: pts.iter().map(|p| DVec2::new(p.0, p.1)).collect(),
+            closed,
+            piece: Some(piece),
+            outer,
         }
     }
 
-    #[test]
-    fn nearest_neighbour_chains_and_reverses() {
-        let strokes = vec![
-            open((100.0, 0.0), (90.0, 0.0)),
-            open((12.0, 0.0), (50.0, 0.0)),
-            open((1.0, 0.0), (10.0, 0.0)),
-        ];
-        let before = travel(&strokes);
-        let mut pen = DVec2::ZERO;
-        let out = nearest_neighbour(strokes, &mut pen);
-        assert_eq!(out.len(), 3);
-        assert_eq!(out[0].points[0], DVec2::new(1.0, 0.0));
-        assert_eq!(out[1].points[0], DVec2::new(12.0, 0.0));
-        assert_eq!(out[2].points[0], DVec2::new(90.0, 0.0));
-        assert!((travel(&out) - (1.0 + 2.0 + 40.0)).abs() < 1e-12);
-        assert!(travel(&out) < before);
+    fn square(piece: usize, x: f64, size: f64, outer: bool) -> Stroke {
+        s(
+            StrokeRole::Cut,
+            piece,
+            &[
+                (x, 0.0),
+                (x + size, 0.0),
+                (x + size, size),
+                (x, size),
+                (x, 0.0),
+            ],
+            outer,
+        )
     }
 
+    /// Draw, fold, hole, outline; per piece or across the sheet.
     #[test]
-    fn closed_stroke_starts_at_nearest_vertex() {
-        let ring = Stroke {
-            role: StrokeRole::Cut,
-            points: [
-                (0.0, 0.0),
-                (10.0, 0.0),
-                (10.0, 10.0),
-                (0.0, 10.0),
-                (0.0, 0.0),
-            ]
-            .iter()
-            .map(|p| DVec2::new(p.0, p.1))
-            .collect(),
-            closed: true,
-            piece: None,
-            outer: false,
+    fn groups_and_per_piece_order() {
+        let strokes = vec![
+            square(0, 0.0, 50.0, true),
+            square(1, 100.0, 50.0, true),
+            square(1, 110.0, 10.0, false),
+            s(StrokeRole::Label, 1, &[(120.0, 30.0), (130.0, 30.0)], false),
+            s(
+                StrokeRole::FoldValley,
+                0,
+                &[(0.0, 25.0), (50.0, 25.0)],
+                false,
+            ),
+            s(StrokeRole::Label, 0, &[(20.0, 30.0), (30.0, 30.0)], false),
+            s(StrokeRole::Weed, 0, &[(60.0, 0.0), (60.0, 50.0)], false).with_piece(None),
+        ];
+        let key = |v: &[Stroke]| -> Vec<(StrokeRole, Option<usize>, bool)> {
+            v.iter().map(|s| (s.role, s.piece, s.outer)).collect()
         };
-        let mut pen = DVec2::new(11.0, 11.0);
-        let out = nearest_neighbour(vec![ring.clone()], &mut pen);
-        assert_eq!(out[0].points[0], DVec2::new(10.0, 10.0));
-        assert_eq!(out[0].points.last(), Some(&DVec2::new(10.0, 10.0)));
-        assert!((out[0].length() - ring.length()).abs() < 1e-12);
+        use StrokeRole::*;
+        assert_eq!(
+            key(&order_sheet(strokes.clone(), false)),
+            vec![
+                (Label, Some(0), false),
+                (Label, Some(1), false),
+                (FoldValley, Some(0), false),
+                (Cut, Some(1), false),
+                (Cut, Some(1), true),
+                (Cut, Some(0), true),
+                (Weed, None, false),
+            ]
+        );
+        assert_eq!(
+            key(&order_sheet(strokes, true)),
+            vec![
+                (Label, Some(0), false),
+                (FoldValley, Some(0), false),
+                (Cut, Some(0), true),
+                (Label, Some(1), false),
+                (Cut, Some(1), false),
+                (Cut, Some(1), true),
+                (Weed, None, false),
+            ]
+        );
+    }
+
+    impl Stroke {
+        fn with_piece(mut self, piece: Option<usize>) -> Stroke {
+            self.piece = piece;
+            self
+        }
     }
 }

@@ -113,7 +113,7 @@ impl Grbl {
             spindle_on: false,
             s: 0.0,
             alarm: false,
-            rec: Recorder::default(),
+            rec: Recorder::for_profile(profile),
             lines_ok: 0,
         }
     }

@@ -110,7 +110,7 @@ impl Hpgl {
             pen: 0,
             relative: false,
             speed_cm_s: None,
-            rec: Recorder::default(),
+            rec: Recorder::for_profile(profile),
             instructions: 0,
             ignored: BTreeMap::new(),
         }
