@@ -125,3 +125,58 @@ fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// "12" set along the edge (0,0)→(10,0), as the pattern stage does.
+    fn text() -> Text {
+        crate::pattern::marks::edge_text("12", DVec2::ZERO, DVec2::new(10.0, 0.0), 10.0, 3.0)
+    }
+
+    /// Reading direction and "up" of the first glyph's strokes on the sheet, from the text's
+    /// box: the first stroke of "1" lies left of the last stroke of "2" when read upright.
+    fn reads_upright(strokes: &[Vec<DVec2>]) -> bool {
+        let first = strokes.first().unwrap()[0];
+        let last = *strokes.last().unwrap().last().unwrap();
+        last.x > first.x
+    }
+
+    #[test]
+    fn text_reads_upright_whatever_the_placement() {
+        let t = text();
+        let own: Vec<DVec2> = t.points().collect();
+        let (lo, hi) = crate::geom::polygon::bounds(own.iter().copied()).unwrap();
+        let (w, h) = (hi.x - lo.x, hi.y - lo.y);
+        for mirror in [false, true] {
+            for quarter in 0..4 {
+                let at = Placement {
+                    sheet: 0,
+                    rotation: quarter as f64 * std::f64::consts::FRAC_PI_2,
+                    mirror,
+                    offset: DVec2::new(100.0, 100.0),
+                };
+                let s = upright(&t, &at);
+                assert!(
+                    reads_upright(&s),
+                    "mirror {mirror}, {quarter} quarter turns"
+                );
+                // Never mirrored: the same shape up to a rotation (compare box sizes and the
+                // signed area swept by the "2", whose orientation a mirror would flip).
+                let pts: Vec<DVec2> = s.iter().flatten().copied().collect();
+                let (l2, h2) = crate::geom::polygon::bounds(pts.iter().copied()).unwrap();
+                let (w2, hh2) = (h2.x - l2.x, h2.y - l2.y);
+                assert!(
+                    ((w2 - w).abs() < 1e-9 && (hh2 - h).abs() < 1e-9)
+                        || ((w2 - h).abs() < 1e-9 && (hh2 - w).abs() < 1e-9)
+                );
+                let two = |v: &[Vec<DVec2>]| crate::geom::polygon::signed_area(v.last().unwrap());
+                assert!((two(&s) - two(&t.strokes)).abs() < 1e-9);
+                // It stays centred where the piece puts its box.
+                let c = at.apply(0.5 * (lo + hi));
+                assert!((0.5 * (l2 + h2) - c).length() < 1e-9);
+            }
+        }
+    }
+}
