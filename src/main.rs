@@ -6,6 +6,13 @@ use flatcut::cli::{run, Cli};
 
 fn main() {
     std::panic::set_hook(Box::new(|info| {
+        // `println!` panics when the reader of stdout has gone (`flatcut … | head`): that is
+        // the environment, not a bug. Files are written whole before anything is printed.
+        let text = info.to_string();
+        if text.contains("failed printing to stdout") {
+            eprintln!("flatcut: standard output was closed; stopped");
+            std::process::exit(1);
+        }
         eprintln!("flatcut: internal error (a bug in flatcut, please report it): {info}");
         std::process::exit(2);
     }));
