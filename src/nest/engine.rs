@@ -220,29 +220,13 @@ pub fn seg_seg_dist2(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
         .min(point_seg_dist2(d, a, b))
 }
 
-/// Even-odd test of one ring (boundary points may go either way).
-#[inline]
-fn in_ring(r: &[DVec2], p: DVec2) -> bool {
-    let n = r.len();
-    let mut inside = false;
-    let mut j = n.wrapping_sub(1);
-    for i in 0..n {
-        let (a, b) = (r[i], r[j]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if p.x < x {
-                inside = !inside;
-            }
-        }
-        j = i;
-    }
-    inside
-}
-
 /// Is `p` in the material of the rings (inside the outer ring, outside every hole)?
 pub fn in_material(rings: &[Vec<DVec2>], p: DVec2) -> bool {
     match rings.split_first() {
-        Some((outer, holes)) => in_ring(outer, p) && !holes.iter().any(|h| in_ring(h, p)),
+        Some((outer, holes)) => {
+            crate::geom::polygon::contains(outer, p)
+                && !holes.iter().any(|h| crate::geom::polygon::contains(h, p))
+        }
         None => false,
     }
 }
