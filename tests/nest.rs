@@ -7,7 +7,7 @@
 
 mod common;
 use common::*;
-use flatcut::geom::polygon::{signed_area, triangles_overlap, triangulate};
+use flatcut::geom::polygon::{segment_distance, signed_area, triangles_overlap, triangulate};
 use glam::DVec2;
 use serde_json::Value;
 
@@ -18,16 +18,6 @@ fn triangles(poly: &[DVec2]) -> Vec<[DVec2; 3]> {
         .collect()
 }
 
-fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t).distance(p)
-}
-
 fn ring_dist(a: &[DVec2], b: &[DVec2]) -> f64 {
     let mut d = f64::INFINITY;
     for i in 0..a.len() {
@@ -35,10 +25,10 @@ fn ring_dist(a: &[DVec2], b: &[DVec2]) -> f64 {
         for k in 0..b.len() {
             let (b0, b1) = (b[k], b[(k + 1) % b.len()]);
             d = d
-                .min(seg_dist(a0, a1, b0))
-                .min(seg_dist(a0, a1, b1))
-                .min(seg_dist(b0, b1, a0))
-                .min(seg_dist(b0, b1, a1));
+                .min(segment_distance(b0, a0, a1))
+                .min(segment_distance(b1, a0, a1))
+                .min(segment_distance(a0, b0, b1))
+                .min(segment_distance(a1, b0, b1));
         }
     }
     d

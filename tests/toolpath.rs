@@ -104,7 +104,9 @@ fn fandisk_weed_lines_cross_and_touch_no_piece() {
         for a in wl.points.windows(2) {
             for o in &outlines {
                 for b in o.points.windows(2) {
-                    least = least.min(weed::segment_segment_distance(a[0], a[1], b[0], b[1]));
+                    least = least.min(flatcut::geom::polygon::segment_segment_distance(
+                        a[0], a[1], b[0], b[1],
+                    ));
                 }
             }
         }

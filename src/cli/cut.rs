@@ -232,11 +232,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     let ext = profile.language.extension();
     let n = job.sheets.len();
     for (i, sheet) in machine.sheets.iter().enumerate() {
-        let name = if n == 1 {
-            format!("{}.{ext}", spec.name)
-        } else {
-            format!("{}-{}.{ext}", spec.name, i + 1)
-        };
+        let name = sheet_file(&spec.name, i, n, ext);
         let bytes = crate::output::program(sheet, &profile).map_err(|e| e.on_sheet(i + 1))?;
         write_atomic(&dir.join(&name), &bytes)?;
         files.push(name.clone());
@@ -313,6 +309,15 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// `<name>.<ext>` for a one-sheet job, else `<name>-<k>.<ext>` for sheet `k` (1-based).
+fn sheet_file(name: &str, i: usize, n: usize, ext: &str) -> String {
+    if n == 1 {
+        format!("{name}.{ext}")
+    } else {
+        format!("{name}-{}.{ext}", i + 1)
+    }
+}
+
 /// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.
 pub fn write_dxf(
     dir: &Path,
@@ -322,11 +327,7 @@ pub fn write_dxf(
     let n = layout.sheets.len();
     let mut files = Vec::new();
     for i in 0..n {
-        let file = if n == 1 {
-            format!("{name}.dxf")
-        } else {
-            format!("{name}-{}.dxf", i + 1)
-        };
+        let file = sheet_file(name, i, n, "dxf");
         write_atomic(
             &dir.join(&file),
             crate::output::dxf::render(layout, i).as_bytes(),

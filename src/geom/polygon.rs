@@ -247,6 +247,17 @@ pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     p.distance(a + ab * t)
 }
 
+/// Least distance between the segments `a`–`b` and `c`–`d` (0 when they touch or cross).
+pub fn segment_segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
+    if segments_intersect(a, b, c, d) {
+        return 0.0;
+    }
+    segment_distance(a, c, d)
+        .min(segment_distance(b, c, d))
+        .min(segment_distance(c, a, b))
+        .min(segment_distance(d, a, b))
+}
+
 /// Even-odd containment in a set of rings (an outer ring and its holes).
 pub fn contains_rings(rings: &[Vec<DVec2>], p: DVec2) -> bool {
     rings.iter().filter(|r| contains(r, p)).count() % 2 == 1

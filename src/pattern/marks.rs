@@ -348,20 +348,9 @@ pub fn arc_at(points: &[DVec2], k: usize, t: f64) -> f64 {
 
 /// The point at arc length `s` along a polyline and the direction of its segment there.
 pub fn point_at(points: &[DVec2], s: f64) -> Option<(DVec2, DVec2)> {
-    let mut left = s;
-    let n = points.len();
-    for (i, w) in points.windows(2).enumerate() {
-        let l = w[0].distance(w[1]);
-        if l <= 0.0 {
-            continue;
-        }
-        if left <= l || i + 2 == n {
-            let t = (left / l).clamp(0.0, 1.0);
-            return Some((w[0].lerp(w[1], t), (w[1] - w[0]) / l));
-        }
-        left -= l;
-    }
-    None
+    let (k, t) = segment_at(points, s);
+    let (a, b) = (*points.get(k)?, *points.get(k + 1)?);
+    Some((a.lerp(b, t), (b - a).try_normalize()?))
 }
 
 /// Strokes of `text` set along the edge `a → b` (interior on its left), inside the face.

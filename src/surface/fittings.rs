@@ -145,10 +145,8 @@ impl Fitting {
                 positive("bottom-diameter", bottom_diameter)?;
                 positive("top-diameter", top_diameter)?;
                 positive("height", height)?;
+                // Equal diameters make a cylinder: fine, the strip handles it.
                 finite("offset", offset)?;
-                if bottom_diameter == top_diameter && offset == 0.0 {
-                    // A cylinder: fine, the strip handles it.
-                }
             }
             Fitting::SquareToRound {
                 width,

@@ -95,16 +95,14 @@ fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
     };
     let c = 0.5 * (lo + hi);
     let cs = at.apply(c);
-    let (r, up) = match t.dir {
-        None => (DVec2::X, DVec2::Y),
-        Some(r) => (r, r.perp()),
-    };
-    // The box's axes on the sheet.
-    let (mut e1, mut e2) = match t.dir {
-        None => (DVec2::X, DVec2::Y),
-        Some(_) => (
+    // The text's axes in the piece, and its box's axes on the sheet.
+    let (r, up, mut e1, mut e2) = match t.dir {
+        None => (DVec2::X, DVec2::Y, DVec2::X, DVec2::Y),
+        Some(r) => (
+            r,
+            r.perp(),
             (at.apply(c + r) - cs).normalize_or_zero(),
-            (at.apply(c + up) - cs).normalize_or_zero(),
+            (at.apply(c + r.perp()) - cs).normalize_or_zero(),
         ),
     };
     if e1.perp_dot(e2) < 0.0 {

@@ -280,19 +280,10 @@ pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
 /// Distance from `pen` to the nearest point a stroke of `group` can start at (an end of an open
 /// stroke, any vertex of a closed one).
 fn nearest_entry(group: &[Stroke], pen: DVec2) -> f64 {
-    let mut best = f64::INFINITY;
-    for s in group {
-        let ends = [s.points.first(), s.points.last()];
-        let points: Box<dyn Iterator<Item = &DVec2>> = if s.closed {
-            Box::new(s.points.iter())
-        } else {
-            Box::new(ends.into_iter().flatten())
-        };
-        for p in points {
-            best = best.min(pen.distance(*p));
-        }
-    }
-    best
+    order::entry_points(group)
+        .iter()
+        .map(|(p, _, _)| pen.distance(*p))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Pen-up travel of a sequence of strokes, starting from the origin.

@@ -234,7 +234,7 @@ impl Grid {
 
 /// Entry points of the strokes: (point, stroke, vertex) — both ends of an open stroke, every
 /// vertex of a closed one.
-fn entry_points(strokes: &[Stroke]) -> Vec<(DVec2, usize, usize)> {
+pub(super) fn entry_points(strokes: &[Stroke]) -> Vec<(DVec2, usize, usize)> {
     let mut entries = Vec::new();
     for (k, s) in strokes.iter().enumerate() {
         if is_closed(s) {

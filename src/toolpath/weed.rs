@@ -201,18 +201,6 @@ fn capsule_interval(a: DVec2, b: DVec2, g: f64, p: DVec2, dir: DVec2) -> Option<
     (lo <= hi).then_some((lo, hi))
 }
 
-/// Least distance between two segments.
-pub fn segment_segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
-    use crate::geom::polygon::{segment_distance, segments_intersect};
-    if segments_intersect(a, b, c, d) {
-        return 0.0;
-    }
-    segment_distance(a, c, d)
-        .min(segment_distance(b, c, d))
-        .min(segment_distance(c, a, b))
-        .min(segment_distance(d, a, b))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -264,7 +252,12 @@ mod tests {
             for s in w.points.windows(2) {
                 for r in &rings {
                     for i in 0..r.len() {
-                        let d = segment_segment_distance(s[0], s[1], r[i], r[(i + 1) % r.len()]);
+                        let d = crate::geom::polygon::segment_segment_distance(
+                            s[0],
+                            s[1],
+                            r[i],
+                            r[(i + 1) % r.len()],
+                        );
                         least = least.min(d);
                     }
                     // Not inside a piece either.
