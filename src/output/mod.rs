@@ -1,7 +1,8 @@
 //! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
 //! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
 //! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
-//! the nested layout for CAD/CAM ([`dxf`]).
+//! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
+//! texture coordinates ([`obj`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
@@ -22,6 +23,7 @@ use glam::DVec2;
 pub mod dxf;
 pub mod gcode;
 pub mod hpgl;
+pub mod obj;
 pub mod png;
 pub mod report;
 pub mod svg;

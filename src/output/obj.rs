@@ -1,0 +1,110 @@
+//! Wavefront OBJ writer: a surface mesh in millimetres, optionally with texture coordinates.
+//!
+//! Used for `--surface-obj` (a bent or generated surface to look at in a 3D viewer) and
+//! `--uv-obj` (the mesh with its flat layout as `vt`, in mm, so anyone can measure the pattern
+//! against the surface). Choices: coordinates are written with `{}` formatting of f64 (shortest
+//! round-trip representation, so a read-back is exact and the output deterministic); faces keep
+//! their vertex order (counter-clockwise seen from the printed side); texture coordinates are
+//! given per face corner — a vertex on a seam has one `vt` per piece it belongs to — and equal
+//! consecutive corners are not merged, so face `f` corner `i` is `vt` number
+//! (sum of earlier faces' corners) + i + 1.
+
+use crate::geom::mesh::Mesh;
+use glam::DVec2;
+use std::fmt::Write as _;
+
+/// The OBJ text of `mesh`, headed by `# comment` lines (one per line of `comment`). With `uv`
+/// (one 2D point per corner of each face, in mm) every face is written `f v/vt …`.
+///
+/// Returns `None` when `uv` does not have one point per corner of every face.
+pub fn write(mesh: &Mesh, uv: Option<&[Vec<DVec2>]>, comment: &str) -> Option<String> {
+    if let Some(uv) = uv {
+        if uv.len() != mesh.faces.len()
+            || uv
+                .iter()
+                .zip(&mesh.faces)
+                .any(|(c, f)| c.len() != f.verts.len())
+        {
+            return None;
+        }
+    }
+    let mut s = String::new();
+    for line in comment.lines() {
+        let _ = writeln!(s, "# {line}");
+    }
+    for v in &mesh.vertices {
+        let _ = writeln!(s, "v {} {} {}", v.x, v.y, v.z);
+    }
+    if let Some(uv) = uv {
+        for p in uv.iter().flatten() {
+            let _ = writeln!(s, "vt {} {}", p.x, p.y);
+        }
+    }
+    let mut t = 0usize;
+    for (fi, f) in mesh.faces.iter().enumerate() {
+        s.push('f');
+        for (i, &v) in f.verts.iter().enumerate() {
+            match uv {
+                Some(_) => {
+                    let _ = write!(s, " {}/{}", v + 1, t + i + 1);
+                }
+                None => {
+                    let _ = write!(s, " {}", v + 1);
+                }
+            }
+        }
+        s.push('\n');
+        if uv.is_some() {
+            t += mesh.faces[fi].verts.len();
+        }
+    }
+    Some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::mesh::Face;
+    use glam::DVec3;
+
+    fn quad() -> Mesh {
+        Mesh {
+            vertices: vec![
+                DVec3::ZERO,
+                DVec3::new(10.0, 0.0, 0.0),
+                DVec3::new(10.0, 5.5, 0.0),
+                DVec3::new(0.0, 5.5, 1.25),
+            ],
+            faces: vec![
+                Face {
+                    verts: vec![0, 1, 2],
+                    line: None,
+                },
+                Face {
+                    verts: vec![0, 2, 3],
+                    line: None,
+                },
+            ],
+        }
+    }
+
+    #[test]
+    fn obj_lists_vertices_faces_and_per_corner_uv() {
+        let m = quad();
+        let plain = write(&m, None, "flatcut").unwrap();
+        assert_eq!(
+            plain,
+            "# flatcut\nv 0 0 0\nv 10 0 0\nv 10 5.5 0\nv 0 5.5 1.25\nf 1 2 3\nf 1 3 4\n"
+        );
+        let uv: Vec<Vec<DVec2>> = vec![
+            vec![DVec2::ZERO, DVec2::X * 10.0, DVec2::new(10.0, 5.5)],
+            vec![DVec2::ZERO, DVec2::new(10.0, 5.5), DVec2::new(0.0, 5.64)],
+        ];
+        let with = write(&m, Some(&uv), "").unwrap();
+        assert!(with.contains("vt 0 5.64\n"), "{with}");
+        assert!(with.ends_with("f 1/1 2/2 3/3\nf 1/4 3/5 4/6\n"), "{with}");
+        // One point short for a face: refused.
+        let short = vec![uv[0].clone(), uv[1][..2].to_vec()];
+        assert!(write(&m, Some(&short), "").is_none());
+    }
+}
