@@ -18,6 +18,7 @@ fn fandisk() -> Surface {
         mesh,
         warnings,
         bends: None,
+        charts: None,
     }
 }
 

@@ -419,6 +419,7 @@ pub(crate) mod tests {
             mesh,
             warnings: Vec::new(),
             bends: None,
+            charts: None,
         }
     }
 

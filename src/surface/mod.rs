@@ -16,7 +16,7 @@ use crate::spec::{SurfaceKind, SurfaceSpec};
 use std::path::PathBuf;
 
 /// A developable surface made of flat polygon panels.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Surface {
     /// Name shown in labels and reports.
     pub name: String,
@@ -30,6 +30,10 @@ pub struct Surface {
     /// Which edges are bend (or score) lines, when the source decides it (strips: the chosen
     /// rulings, with their angles); `None` leaves it to the pattern stage's angle threshold.
     pub bends: Option<Vec<Bend>>,
+    /// Chart of each face, when the source segmented a smooth mesh into nearly developable
+    /// charts that the flatten stage parameterises one by one; `None`: the faces are exact flat
+    /// panels, unfolded as they are.
+    pub charts: Option<Vec<usize>>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -93,6 +97,7 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
                 mesh,
                 warnings,
                 bends: None,
+                charts: None,
             })
         }
         SurfaceKind::Strip => build_strip(spec),
@@ -155,5 +160,6 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         mesh: s.mesh(&steps),
         warnings,
         bends: Some(s.bends(&steps, st.bend_lines)),
+        charts: None,
     })
 }
