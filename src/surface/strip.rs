@@ -399,6 +399,12 @@ impl Strip {
     /// `d` reduces to `d̂·(e_a × e_b)` (the `d` part of `q_{j±1} − p_i` drops out). This is
     /// [`Strip::locally_convex`] and [`Strip::energy`] rewritten without repeated work; the
     /// tests check both against the plain versions through a Dijkstra on the same graph.
+    ///
+    /// The work is split in two: what each node costs ([`Strip::cost_row`], independent per
+    /// row, computed in bands of rows on every core) and the recurrence over the grid (one
+    /// thread, in row order, a few comparisons per node). A band's first row recomputes the
+    /// triangles it shares with the row above by the same expression the row above used, so
+    /// the costs, and the triangulation, are bit-identical whatever the number of threads.
     fn global(&self, method: Method) -> Vec<Step> {
         match method {
             Method::Godt => self.global_dp::<true, false, false>(),
@@ -411,177 +417,239 @@ impl Strip {
     /// [`Strip::global`] for one objective, known at compile time.
     fn global_dp<const COUNT: bool, const ENERGY: bool, const AREA: bool>(&self) -> Vec<Step> {
         let (m, n) = (self.m(), self.n());
-        let (use_count, use_energy, use_area) = (COUNT, ENERGY, AREA);
+        // Rows per band: enough work per hand-over, small enough to stay in cache.
+        let band = (65_536 / n.max(1)).clamp(1, 64);
+        let workers = if m * n < 250_000 {
+            1
+        } else {
+            std::thread::available_parallelism().map_or(1, |p| p.get())
+        };
+        self.global_bands::<COUNT, ENERGY, AREA>(band, workers)
+    }
+
+    /// [`Strip::global_dp`] with `band` rows per band and the costs computed on `workers`
+    /// threads (1: on this one).
+    fn global_bands<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
+        &self,
+        band: usize,
+        workers: usize,
+    ) -> Vec<Step> {
+        let (m, n) = (self.m(), self.n());
         let pb = Self::banks(&self.p, self.closed);
         let qb = Self::banks(&self.q, self.closed);
-        const INF: u32 = u32::MAX;
-        // Costs of reaching (i, j) by a P step [0] or a Q step [1]: rows i (cur) and i+1.
-        let mut cc = vec![[INF; 2]; n];
-        let mut cv = vec![[f64::INFINITY; 2]; n];
-        let mut nc = vec![[INF; 2]; n];
-        let mut nv = vec![[f64::INFINITY; 2]; n];
-        cc[0] = [0, 0];
-        cv[0] = [0.0, 0.0];
-        let mut back = vec![0u8; m * n];
-        // A triangle after one bridge is the triangle before the next: keep the area vectors
-        // (with squared and plain lengths) of the P-step triangles of the previous row and of
-        // the Q-step triangle of the previous column.
-        let mut above = vec![(DVec3::ZERO, 0.0, 0.0, 0.0); n];
-        #[allow(clippy::needless_range_loop)] // i is also a grid coordinate
-        for i in 0..m {
-            let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
-            let pi = self.p[i];
-            let last_row = i + 1 == m;
-            let mut left = (DVec3::ZERO, 0.0, 0.0, 0.0);
-            for j in 0..n {
-                let last_col = j + 1 == n;
-                if last_row && last_col {
-                    break;
-                }
-                let ([eq0, eq1, cq], [lq0, lq1]) = qb[j];
-                let d = self.q[j] - pi;
-                let l2 = d.length_squared();
-                // Area vectors (twice the area) of the triangles around the bridge.
-                // (area vector, its squared length, length, 1 / squared length or 0); the squared
-                // length is kept for symmetry with `fresh`, only the others are read.
-                let fresh = |v: DVec3| {
-                    let q = v.length_squared();
-                    (v, q, q.sqrt(), if q > 0.0 { 1.0 / q } else { 0.0 })
-                };
-                // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
-                let p0 = if i == 0 {
-                    fresh(d.cross(ep0))
-                } else {
-                    above[j]
-                };
-                let q0 = if j == 0 { fresh(d.cross(eq0)) } else { left };
-                let p1 = fresh(ep1.cross(d));
-                let q1 = fresh(eq1.cross(d));
-                above[j] = p1;
-                left = q1;
-                let (np0, nq0, np1, nq1) = (p0.0, q0.0, p1.0, q1.0);
-                let start = i == 0 && j == 0;
-                let len = [p0.2, p1.2, q0.2, q1.2];
-                let inv = [p0.3, p1.3, q0.3, q1.3];
-                let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
-                // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺.
-                let t01 = d.dot(cp);
-                let t23 = d.dot(cq);
-                let t02 = -ep0.dot(nq0);
-                let t03 = ep0.dot(nq1);
-                let t12 = -ep1.dot(nq0);
-                let t13 = ep1.dot(nq1);
-                let tt = [
-                    [0.0, t01, t02, t03],
-                    [-t01, 0.0, t12, t13],
-                    [-t02, -t12, 0.0, t23],
-                    [-t03, -t13, -t23, 0.0],
-                ];
-                let invalid = use_count && !start && {
-                    let l = l2.sqrt();
-                    // len: projected neighbour lengths times l.
-                    let es = [lp0, lp1, lq0, lq1];
-                    let on = [0, 1, 2, 3].map(|k| len[k] > 1e-12 * l * es[k].max(l));
-                    // Branch-free: some vector s has every other one on one side of it.
-                    let mut any = false;
-                    let mut real = 0;
-                    for s in 0..4 {
-                        let (mut pos, mut neg) = (true, true);
-                        for u in 0..4 {
-                            // tt is l² times the 2D cross; len is l times the projected length.
-                            let tol = 1e-9 * len[s] * len[u];
-                            let x = tt[s][u] * l;
-                            let skip = u == s || !on[u];
-                            pos &= skip | (x >= -tol);
-                            neg &= skip | (x <= tol);
-                        }
-                        real += usize::from(on[s]);
-                        any |= on[s] & (pos | neg);
-                    }
-                    !(any || real <= 1)
-                };
-                let inc = u32::from(invalid);
-                let cur_c = cc[j];
-                let cur_v = cv[j];
-                for t in 0..2 {
-                    if (t == 0 && last_row) || (t == 1 && last_col) {
-                        continue;
-                    }
-                    let k2 = if t == 0 { 1 } else { 3 };
-                    let n2 = if t == 0 { np1 } else { nq1 };
-                    let mut best_c = INF;
-                    let mut best_v = f64::INFINITY;
-                    let mut arg = 0u8;
-                    for s in 0..2 {
-                        if cur_c[s] == INF {
-                            continue;
-                        }
-                        let c = cur_c[s] + inc;
-                        let mut v = cur_v[s];
-                        if use_energy && !start {
-                            // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no
-                            // cross product: A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²).
-                            let k1 = 2 * s;
-                            let n1 = if s == 0 { np0 } else { nq0 };
-                            let x = tt[k1][k2];
-                            let s2 = (x * x * l2 * inv[k1] * inv[k2]).min(1.0);
-                            let sn = if n1.dot(n2) >= 0.0 { s2 } else { 2.0 - s2 };
-                            // A degenerate triangle (inv 0) bends nothing.
-                            let live = f64::from(u8::from(inv[k1] > 0.0 && inv[k2] > 0.0));
-                            v += live * 0.5 * (len[k1] + len[k2]) * sn * inv_l2;
-                        }
-                        if use_area {
-                            v += 0.5 * len[k2];
-                        }
-                        if c < best_c || (c == best_c && v < best_v) {
-                            best_c = c;
-                            best_v = v;
-                            arg = s as u8;
-                        }
-                    }
-                    if best_c == INF {
-                        continue;
-                    }
-                    let (ti, tj) = if t == 0 { (i + 1, j) } else { (i, j + 1) };
-                    let (sc, sv) = if t == 0 {
-                        (&mut nc[tj][0], &mut nv[tj][0])
-                    } else {
-                        (&mut cc[tj][1], &mut cv[tj][1])
-                    };
-                    if best_c < *sc || (best_c == *sc && best_v < *sv) {
-                        *sc = best_c;
-                        *sv = best_v;
-                        let b = &mut back[ti * n + tj];
-                        *b = (*b & !(1 << t)) | (arg << t);
-                    }
-                }
+        let band = band.max(1);
+        let bands = m.div_ceil(band);
+        let workers = workers.min(bands);
+        let compute = |b: usize, out: &mut Vec<NodeCost>, above: &mut Vec<Tri>| {
+            let r0 = b * band;
+            let r1 = (r0 + band).min(m);
+            out.clear();
+            out.resize((r1 - r0) * n, NodeCost::default());
+            if r0 > 0 {
+                // The P-step triangles after row r0 − 1, by the expression cost_row uses.
+                let (pi, ep1) = (self.p[r0 - 1], pb[r0 - 1].0[1]);
+                above.clear();
+                above.extend(self.q.iter().map(|&q| Tri::new(ep1.cross(q - pi))));
+            } else {
+                above.clear();
+                above.resize(n, Tri::default());
             }
-            if last_row {
+            for (k, i) in (r0..r1).enumerate() {
+                self.cost_row::<COUNT, ENERGY, AREA>(
+                    i,
+                    &pb,
+                    &qb,
+                    above,
+                    &mut out[k * n..(k + 1) * n],
+                );
+            }
+        };
+        let mut dp = Recurrence::new(m, n);
+        if workers <= 1 {
+            let (mut out, mut above) = (Vec::new(), Vec::new());
+            for b in 0..bands {
+                compute(b, &mut out, &mut above);
+                dp.rows(b * band, &out);
+            }
+        } else {
+            use std::sync::atomic::{AtomicUsize, Ordering};
+            use std::sync::mpsc;
+            let next = AtomicUsize::new(0);
+            // A worker takes a buffer before a band number, so the band the recurrence waits
+            // for always has a buffer and a worker: no deadlock, at most `pool` bands in flight.
+            let pool = 2 * workers;
+            let (free_tx, free_rx) = mpsc::sync_channel::<Vec<NodeCost>>(pool);
+            for _ in 0..pool {
+                let _ = free_tx.send(Vec::new());
+            }
+            let free_rx = std::sync::Mutex::new(free_rx);
+            let (done_tx, done_rx) = mpsc::channel::<(usize, Vec<NodeCost>)>();
+            std::thread::scope(|sc| {
+                for _ in 0..workers {
+                    let done_tx = done_tx.clone();
+                    let (free_rx, next, compute) = (&free_rx, &next, &compute);
+                    sc.spawn(move || {
+                        let mut above = Vec::new();
+                        loop {
+                            let buf = match free_rx.lock() {
+                                Ok(rx) => rx.recv(),
+                                Err(_) => return,
+                            };
+                            let Ok(mut buf) = buf else { return };
+                            let b = next.fetch_add(1, Ordering::Relaxed);
+                            if b >= bands {
+                                return;
+                            }
+                            compute(b, &mut buf, &mut above);
+                            if done_tx.send((b, buf)).is_err() {
+                                return;
+                            }
+                        }
+                    });
+                }
+                drop(done_tx);
+                let mut waiting = std::collections::BTreeMap::new();
+                let mut b = 0;
+                while b < bands {
+                    let buf = match waiting.remove(&b) {
+                        Some(buf) => buf,
+                        None => match done_rx.recv() {
+                            Ok((k, buf)) => {
+                                waiting.insert(k, buf);
+                                continue;
+                            }
+                            // A worker died (it cannot: cost_row does not panic); fall back.
+                            Err(_) => {
+                                let (mut out, mut above) = (Vec::new(), Vec::new());
+                                compute(b, &mut out, &mut above);
+                                out
+                            }
+                        },
+                    };
+                    dp.rows(b * band, &buf);
+                    let _ = free_tx.send(buf);
+                    b += 1;
+                }
+                // Wake the workers waiting for a buffer: they see the bands are all taken.
+                for _ in 0..workers {
+                    let _ = free_tx.try_send(Vec::new());
+                }
+            });
+        }
+        dp.path()
+    }
+
+    /// The costs of every node of row `i`: whether its bridge is invalid, and the weight of
+    /// each pair of steps through it. `above` holds, for each column, the P-step triangle that
+    /// ends at the node (the one after the node of the row above; ignored on row 0) and
+    /// receives this row's.
+    fn cost_row<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
+        &self,
+        i: usize,
+        pb: &[([DVec3; 3], [f64; 2])],
+        qb: &[([DVec3; 3], [f64; 2])],
+        above: &mut [Tri],
+        out: &mut [NodeCost],
+    ) {
+        let (m, n) = (self.m(), self.n());
+        let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
+        let pi = self.p[i];
+        let last_row = i + 1 == m;
+        let mut left = Tri::default();
+        for j in 0..n {
+            if last_row && j + 1 == n {
                 break;
             }
-            std::mem::swap(&mut cc, &mut nc);
-            std::mem::swap(&mut cv, &mut nv);
-            nc.iter_mut().for_each(|x| *x = [INF; 2]);
-            nv.iter_mut().for_each(|x| *x = [f64::INFINITY; 2]);
-        }
-        // `cc`/`cv` hold row m−1; pick the better end state (ties: P).
-        let (ec, ev) = (cc[n - 1], cv[n - 1]);
-        let mut s = usize::from(ec[1] < ec[0] || (ec[1] == ec[0] && ev[1] < ev[0]));
-        let mut steps = Vec::with_capacity(m + n - 2);
-        let (mut i, mut j) = (m - 1, n - 1);
-        while i > 0 || j > 0 {
-            let b = (back[i * n + j] >> s) & 1;
-            if s == 0 {
-                steps.push(Step::P);
-                i -= 1;
+            let ([eq0, eq1, cq], [lq0, lq1]) = qb[j];
+            let d = self.q[j] - pi;
+            let l2 = d.length_squared();
+            // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
+            let p0 = if i == 0 {
+                Tri::new(d.cross(ep0))
             } else {
-                steps.push(Step::Q);
-                j -= 1;
+                above[j]
+            };
+            let q0 = if j == 0 { Tri::new(d.cross(eq0)) } else { left };
+            let p1 = Tri::new(ep1.cross(d));
+            let q1 = Tri::new(eq1.cross(d));
+            above[j] = p1;
+            left = q1;
+            let node = &mut out[j];
+            if AREA {
+                // The area of the triangle a step makes (the start's count too).
+                for w in &mut node.w {
+                    w[0] += 0.5 * p1.len;
+                    w[1] += 0.5 * q1.len;
+                }
             }
-            s = b as usize;
+            if i == 0 && j == 0 {
+                continue;
+            }
+            let len = [p0.len, p1.len, q0.len, q1.len];
+            // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺ (a < b).
+            let t01 = d.dot(cp);
+            let t23 = d.dot(cq);
+            let t02 = -ep0.dot(q0.v);
+            let t03 = ep0.dot(q1.v);
+            let t12 = -ep1.dot(q0.v);
+            let t13 = ep1.dot(q1.v);
+            if COUNT {
+                let l = l2.sqrt();
+                // len: the neighbours' distances from the bridge's line, times l.
+                let on = [
+                    len[0] > 1e-12 * l * lp0.max(l),
+                    len[1] > 1e-12 * l * lp1.max(l),
+                    len[2] > 1e-12 * l * lq0.max(l),
+                    len[3] > 1e-12 * l * lq1.max(l),
+                ];
+                // For a pair (a, b), a < b: x = l·t_ab is l³ times the 2D cross product of
+                // the projections, len[a]·len[b] is l² times their lengths' product. `ge`: b
+                // is not clearly clockwise of a, `le`: not clearly counter-clockwise; seen
+                // from b the roles swap (the cross product changes sign, the tolerance not).
+                let pair = |a: usize, b: usize, t: f64| {
+                    let x = t * l;
+                    let tol = 1e-9 * len[a] * len[b];
+                    (x >= -tol, x <= tol)
+                };
+                let (ge01, le01) = pair(0, 1, t01);
+                let (ge02, le02) = pair(0, 2, t02);
+                let (ge03, le03) = pair(0, 3, t03);
+                let (ge12, le12) = pair(1, 2, t12);
+                let (ge13, le13) = pair(1, 3, t13);
+                let (ge23, le23) = pair(2, 3, t23);
+                // Some neighbour has every other one on one side of it (or at most one
+                // neighbour is off the bridge's line): the bridge is on the hull.
+                let side = |ok: [(bool, usize); 3]| ok.iter().all(|&(x, u)| x | !on[u]);
+                let hull0 = side([(ge01, 1), (ge02, 2), (ge03, 3)])
+                    | side([(le01, 1), (le02, 2), (le03, 3)]);
+                let hull1 = side([(le01, 0), (ge12, 2), (ge13, 3)])
+                    | side([(ge01, 0), (le12, 2), (le13, 3)]);
+                let hull2 = side([(le02, 0), (le12, 1), (ge23, 3)])
+                    | side([(ge02, 0), (ge12, 1), (le23, 3)]);
+                let hull3 = side([(le03, 0), (le13, 1), (le23, 2)])
+                    | side([(ge03, 0), (ge13, 1), (ge23, 2)]);
+                let any = (on[0] & hull0) | (on[1] & hull1) | (on[2] & hull2) | (on[3] & hull3);
+                let real = on.iter().filter(|&&x| x).count();
+                node.invalid = !(any || real <= 1);
+            }
+            if ENERGY {
+                // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no cross product:
+                // A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²). A degenerate triangle
+                // (inv 0) bends nothing.
+                let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
+                let bend = |a: Tri, b: Tri, t: f64| {
+                    let s2 = (t * t * l2 * a.inv * b.inv).min(1.0);
+                    let sn = if a.v.dot(b.v) >= 0.0 { s2 } else { 2.0 - s2 };
+                    let live = f64::from(u8::from(a.inv > 0.0 && b.inv > 0.0));
+                    live * 0.5 * (a.len + b.len) * sn * inv_l2
+                };
+                // [step that made the bridge][step that leaves it].
+                node.w[0][0] += bend(p0, p1, t01);
+                node.w[0][1] += bend(p0, q1, t03);
+                node.w[1][0] += bend(q0, p1, t12);
+                node.w[1][1] += bend(q0, q1, t23);
+            }
         }
-        steps.reverse();
-        steps
     }
 
     /// LODT + LMBT (§4).
@@ -931,6 +999,141 @@ fn same_loop(a: &[DVec3], b: &[DVec3], size: f64) -> bool {
     fwd || bwd
 }
 
+/// A triangle's area vector (twice its area, along its normal), the vector's length and
+/// 1 / its squared length (0 for a degenerate triangle).
+#[derive(Debug, Clone, Copy, Default)]
+struct Tri {
+    v: DVec3,
+    len: f64,
+    inv: f64,
+}
+
+impl Tri {
+    fn new(v: DVec3) -> Tri {
+        let q = v.length_squared();
+        Tri {
+            v,
+            len: q.sqrt(),
+            inv: if q > 0.0 { 1.0 / q } else { 0.0 },
+        }
+    }
+}
+
+/// What a grid node costs: its bridge is not locally convex (GODT), and the weight of the pair
+/// of steps through it, `w[made by][leaves by]` (P = 0, Q = 1): bending energy (GMBT) or the
+/// area of the triangle it leaves by (GMAT).
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeCost {
+    invalid: bool,
+    w: [[f64; 2]; 2],
+}
+
+/// The recurrence of the global triangulations, fed row by row with the nodes' costs: the best
+/// (fewest invalid bridges, then least weight) way to reach each node by a P step and by a Q
+/// step, two rows at a time, and one byte of back pointers per node.
+struct Recurrence {
+    m: usize,
+    n: usize,
+    cc: Vec<[u32; 2]>,
+    cv: Vec<[f64; 2]>,
+    nc: Vec<[u32; 2]>,
+    nv: Vec<[f64; 2]>,
+    back: Vec<u8>,
+}
+
+impl Recurrence {
+    const INF: u32 = 1 << 30;
+
+    fn new(m: usize, n: usize) -> Recurrence {
+        let mut r = Recurrence {
+            m,
+            n,
+            cc: vec![[Self::INF; 2]; n],
+            cv: vec![[f64::INFINITY; 2]; n],
+            nc: vec![[Self::INF; 2]; n],
+            nv: vec![[f64::INFINITY; 2]; n],
+            back: vec![0u8; m * n],
+        };
+        r.cc[0] = [0, 0];
+        r.cv[0] = [0.0, 0.0];
+        r
+    }
+
+    /// Rows `r0`, `r0 + 1`, … (in order, after all rows before `r0`), `n` costs each.
+    fn rows(&mut self, r0: usize, costs: &[NodeCost]) {
+        for (k, row) in costs.chunks(self.n).enumerate() {
+            self.row(r0 + k, row);
+        }
+    }
+
+    fn row(&mut self, i: usize, costs: &[NodeCost]) {
+        let (m, n) = (self.m, self.n);
+        let last_row = i + 1 == m;
+        // Each state has exactly one predecessor node (a P state the node above, a Q state
+        // the node to the left), so a state is written once, with the better of the two
+        // states it can come from (ties: P); written without branches, as the comparisons
+        // are unpredictable. Unreachable states hold INF (and ∞), which loses every
+        // comparison and stays far below u32::MAX after the at most m + n increments.
+        let pick = |c: [u32; 2], v: [f64; 2]| {
+            let q = c[1] < c[0] || (c[1] == c[0] && v[1] < v[0]);
+            (
+                if q { c[1] } else { c[0] },
+                if q { v[1] } else { v[0] },
+                u8::from(q),
+            )
+        };
+        let row = i * n;
+        let ends = if last_row { n - 1 } else { n };
+        for (j, node) in costs[..ends].iter().enumerate() {
+            let inc = u32::from(node.invalid);
+            let cur_c = self.cc[j];
+            let cur_v = self.cv[j];
+            let c = [cur_c[0] + inc, cur_c[1] + inc];
+            if !last_row {
+                let (bc, bv, arg) = pick(c, [cur_v[0] + node.w[0][0], cur_v[1] + node.w[1][0]]);
+                self.nc[j][0] = bc;
+                self.nv[j][0] = bv;
+                self.back[row + n + j] |= arg;
+            }
+            if j + 1 < n {
+                let (bc, bv, arg) = pick(c, [cur_v[0] + node.w[0][1], cur_v[1] + node.w[1][1]]);
+                self.cc[j + 1][1] = bc;
+                self.cv[j + 1][1] = bv;
+                self.back[row + j + 1] |= arg << 1;
+            }
+        }
+        if !last_row {
+            std::mem::swap(&mut self.cc, &mut self.nc);
+            std::mem::swap(&mut self.cv, &mut self.nv);
+            self.nc.iter_mut().for_each(|x| *x = [Self::INF; 2]);
+            self.nv.iter_mut().for_each(|x| *x = [f64::INFINITY; 2]);
+        }
+    }
+
+    /// The steps of the best path, once every row has been fed.
+    fn path(self) -> Vec<Step> {
+        let (m, n) = (self.m, self.n);
+        // `cc`/`cv` hold row m−1; pick the better end state (ties: P).
+        let (ec, ev) = (self.cc[n - 1], self.cv[n - 1]);
+        let mut s = usize::from(ec[1] < ec[0] || (ec[1] == ec[0] && ev[1] < ev[0]));
+        let mut steps = Vec::with_capacity(m + n - 2);
+        let (mut i, mut j) = (m - 1, n - 1);
+        while i > 0 || j > 0 {
+            let b = (self.back[i * n + j] >> s) & 1;
+            if s == 0 {
+                steps.push(Step::P);
+                i -= 1;
+            } else {
+                steps.push(Step::Q);
+                j -= 1;
+            }
+            s = b as usize;
+        }
+        steps.reverse();
+        steps
+    }
+}
+
 /// Unit normal (zero when degenerate) and area of a triangle.
 fn tri(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
     let x = (b - a).cross(c - a);
@@ -1111,6 +1314,30 @@ pub(crate) mod tests {
     }
 
     /// Every step sequence with m−1 P's and n−1 Q's.
+    #[test]
+    fn strip_dp_is_the_same_on_any_number_of_threads_and_bands() {
+        let mut rng = Rng(7);
+        for (m, n) in [(37, 29), (120, 64)] {
+            let s = random_strip(&mut rng, m, n);
+            for method in [Method::GodtGmbt, Method::Godt, Method::Gmbt, Method::Gmat] {
+                let one = s.triangulate(method);
+                let run = |band: usize, workers: usize| match method {
+                    Method::Godt => s.global_bands::<true, false, false>(band, workers),
+                    Method::Gmbt => s.global_bands::<false, true, false>(band, workers),
+                    Method::Gmat => s.global_bands::<false, false, true>(band, workers),
+                    _ => s.global_bands::<true, true, false>(band, workers),
+                };
+                for (band, workers) in [(1, 1), (1, 3), (5, 2), (7, 4), (64, 2)] {
+                    assert_eq!(
+                        run(band, workers),
+                        one,
+                        "{method:?} band {band} workers {workers}"
+                    );
+                }
+            }
+        }
+    }
+
     fn all_paths(m: usize, n: usize) -> Vec<Vec<Step>> {
         if m == 1 && n == 1 {
             return vec![vec![]];
