@@ -440,35 +440,25 @@ impl Strip {
         let band = band.max(1);
         let bands = m.div_ceil(band);
         let workers = workers.min(bands);
-        let compute = |b: usize, out: &mut Vec<NodeCost>, above: &mut Vec<Tri>| {
+        let cols = Columns::new(&self.q, &qb);
+        let compute = |b: usize, out: &mut Costs, row: &mut Tris| {
             let r0 = b * band;
             let r1 = (r0 + band).min(m);
-            out.clear();
-            out.resize((r1 - r0) * n, NodeCost::default());
+            out.resize((r1 - r0) * n);
+            row.resize(n);
             if r0 > 0 {
                 // The P-step triangles after row r0 − 1, by the expression cost_row uses.
-                let (pi, ep1) = (self.p[r0 - 1], pb[r0 - 1].0[1]);
-                above.clear();
-                above.extend(self.q.iter().map(|&q| Tri::new(ep1.cross(q - pi))));
-            } else {
-                above.clear();
-                above.resize(n, Tri::default());
+                row.after_p(&cols, self.p[r0 - 1], pb[r0 - 1].0[1]);
             }
             for (k, i) in (r0..r1).enumerate() {
-                self.cost_row::<COUNT, ENERGY, AREA>(
-                    i,
-                    &pb,
-                    &qb,
-                    above,
-                    &mut out[k * n..(k + 1) * n],
-                );
+                self.cost_row::<COUNT, ENERGY, AREA>(i, &pb, &cols, row, out, k * n);
             }
         };
         let mut dp = Recurrence::new(m, n);
         if workers <= 1 {
-            let (mut out, mut above) = (Vec::new(), Vec::new());
+            let (mut out, mut row) = (Costs::default(), Tris::default());
             for b in 0..bands {
-                compute(b, &mut out, &mut above);
+                compute(b, &mut out, &mut row);
                 dp.rows(b * band, &out);
             }
         } else {
@@ -478,18 +468,18 @@ impl Strip {
             // A worker takes a buffer before a band number, so the band the recurrence waits
             // for always has a buffer and a worker: no deadlock, at most `pool` bands in flight.
             let pool = 2 * workers;
-            let (free_tx, free_rx) = mpsc::sync_channel::<Vec<NodeCost>>(pool);
+            let (free_tx, free_rx) = mpsc::sync_channel::<Costs>(pool);
             for _ in 0..pool {
-                let _ = free_tx.send(Vec::new());
+                let _ = free_tx.send(Costs::default());
             }
             let free_rx = std::sync::Mutex::new(free_rx);
-            let (done_tx, done_rx) = mpsc::channel::<(usize, Vec<NodeCost>)>();
+            let (done_tx, done_rx) = mpsc::channel::<(usize, Costs)>();
             std::thread::scope(|sc| {
                 for _ in 0..workers {
                     let done_tx = done_tx.clone();
                     let (free_rx, next, compute) = (&free_rx, &next, &compute);
                     sc.spawn(move || {
-                        let mut above = Vec::new();
+                        let mut row = Tris::default();
                         loop {
                             let buf = match free_rx.lock() {
                                 Ok(rx) => rx.recv(),
@@ -500,7 +490,7 @@ impl Strip {
                             if b >= bands {
                                 return;
                             }
-                            compute(b, &mut buf, &mut above);
+                            compute(b, &mut buf, &mut row);
                             if done_tx.send((b, buf)).is_err() {
                                 return;
                             }
@@ -520,8 +510,8 @@ impl Strip {
                             }
                             // A worker died (it cannot: cost_row does not panic); fall back.
                             Err(_) => {
-                                let (mut out, mut above) = (Vec::new(), Vec::new());
-                                compute(b, &mut out, &mut above);
+                                let (mut out, mut row) = (Costs::default(), Tris::default());
+                                compute(b, &mut out, &mut row);
                                 out
                             }
                         },
@@ -532,123 +522,188 @@ impl Strip {
                 }
                 // Wake the workers waiting for a buffer: they see the bands are all taken.
                 for _ in 0..workers {
-                    let _ = free_tx.try_send(Vec::new());
+                    let _ = free_tx.try_send(Costs::default());
                 }
             });
         }
         dp.path()
     }
 
-    /// The costs of every node of row `i`: whether its bridge is invalid, and the weight of
-    /// each pair of steps through it. `above` holds, for each column, the P-step triangle that
-    /// ends at the node (the one after the node of the row above; ignored on row 0) and
-    /// receives this row's.
+    /// The costs of every node of row `i`, written at `out[at..at + n]`. `row` holds, for
+    /// each column, the P-step triangle that ends at the node (the one after the node of the
+    /// row above; recomputed on row 0) and receives this row's.
+    ///
+    /// The columns go in chunks of [`LANES`] fixed-size arrays, each step a loop over the
+    /// chunk with no dependency between columns, which the compiler turns into instructions
+    /// that handle several columns at once; the only thing carried from one chunk to the
+    /// next is the Q-step triangle after the chunk's last column.
+    #[allow(clippy::too_many_arguments)]
     fn cost_row<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
         &self,
         i: usize,
         pb: &[([DVec3; 3], [f64; 2])],
-        qb: &[([DVec3; 3], [f64; 2])],
-        above: &mut [Tri],
-        out: &mut [NodeCost],
+        cols: &Columns,
+        row: &mut Tris,
+        out: &mut Costs,
+        at: usize,
     ) {
-        let (m, n) = (self.m(), self.n());
+        const L: usize = LANES;
+        let n = self.n();
         let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
         let pi = self.p[i];
-        let last_row = i + 1 == m;
-        let mut left = Tri::default();
-        for j in 0..n {
-            if last_row && j + 1 == n {
-                break;
-            }
-            let ([eq0, eq1, cq], [lq0, lq1]) = qb[j];
-            let d = self.q[j] - pi;
-            let l2 = d.length_squared();
-            // Before, by a P step (d × e_p⁻) and by a Q step (d × e_q⁻); after (e⁺ × d).
-            let p0 = if i == 0 {
-                Tri::new(d.cross(ep0))
-            } else {
-                above[j]
+        // The Q-step triangle after the previous column (before the current one).
+        let mut carry = Tri3::default();
+        for c0 in (0..n).step_by(L) {
+            let w = L.min(n - c0);
+            let ld = |v: &[f64]| -> [f64; L] {
+                let mut a = [0.0; L];
+                a.copy_from_slice(&v[c0..c0 + L]);
+                a
             };
-            let q0 = if j == 0 { Tri::new(d.cross(eq0)) } else { left };
-            let p1 = Tri::new(ep1.cross(d));
-            let q1 = Tri::new(eq1.cross(d));
-            above[j] = p1;
-            left = q1;
-            let node = &mut out[j];
-            if AREA {
-                // The area of the triangle a step makes (the start's count too).
-                for w in &mut node.w {
-                    w[0] += 0.5 * p1.len;
-                    w[1] += 0.5 * q1.len;
+            let (qx, qy, qz) = (ld(&cols.q.x), ld(&cols.q.y), ld(&cols.q.z));
+            let (mut dx, mut dy, mut dz, mut l2) = ([0.0; L], [0.0; L], [0.0; L], [0.0; L]);
+            for k in 0..L {
+                dx[k] = qx[k] - pi.x;
+                dy[k] = qy[k] - pi.y;
+                dz[k] = qz[k] - pi.z;
+                l2[k] = dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k];
+            }
+            // After, by a P step (e_p⁺ × d) and by a Q step (e_q⁺ × d).
+            let (e1x, e1y, e1z) = (ld(&cols.e1.x), ld(&cols.e1.y), ld(&cols.e1.z));
+            let mut p1 = Chunk::default();
+            let mut q1 = Chunk::default();
+            for k in 0..L {
+                p1.set(k, cross(ep1.x, ep1.y, ep1.z, dx[k], dy[k], dz[k]));
+                q1.set(k, cross(e1x[k], e1y[k], e1z[k], dx[k], dy[k], dz[k]));
+            }
+            // Before, by a P step: d × e_p⁻ on row 0, else the row above's.
+            let mut p0 = Chunk::default();
+            if i == 0 {
+                for k in 0..L {
+                    p0.set(k, cross(dx[k], dy[k], dz[k], ep0.x, ep0.y, ep0.z));
+                }
+            } else {
+                p0 = Chunk {
+                    x: ld(&row.x),
+                    y: ld(&row.y),
+                    z: ld(&row.z),
+                    len: ld(&row.len),
+                    inv: ld(&row.inv),
+                };
+            }
+            row.store(c0, &p1);
+            // Before, by a Q step: the previous column's Q step after (d × e_q⁻ on column 0).
+            if c0 == 0 {
+                let e0 = DVec3::new(cols.e0.x[0], cols.e0.y[0], cols.e0.z[0]);
+                carry = Tri3::of(cross(dx[0], dy[0], dz[0], e0.x, e0.y, e0.z));
+            }
+            let mut q0 = Chunk::default();
+            q0.put(0, carry);
+            for k in 1..L {
+                q0.x[k] = q1.x[k - 1];
+                q0.y[k] = q1.y[k - 1];
+                q0.z[k] = q1.z[k - 1];
+                q0.len[k] = q1.len[k - 1];
+                q0.inv[k] = q1.inv[k - 1];
+            }
+            carry = q1.get(L - 1);
+
+            let (cqx, cqy, cqz) = (ld(&cols.c.x), ld(&cols.c.y), ld(&cols.c.z));
+            let (lq0, lq1) = (ld(&cols.l0), ld(&cols.l1));
+            let mut invalid = [false; L];
+            let (mut w00, mut w01, mut w10, mut w11) = ([0.0; L], [0.0; L], [0.0; L], [0.0; L]);
+            let dot = |t: &Chunk, k: usize, e: DVec3| e.x * t.x[k] + e.y * t.y[k] + e.z * t.z[k];
+            for k in 0..L {
+                let l2 = l2[k];
+                let len = [p0.len[k], p1.len[k], q0.len[k], q1.len[k]];
+                // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺ (a < b).
+                let t01 = dx[k] * cp.x + dy[k] * cp.y + dz[k] * cp.z;
+                let t23 = dx[k] * cqx[k] + dy[k] * cqy[k] + dz[k] * cqz[k];
+                let t02 = -dot(&q0, k, ep0);
+                let t03 = dot(&q1, k, ep0);
+                let t12 = -dot(&q0, k, ep1);
+                let t13 = dot(&q1, k, ep1);
+                if COUNT {
+                    let l = l2.sqrt();
+                    // len: the neighbours' distances from the bridge's line, times l.
+                    let o0 = len[0] > 1e-12 * l * lp0.max(l);
+                    let o1 = len[1] > 1e-12 * l * lp1.max(l);
+                    let o2 = len[2] > 1e-12 * l * lq0[k].max(l);
+                    let o3 = len[3] > 1e-12 * l * lq1[k].max(l);
+                    // For a pair (a, b), a < b: x = l·t_ab is l³ times the 2D cross product
+                    // of the projections, len[a]·len[b] is l² times their lengths' product.
+                    // `ge`: b is not clearly clockwise of a, `le`: not clearly
+                    // counter-clockwise; seen from b the roles swap (the cross product
+                    // changes sign, the tolerance not).
+                    let pair = |a: usize, b: usize, t: f64| {
+                        let x = t * l;
+                        let tol = 1e-9 * len[a] * len[b];
+                        (x >= -tol, x <= tol)
+                    };
+                    let (ge01, le01) = pair(0, 1, t01);
+                    let (ge02, le02) = pair(0, 2, t02);
+                    let (ge03, le03) = pair(0, 3, t03);
+                    let (ge12, le12) = pair(1, 2, t12);
+                    let (ge13, le13) = pair(1, 3, t13);
+                    let (ge23, le23) = pair(2, 3, t23);
+                    // Some neighbour has every other one on one side of it (or at most one
+                    // neighbour is off the bridge's line): the bridge is on the hull.
+                    let hull0 = ((ge01 | !o1) & (ge02 | !o2) & (ge03 | !o3))
+                        | ((le01 | !o1) & (le02 | !o2) & (le03 | !o3));
+                    let hull1 = ((le01 | !o0) & (ge12 | !o2) & (ge13 | !o3))
+                        | ((ge01 | !o0) & (le12 | !o2) & (le13 | !o3));
+                    let hull2 = ((le02 | !o0) & (le12 | !o1) & (ge23 | !o3))
+                        | ((ge02 | !o0) & (ge12 | !o1) & (le23 | !o3));
+                    let hull3 = ((le03 | !o0) & (le13 | !o1) & (le23 | !o2))
+                        | ((ge03 | !o0) & (ge13 | !o1) & (ge23 | !o2));
+                    let any = (o0 & hull0) | (o1 & hull1) | (o2 & hull2) | (o3 & hull3);
+                    let real = u8::from(o0) + u8::from(o1) + u8::from(o2) + u8::from(o3);
+                    invalid[k] = !(any | (real <= 1));
+                }
+                if ENERGY {
+                    // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no cross product:
+                    // A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²). A degenerate triangle
+                    // (inv 0) bends nothing.
+                    let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
+                    let bend = |a: &Chunk, b: &Chunk, t: f64| {
+                        let s2 = (t * t * l2 * a.inv[k] * b.inv[k]).min(1.0);
+                        let ab = a.x[k] * b.x[k] + a.y[k] * b.y[k] + a.z[k] * b.z[k];
+                        let sn = if ab >= 0.0 { s2 } else { 2.0 - s2 };
+                        let live = f64::from(u8::from((a.inv[k] > 0.0) & (b.inv[k] > 0.0)));
+                        live * 0.5 * (a.len[k] + b.len[k]) * sn * inv_l2
+                    };
+                    w00[k] = bend(&p0, &p1, t01);
+                    w01[k] = bend(&p0, &q1, t03);
+                    w10[k] = bend(&q0, &p1, t12);
+                    w11[k] = bend(&q0, &q1, t23);
+                }
+                if AREA {
+                    // The area of the triangle a step makes.
+                    let (a0, a1) = (0.5 * p1.len[k], 0.5 * q1.len[k]);
+                    w00[k] += a0;
+                    w10[k] += a0;
+                    w01[k] += a1;
+                    w11[k] += a1;
                 }
             }
-            if i == 0 && j == 0 {
-                continue;
-            }
-            let len = [p0.len, p1.len, q0.len, q1.len];
-            // Triple products d·(e_a × e_b) over the banks p⁻, p⁺, q⁻, q⁺ (a < b).
-            let t01 = d.dot(cp);
-            let t23 = d.dot(cq);
-            let t02 = -ep0.dot(q0.v);
-            let t03 = ep0.dot(q1.v);
-            let t12 = -ep1.dot(q0.v);
-            let t13 = ep1.dot(q1.v);
-            if COUNT {
-                let l = l2.sqrt();
-                // len: the neighbours' distances from the bridge's line, times l.
-                let on = [
-                    len[0] > 1e-12 * l * lp0.max(l),
-                    len[1] > 1e-12 * l * lp1.max(l),
-                    len[2] > 1e-12 * l * lq0.max(l),
-                    len[3] > 1e-12 * l * lq1.max(l),
-                ];
-                // For a pair (a, b), a < b: x = l·t_ab is l³ times the 2D cross product of
-                // the projections, len[a]·len[b] is l² times their lengths' product. `ge`: b
-                // is not clearly clockwise of a, `le`: not clearly counter-clockwise; seen
-                // from b the roles swap (the cross product changes sign, the tolerance not).
-                let pair = |a: usize, b: usize, t: f64| {
-                    let x = t * l;
-                    let tol = 1e-9 * len[a] * len[b];
-                    (x >= -tol, x <= tol)
+            if i == 0 && c0 == 0 {
+                // The starting bridge counts as valid and bends nothing; its step's area
+                // counts.
+                invalid[0] = false;
+                let (a0, a1) = if AREA {
+                    (0.5 * p1.len[0], 0.5 * q1.len[0])
+                } else {
+                    (0.0, 0.0)
                 };
-                let (ge01, le01) = pair(0, 1, t01);
-                let (ge02, le02) = pair(0, 2, t02);
-                let (ge03, le03) = pair(0, 3, t03);
-                let (ge12, le12) = pair(1, 2, t12);
-                let (ge13, le13) = pair(1, 3, t13);
-                let (ge23, le23) = pair(2, 3, t23);
-                // Some neighbour has every other one on one side of it (or at most one
-                // neighbour is off the bridge's line): the bridge is on the hull.
-                let side = |ok: [(bool, usize); 3]| ok.iter().all(|&(x, u)| x | !on[u]);
-                let hull0 = side([(ge01, 1), (ge02, 2), (ge03, 3)])
-                    | side([(le01, 1), (le02, 2), (le03, 3)]);
-                let hull1 = side([(le01, 0), (ge12, 2), (ge13, 3)])
-                    | side([(ge01, 0), (le12, 2), (le13, 3)]);
-                let hull2 = side([(le02, 0), (le12, 1), (ge23, 3)])
-                    | side([(ge02, 0), (ge12, 1), (le23, 3)]);
-                let hull3 = side([(le03, 0), (le13, 1), (le23, 2)])
-                    | side([(ge03, 0), (ge13, 1), (ge23, 2)]);
-                let any = (on[0] & hull0) | (on[1] & hull1) | (on[2] & hull2) | (on[3] & hull3);
-                let real = on.iter().filter(|&&x| x).count();
-                node.invalid = !(any || real <= 1);
+                (w00[0], w10[0], w01[0], w11[0]) = (a0, a0, a1, a1);
             }
-            if ENERGY {
-                // |N1 × N2| = |d|·|d·(a × b)|, so sin²θ·A/L² needs no cross product:
-                // A sin²θ / L² = ½(|N1|+|N2|)·t²/(|N1|²|N2|²). A degenerate triangle
-                // (inv 0) bends nothing.
-                let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
-                let bend = |a: Tri, b: Tri, t: f64| {
-                    let s2 = (t * t * l2 * a.inv * b.inv).min(1.0);
-                    let sn = if a.v.dot(b.v) >= 0.0 { s2 } else { 2.0 - s2 };
-                    let live = f64::from(u8::from(a.inv > 0.0 && b.inv > 0.0));
-                    live * 0.5 * (a.len + b.len) * sn * inv_l2
-                };
-                // [step that made the bridge][step that leaves it].
-                node.w[0][0] += bend(p0, p1, t01);
-                node.w[0][1] += bend(p0, q1, t03);
-                node.w[1][0] += bend(q0, p1, t12);
-                node.w[1][1] += bend(q0, q1, t23);
-            }
+            let o = at + c0;
+            out.invalid[o..o + w].copy_from_slice(&invalid[..w]);
+            let [[o00, o01], [o10, o11]] = &mut out.w;
+            o00[o..o + w].copy_from_slice(&w00[..w]);
+            o01[o..o + w].copy_from_slice(&w01[..w]);
+            o10[o..o + w].copy_from_slice(&w10[..w]);
+            o11[o..o + w].copy_from_slice(&w11[..w]);
         }
     }
 
@@ -999,33 +1054,185 @@ fn same_loop(a: &[DVec3], b: &[DVec3], size: f64) -> bool {
     fwd || bwd
 }
 
-/// A triangle's area vector (twice its area, along its normal), the vector's length and
-/// 1 / its squared length (0 for a degenerate triangle).
+/// Columns per chunk in [`Strip::cost_row`].
+const LANES: usize = 8;
+
+/// Vectors stored one array per axis (structure of arrays), padded with zeros to a whole
+/// number of [`LANES`] chunks.
+#[derive(Debug, Clone, Default)]
+struct Soa3 {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+}
+
+impl Soa3 {
+    fn of(v: impl Iterator<Item = DVec3> + Clone) -> Soa3 {
+        Soa3 {
+            x: padded(v.clone().map(|p| p.x)),
+            y: padded(v.clone().map(|p| p.y)),
+            z: padded(v.map(|p| p.z)),
+        }
+    }
+}
+
+/// The values, then zeros up to a whole number of [`LANES`].
+fn padded(v: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut a: Vec<f64> = v.collect();
+    a.resize(a.len().div_ceil(LANES) * LANES, 0.0);
+    a
+}
+
+/// A triangle's area vector (twice its area, along its normal), its length and 1 / its
+/// squared length (0 for a degenerate triangle).
 #[derive(Debug, Clone, Copy, Default)]
-struct Tri {
-    v: DVec3,
+struct Tri3 {
+    x: f64,
+    y: f64,
+    z: f64,
     len: f64,
     inv: f64,
 }
 
-impl Tri {
-    fn new(v: DVec3) -> Tri {
-        let q = v.length_squared();
-        Tri {
-            v,
+impl Tri3 {
+    #[inline(always)]
+    fn of((x, y, z): (f64, f64, f64)) -> Tri3 {
+        let q = x * x + y * y + z * z;
+        Tri3 {
+            x,
+            y,
+            z,
             len: q.sqrt(),
             inv: if q > 0.0 { 1.0 / q } else { 0.0 },
         }
     }
 }
 
-/// What a grid node costs: its bridge is not locally convex (GODT), and the weight of the pair
-/// of steps through it, `w[made by][leaves by]` (P = 0, Q = 1): bending energy (GMBT) or the
-/// area of the triangle it leaves by (GMAT).
+/// [`Tri3`]s of one chunk of columns, one array per field.
 #[derive(Debug, Clone, Copy, Default)]
-struct NodeCost {
-    invalid: bool,
-    w: [[f64; 2]; 2],
+struct Chunk {
+    x: [f64; LANES],
+    y: [f64; LANES],
+    z: [f64; LANES],
+    len: [f64; LANES],
+    inv: [f64; LANES],
+}
+
+impl Chunk {
+    #[inline(always)]
+    fn put(&mut self, k: usize, t: Tri3) {
+        (self.x[k], self.y[k], self.z[k], self.len[k], self.inv[k]) = (t.x, t.y, t.z, t.len, t.inv);
+    }
+
+    #[inline(always)]
+    fn set(&mut self, k: usize, v: (f64, f64, f64)) {
+        self.put(k, Tri3::of(v));
+    }
+
+    fn get(&self, k: usize) -> Tri3 {
+        Tri3 {
+            x: self.x[k],
+            y: self.y[k],
+            z: self.z[k],
+            len: self.len[k],
+            inv: self.inv[k],
+        }
+    }
+}
+
+/// [`Tri3`]s of a whole row, one array per field, padded to whole chunks: the P-step
+/// triangles that end at the next row.
+#[derive(Debug, Clone, Default)]
+struct Tris {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    len: Vec<f64>,
+    inv: Vec<f64>,
+}
+
+impl Tris {
+    fn resize(&mut self, n: usize) {
+        let n = n.div_ceil(LANES) * LANES;
+        for a in [
+            &mut self.x,
+            &mut self.y,
+            &mut self.z,
+            &mut self.len,
+            &mut self.inv,
+        ] {
+            a.resize(n, 0.0);
+        }
+    }
+
+    fn store(&mut self, c0: usize, c: &Chunk) {
+        self.x[c0..c0 + LANES].copy_from_slice(&c.x);
+        self.y[c0..c0 + LANES].copy_from_slice(&c.y);
+        self.z[c0..c0 + LANES].copy_from_slice(&c.z);
+        self.len[c0..c0 + LANES].copy_from_slice(&c.len);
+        self.inv[c0..c0 + LANES].copy_from_slice(&c.inv);
+    }
+
+    /// The P-step triangles after the bridges from `p` (bank `e1` to the next point):
+    /// `e1 × (q_j − p)`, the expression [`Strip::cost_row`] computes them with.
+    fn after_p(&mut self, cols: &Columns, p: DVec3, e1: DVec3) {
+        for j in 0..self.x.len() {
+            let (dx, dy, dz) = (cols.q.x[j] - p.x, cols.q.y[j] - p.y, cols.q.z[j] - p.z);
+            let t = Tri3::of(cross(e1.x, e1.y, e1.z, dx, dy, dz));
+            (self.x[j], self.y[j], self.z[j], self.len[j], self.inv[j]) =
+                (t.x, t.y, t.z, t.len, t.inv);
+        }
+    }
+}
+
+/// The points of Q and their banks (to the previous and next point, their cross product and
+/// lengths), by column, padded to whole chunks.
+struct Columns {
+    q: Soa3,
+    e0: Soa3,
+    e1: Soa3,
+    c: Soa3,
+    l0: Vec<f64>,
+    l1: Vec<f64>,
+}
+
+impl Columns {
+    fn new(q: &[DVec3], qb: &[([DVec3; 3], [f64; 2])]) -> Columns {
+        Columns {
+            q: Soa3::of(q.iter().copied()),
+            e0: Soa3::of(qb.iter().map(|b| b.0[0])),
+            e1: Soa3::of(qb.iter().map(|b| b.0[1])),
+            c: Soa3::of(qb.iter().map(|b| b.0[2])),
+            l0: padded(qb.iter().map(|b| b.1[0])),
+            l1: padded(qb.iter().map(|b| b.1[1])),
+        }
+    }
+}
+
+/// `a × b`, component-wise (glam's expression, so results match `DVec3::cross`).
+#[inline(always)]
+fn cross(ax: f64, ay: f64, az: f64, bx: f64, by: f64, bz: f64) -> (f64, f64, f64) {
+    (ay * bz - by * az, az * bx - bz * ax, ax * by - bx * ay)
+}
+
+/// What the nodes of a band of rows cost, row after row: the bridge is not locally convex
+/// (GODT), and the weight of the pair of steps through it, `w[made by][leaves by]` (P = 0,
+/// Q = 1): bending energy (GMBT) or the area of the triangle it leaves by (GMAT).
+#[derive(Debug, Clone, Default)]
+struct Costs {
+    invalid: Vec<bool>,
+    w: [[Vec<f64>; 2]; 2],
+}
+
+impl Costs {
+    fn resize(&mut self, len: usize) {
+        self.invalid.clear();
+        self.invalid.resize(len, false);
+        for w in self.w.iter_mut().flatten() {
+            w.clear();
+            w.resize(len, 0.0);
+        }
+    }
 }
 
 /// The recurrence of the global triangulations, fed row by row with the nodes' costs: the best
@@ -1060,13 +1267,14 @@ impl Recurrence {
     }
 
     /// Rows `r0`, `r0 + 1`, … (in order, after all rows before `r0`), `n` costs each.
-    fn rows(&mut self, r0: usize, costs: &[NodeCost]) {
-        for (k, row) in costs.chunks(self.n).enumerate() {
-            self.row(r0 + k, row);
+    fn rows(&mut self, r0: usize, costs: &Costs) {
+        for k in 0..costs.invalid.len() / self.n {
+            self.row(r0 + k, costs, k * self.n);
         }
     }
 
-    fn row(&mut self, i: usize, costs: &[NodeCost]) {
+    /// Row `i`, whose costs start at `at` in `costs`.
+    fn row(&mut self, i: usize, costs: &Costs, at: usize) {
         let (m, n) = (self.m, self.n);
         let last_row = i + 1 == m;
         // Each state has exactly one predecessor node (a P state the node above, a Q state
@@ -1084,19 +1292,23 @@ impl Recurrence {
         };
         let row = i * n;
         let ends = if last_row { n - 1 } else { n };
-        for (j, node) in costs[..ends].iter().enumerate() {
-            let inc = u32::from(node.invalid);
+        let inv = &costs.invalid[at..at + ends];
+        let [[w00, w01], [w10, w11]] = &costs.w;
+        let (w00, w01) = (&w00[at..at + ends], &w01[at..at + ends]);
+        let (w10, w11) = (&w10[at..at + ends], &w11[at..at + ends]);
+        for j in 0..ends {
+            let inc = u32::from(inv[j]);
             let cur_c = self.cc[j];
             let cur_v = self.cv[j];
             let c = [cur_c[0] + inc, cur_c[1] + inc];
             if !last_row {
-                let (bc, bv, arg) = pick(c, [cur_v[0] + node.w[0][0], cur_v[1] + node.w[1][0]]);
+                let (bc, bv, arg) = pick(c, [cur_v[0] + w00[j], cur_v[1] + w10[j]]);
                 self.nc[j][0] = bc;
                 self.nv[j][0] = bv;
                 self.back[row + n + j] |= arg;
             }
             if j + 1 < n {
-                let (bc, bv, arg) = pick(c, [cur_v[0] + node.w[0][1], cur_v[1] + node.w[1][1]]);
+                let (bc, bv, arg) = pick(c, [cur_v[0] + w01[j], cur_v[1] + w11[j]]);
                 self.cc[j + 1][1] = bc;
                 self.cv[j + 1][1] = bv;
                 self.back[row + j + 1] |= arg << 1;
