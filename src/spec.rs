@@ -86,8 +86,13 @@
 //!
 //! Points have 2 or 3 coordinates (z = 0 when left out). A curve's keys are checked when the
 //! spec is read (errors name `surface[k].p.radius` and the line of `p`), the curves are
-//! sampled there too, and `q` equal to `p` is an error. A strip in a spec is developed as
-//! given; the neutral-surface shift of sheet metal is the `fitting` command's.
+//! sampled there too, and `q` equal to `p` is an error.
+//!
+//! Sheet thickness: in `[material] kind = "metal"` a strip is developed on the neutral surface
+//! of the sheet, K·t from the inside, like the `fitting` command's blanks: `side` says which
+//! surface the curves describe ("outside" default: the neutral surface is (1 − K)·t inside
+//! them; "inside": K·t outside; "neutral": as given) and `k_factor` is K (0 to 1, default 0.4,
+//! FreeCAD SheetMetal's). Paper and fabric strips are developed as given.
 
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
@@ -147,6 +152,60 @@ pub struct StripSpec {
     /// How far (mm) the developed surface lies inside the given one: (1 − K)·t for a metal
     /// blank given by its outside, 0 to develop the given surface.
     pub neutral_offset: f64,
+    /// For a strip from a spec file: which surface of the sheet the curves describe and the
+    /// K factor, from which [`SurfaceSpec::for_material`] sets `neutral_offset` once the
+    /// material is known (flags may change it after the spec is read); `None` keeps
+    /// `neutral_offset` as it is (the `fitting` command sets it itself).
+    pub sheet: Option<(SheetSide, f64)>,
+}
+
+/// Which surface of a metal sheet a strip's curves describe (`side`); the blank is developed
+/// on the neutral surface, K·t from the inside.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SheetSide {
+    /// The outside (as a shop measures a duct): the neutral surface is (1 − K)·t inside.
+    #[default]
+    Outside,
+    /// The inside: the neutral surface is K·t outside.
+    Inside,
+    /// The curves already describe the neutral surface.
+    Neutral,
+}
+
+impl SheetSide {
+    pub const NAMES: [(&'static str, SheetSide); 3] = [
+        ("outside", SheetSide::Outside),
+        ("inside", SheetSide::Inside),
+        ("neutral", SheetSide::Neutral),
+    ];
+
+    /// How far inside the given surface the neutral surface lies (negative: outside) for a
+    /// sheet `t` mm thick with K factor `k`.
+    pub fn neutral_offset(self, k: f64, t: f64) -> f64 {
+        match self {
+            SheetSide::Outside => (1.0 - k) * t,
+            SheetSide::Inside => -k * t,
+            SheetSide::Neutral => 0.0,
+        }
+    }
+}
+
+impl SurfaceSpec {
+    /// This surface as it is developed in `material`: a strip from a spec file in metal moves
+    /// to its neutral surface (see [`StripSpec::sheet`]); paper and fabric are thin enough to
+    /// be developed as given.
+    pub fn for_material(&self, material: &Material) -> SurfaceSpec {
+        let mut s = self.clone();
+        if let Some(st) = &mut s.strip {
+            if let Some((side, k)) = st.sheet {
+                st.neutral_offset = match material.kind {
+                    MaterialKind::Metal => side.neutral_offset(k, material.thickness),
+                    _ => 0.0,
+                };
+            }
+        }
+        s
+    }
 }
 
 /// How a surface is made.
@@ -494,6 +553,8 @@ struct RawSurface {
     method: Option<Spanned<Val>>,
     bend_lines: Option<Spanned<Val>>,
     tolerance: Option<Spanned<Val>>,
+    side: Option<Spanned<Val>>,
+    k_factor: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -1124,6 +1185,17 @@ impl Ctx<'_> {
         let method = self
             .choice(&s.method, &format!("{key}.method"), &Method::NAMES)?
             .unwrap_or_default();
+        let side = self
+            .choice(&s.side, &format!("{key}.side"), &SheetSide::NAMES)?
+            .unwrap_or_default();
+        let k_factor = self
+            .number(
+                &s.k_factor,
+                &format!("{key}.k_factor"),
+                "a number from 0 to 1",
+                |v| (0.0..=1.0).contains(&v),
+            )?
+            .map_or(0.4, |(v, _)| v);
         let bend_lines = match &s.bend_lines {
             None => BendLines::All,
             Some(v) => match v.get_ref() {
@@ -1188,6 +1260,7 @@ impl Ctx<'_> {
                 bend_lines,
                 tolerance,
                 neutral_offset: 0.0,
+                sheet: Some((side, k_factor)),
             }),
         })
     }

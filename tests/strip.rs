@@ -491,3 +491,84 @@ height = 1000
         assert_eq!(a.surface.mesh, b.surface.mesh);
     }
 }
+
+#[test]
+fn strip_spec_metal_cone_is_developed_on_the_neutral_surface_of_its_side() {
+    let dir = scratch("strip-spec-metal");
+    // A frustum Ø300 → Ø160, 200 high, 2 mm metal, K = 0.4 unless the spec says otherwise.
+    let spec = |material: &str, extra: &str| {
+        format!(
+            r#"
+name = "metal-cone"
+
+[[surface]]
+kind = "strip"
+p = {{ kind = "circle", center = [0, 0, 0], diameter = 300 }}
+q = {{ kind = "circle", center = [0, 0, 200], diameter = 160 }}
+bend_lines = "none"
+{extra}
+
+[material]
+kind = "{material}"
+thickness = 2
+
+[sheet]
+width = 1500
+height = 1000
+"#
+        )
+    };
+    let area = |name: &str, text: &str| -> f64 {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join(name);
+        let o = flatcut(&[
+            "cut",
+            path.to_str().unwrap(),
+            "--device",
+            "hpgl-pens",
+            "--dry-run",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let plt = std::fs::read_to_string(out.join("metal-cone.plt")).unwrap();
+        cut_contour(&plt).0
+    };
+    let s = (70.0f64.powi(2) + 200.0f64.powi(2)).sqrt();
+    // The neutral surface lies δ along the normal from the given one; the end circles stay in
+    // their planes, so both radii change by δ·s/h and the slant height stays s.
+    let exact = |delta: f64| {
+        let dr = delta * s / 200.0;
+        PI * (150.0 - dr + 80.0 - dr) * s
+    };
+    for (name, material, extra, delta) in [
+        ("outside", "metal", "", 0.6 * 2.0),
+        ("inside", "metal", "side = \"inside\"", -0.4 * 2.0),
+        (
+            "k-half",
+            "metal",
+            "side = \"outside\"\nk_factor = 0.5",
+            0.5 * 2.0,
+        ),
+        ("neutral", "metal", "side = \"neutral\"", 0.0),
+        ("paper", "paper", "side = \"outside\"", 0.0),
+    ] {
+        let got = area(name, &spec(material, extra));
+        let want = exact(delta);
+        let err = (got - want).abs() / want;
+        eprintln!(
+            "{name}: blank {got:.1} mm², neutral surface {want:.1} mm² ({:.4} %)",
+            100.0 * err
+        );
+        assert!(err < 0.002, "{name}: {got} vs {want}");
+    }
+    // The outside and inside blanks differ by far more than the tolerance: the shift is real.
+    assert!(exact(1.2) < exact(0.0) * 0.99);
+    // A K factor outside 0..1 is refused naming the key.
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, spec("metal", "k_factor = 1.5")).unwrap();
+    let o = flatcut(&["cut", bad.to_str().unwrap(), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("surface[1].k_factor"), "{}", stderr(&o));
+}

@@ -138,7 +138,7 @@ impl PatternArgs {
 pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
     let mut flats = Vec::new();
     for s in &spec.surfaces {
-        let surface = crate::surface::build(s).map_err(|e| {
+        let surface = crate::surface::build(&s.for_material(&spec.material)).map_err(|e| {
             if s.line > 0 {
                 Error::At {
                     file: spec.path.clone(),

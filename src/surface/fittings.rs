@@ -422,6 +422,7 @@ impl Fitting {
             bend_lines: opts.bend_lines,
             tolerance: opts.tolerance,
             neutral_offset: (1.0 - k) * t,
+            sheet: None,
         })
     }
 }

@@ -144,9 +144,9 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             mt.interior
         ));
     }
-    if st.neutral_offset > 0.0 {
+    if st.neutral_offset != 0.0 {
         let reach = s.inner_reach();
-        if st.neutral_offset >= reach {
+        if st.neutral_offset > 0.0 && st.neutral_offset >= reach {
             return Err(err(format!(
                 "the neutral surface lies {:.3} mm inside, more than the curves allow ({reach:.3} mm from their centre): the thickness is larger than a radius",
                 st.neutral_offset
