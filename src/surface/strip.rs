@@ -451,7 +451,7 @@ impl Strip {
                 row.after_p(&cols, self.p[r0 - 1], pb[r0 - 1].0[1]);
             }
             for (k, i) in (r0..r1).enumerate() {
-                self.cost_row::<COUNT, ENERGY, AREA>(i, &pb, &cols, row, out, k * n);
+                self.cost_row_fastest::<COUNT, ENERGY, AREA>(i, &pb, &cols, row, out, k * n);
             }
         };
         let mut dp = Recurrence::new(m, n);
@@ -529,6 +529,47 @@ impl Strip {
         dp.path()
     }
 
+    /// [`Strip::cost_row`] compiled for the widest vector instructions the CPU has: AVX2 on
+    /// x86-64 machines that have it (checked at run time), else the baseline. The compiler
+    /// never fuses a multiply and an add on its own, so both give bit-identical costs.
+    #[allow(clippy::too_many_arguments)]
+    fn cost_row_fastest<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
+        &self,
+        i: usize,
+        pb: &[([DVec3; 3], [f64; 2])],
+        cols: &Columns,
+        row: &mut Tris,
+        out: &mut Costs,
+        at: usize,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            unsafe { self.cost_row_avx2::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at) };
+            return;
+        }
+        self.cost_row::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at);
+    }
+
+    /// [`Strip::cost_row`] with AVX2 instructions.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn cost_row_avx2<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
+        &self,
+        i: usize,
+        pb: &[([DVec3; 3], [f64; 2])],
+        cols: &Columns,
+        row: &mut Tris,
+        out: &mut Costs,
+        at: usize,
+    ) {
+        self.cost_row::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at);
+    }
+
     /// The costs of every node of row `i`, written at `out[at..at + n]`. `row` holds, for
     /// each column, the P-step triangle that ends at the node (the one after the node of the
     /// row above; recomputed on row 0) and receives this row's.
@@ -538,6 +579,7 @@ impl Strip {
     /// that handle several columns at once; the only thing carried from one chunk to the
     /// next is the Q-step triangle after the chunk's last column.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn cost_row<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
         &self,
         i: usize,
@@ -1055,7 +1097,7 @@ fn same_loop(a: &[DVec3], b: &[DVec3], size: f64) -> bool {
 }
 
 /// Columns per chunk in [`Strip::cost_row`].
-const LANES: usize = 8;
+const LANES: usize = 4;
 
 /// Vectors stored one array per axis (structure of arrays), padded with zeros to a whole
 /// number of [`LANES`] chunks.
@@ -1225,11 +1267,10 @@ struct Costs {
 }
 
 impl Costs {
+    /// Room for `len` nodes; the values left are overwritten by [`Strip::cost_row`].
     fn resize(&mut self, len: usize) {
-        self.invalid.clear();
         self.invalid.resize(len, false);
         for w in self.w.iter_mut().flatten() {
-            w.clear();
             w.resize(len, 0.0);
         }
     }
@@ -1237,15 +1278,35 @@ impl Costs {
 
 /// The recurrence of the global triangulations, fed row by row with the nodes' costs: the best
 /// (fewest invalid bridges, then least weight) way to reach each node by a P step and by a Q
-/// step, two rows at a time, and one byte of back pointers per node.
+/// step, for three rows at a time, and one byte of back pointers per node.
+///
+/// Each state has exactly one predecessor node (a P state the node above, a Q state the node
+/// to the left), so a state is written once, with the better of the two states it can come
+/// from (ties: P), without branches, as the comparisons are unpredictable. Unreachable states
+/// hold INF (and ∞), which loses every comparison and stays far below `u32::MAX` after the at
+/// most m + n increments. Along a row each node waits for the one before it; two rows are
+/// worked on together, the lower one column behind, so that the processor overlaps two such
+/// chains.
 struct Recurrence {
     m: usize,
     n: usize,
-    cc: Vec<[u32; 2]>,
-    cv: Vec<[f64; 2]>,
-    nc: Vec<[u32; 2]>,
-    nv: Vec<[f64; 2]>,
+    /// Row i's states at `(i % 3) · n + j`.
+    st: Vec<State>,
     back: Vec<u8>,
+}
+
+/// The best costs of reaching a node by a P step ([0]) and by a Q step ([1]).
+#[derive(Debug, Clone, Copy)]
+struct State {
+    c: [u32; 2],
+    v: [f64; 2],
+}
+
+impl State {
+    const NONE: State = State {
+        c: [Recurrence::INF; 2],
+        v: [f64::INFINITY; 2],
+    };
 }
 
 impl Recurrence {
@@ -1255,34 +1316,45 @@ impl Recurrence {
         let mut r = Recurrence {
             m,
             n,
-            cc: vec![[Self::INF; 2]; n],
-            cv: vec![[f64::INFINITY; 2]; n],
-            nc: vec![[Self::INF; 2]; n],
-            nv: vec![[f64::INFINITY; 2]; n],
+            st: vec![State::NONE; 3 * n],
             back: vec![0u8; m * n],
         };
-        r.cc[0] = [0, 0];
-        r.cv[0] = [0.0, 0.0];
+        r.st[0] = State {
+            c: [0, 0],
+            v: [0.0, 0.0],
+        };
         r
     }
 
     /// Rows `r0`, `r0 + 1`, … (in order, after all rows before `r0`), `n` costs each.
     fn rows(&mut self, r0: usize, costs: &Costs) {
-        for k in 0..costs.invalid.len() / self.n {
-            self.row(r0 + k, costs, k * self.n);
+        let n = self.n;
+        let rows = costs.invalid.len() / n;
+        let mut k = 0;
+        while k < rows {
+            let i = r0 + k;
+            // Two rows together while neither is the last one (which has no P steps).
+            if k + 1 < rows && i + 2 < self.m {
+                self.two_rows(i, costs, k * n);
+                k += 2;
+            } else {
+                self.one_row(i, costs, k * n);
+                k += 1;
+            }
         }
     }
 
-    /// Row `i`, whose costs start at `at` in `costs`.
-    fn row(&mut self, i: usize, costs: &Costs, at: usize) {
-        let (m, n) = (self.m, self.n);
-        let last_row = i + 1 == m;
-        // Each state has exactly one predecessor node (a P state the node above, a Q state
-        // the node to the left), so a state is written once, with the better of the two
-        // states it can come from (ties: P); written without branches, as the comparisons
-        // are unpredictable. Unreachable states hold INF (and ∞), which loses every
-        // comparison and stays far below u32::MAX after the at most m + n increments.
-        let pick = |c: [u32; 2], v: [f64; 2]| {
+    /// The states of node (i, j)'s successors, from its own and its costs at `costs[at + j]`:
+    /// the P state of (i + 1, j) unless `i` is the last row, the Q state of (i, j + 1).
+    #[inline(always)]
+    fn node(&mut self, i: usize, j: usize, costs: &Costs, at: usize) {
+        let n = self.n;
+        let cur = (i % 3) * n;
+        let s = self.st[cur + j];
+        let inc = u32::from(costs.invalid[at + j]);
+        let [[w00, w01], [w10, w11]] = &costs.w;
+        let c = [s.c[0] + inc, s.c[1] + inc];
+        let pick = |v: [f64; 2]| {
             let q = c[1] < c[0] || (c[1] == c[0] && v[1] < v[0]);
             (
                 if q { c[1] } else { c[0] },
@@ -1290,43 +1362,59 @@ impl Recurrence {
                 u8::from(q),
             )
         };
-        let row = i * n;
-        let ends = if last_row { n - 1 } else { n };
-        let inv = &costs.invalid[at..at + ends];
-        let [[w00, w01], [w10, w11]] = &costs.w;
-        let (w00, w01) = (&w00[at..at + ends], &w01[at..at + ends]);
-        let (w10, w11) = (&w10[at..at + ends], &w11[at..at + ends]);
+        if i + 1 < self.m {
+            let (bc, bv, arg) = pick([s.v[0] + w00[at + j], s.v[1] + w10[at + j]]);
+            let next = ((i + 1) % 3) * n;
+            self.st[next + j].c[0] = bc;
+            self.st[next + j].v[0] = bv;
+            self.back[(i + 1) * n + j] |= arg;
+        }
+        if j + 1 < n {
+            let (bc, bv, arg) = pick([s.v[0] + w01[at + j], s.v[1] + w11[at + j]]);
+            self.st[cur + j + 1].c[1] = bc;
+            self.st[cur + j + 1].v[1] = bv;
+            self.back[i * n + j + 1] |= arg << 1;
+        }
+    }
+
+    /// Clear the states of row `i` (its buffer last held row i − 3).
+    fn clear(&mut self, i: usize) {
+        let b = (i % 3) * self.n;
+        self.st[b..b + self.n].fill(State::NONE);
+    }
+
+    /// Row `i`, whose costs start at `at` in `costs`.
+    fn one_row(&mut self, i: usize, costs: &Costs, at: usize) {
+        let n = self.n;
+        if i + 1 < self.m {
+            self.clear(i + 1);
+        }
+        let ends = if i + 1 == self.m { n - 1 } else { n };
         for j in 0..ends {
-            let inc = u32::from(inv[j]);
-            let cur_c = self.cc[j];
-            let cur_v = self.cv[j];
-            let c = [cur_c[0] + inc, cur_c[1] + inc];
-            if !last_row {
-                let (bc, bv, arg) = pick(c, [cur_v[0] + w00[j], cur_v[1] + w10[j]]);
-                self.nc[j][0] = bc;
-                self.nv[j][0] = bv;
-                self.back[row + n + j] |= arg;
-            }
-            if j + 1 < n {
-                let (bc, bv, arg) = pick(c, [cur_v[0] + w01[j], cur_v[1] + w11[j]]);
-                self.cc[j + 1][1] = bc;
-                self.cv[j + 1][1] = bv;
-                self.back[row + j + 1] |= arg << 1;
-            }
+            self.node(i, j, costs, at);
         }
-        if !last_row {
-            std::mem::swap(&mut self.cc, &mut self.nc);
-            std::mem::swap(&mut self.cv, &mut self.nv);
-            self.nc.iter_mut().for_each(|x| *x = [Self::INF; 2]);
-            self.nv.iter_mut().for_each(|x| *x = [f64::INFINITY; 2]);
+    }
+
+    /// Rows `i` and `i + 1` (neither the last), costs at `at` and `at + n`: node (i + 1, j − 1)
+    /// after node (i, j), which set its P state.
+    fn two_rows(&mut self, i: usize, costs: &Costs, at: usize) {
+        let n = self.n;
+        self.clear(i + 1);
+        self.clear(i + 2);
+        self.node(i, 0, costs, at);
+        for j in 1..n {
+            self.node(i, j, costs, at);
+            self.node(i + 1, j - 1, costs, at + n);
         }
+        self.node(i + 1, n - 1, costs, at + n);
     }
 
     /// The steps of the best path, once every row has been fed.
     fn path(self) -> Vec<Step> {
         let (m, n) = (self.m, self.n);
-        // `cc`/`cv` hold row m−1; pick the better end state (ties: P).
-        let (ec, ev) = (self.cc[n - 1], self.cv[n - 1]);
+        // Row m−1's last node: pick the better end state (ties: P).
+        let e = self.st[((m - 1) % 3) * n + n - 1];
+        let (ec, ev) = (e.c, e.v);
         let mut s = usize::from(ec[1] < ec[0] || (ec[1] == ec[0] && ev[1] < ev[0]));
         let mut steps = Vec::with_capacity(m + n - 2);
         let (mut i, mut j) = (m - 1, n - 1);
