@@ -233,6 +233,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             name,
             line: 0,
             strip: Some(strip),
+            bent: None,
         }],
         material: Material {
             kind,
