@@ -266,6 +266,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         dry_run: a.dry_run,
         link: a.link.clone(),
         quiet: a.quiet,
+        surface_obj: None,
     };
     run_spec(spec, &cut)
 }

@@ -713,10 +713,7 @@ fn piece_folds(
     tol: f64,
 ) -> Result<PieceFolds, GeodesicError> {
     let cerr = |message: String| GeodesicError::Control { piece, message };
-    let [a, b] = spec.line;
-    let len = a.distance(b);
-    let d = (b - a) / len;
-    let dp = d.perp();
+    let len = spec.line[0].distance(spec.line[1]);
     let mut warnings = Vec::new();
 
     // Length (§4.1.3).
@@ -778,7 +775,54 @@ fn piece_folds(
         len
     };
     const MAX_STEPS: usize = 200_000;
-    let n = ((len / h_max).ceil() as usize).max(2);
+    let folds_at = |n: usize| folds_at_n(piece, n, &fitted, &arc, spec.line, up, tol);
+    let mut n = ((len / h_max).ceil() as usize).max(2);
+    // The folded line strays O(h²) from the curve: refine until it is within the tolerance.
+    let mut tries = 0;
+    let (folds, place, drift) = loop {
+        let (folds, place, drift) = folds_at(n)?;
+        tries += 1;
+        if drift <= tol || tries >= 4 || n >= MAX_STEPS {
+            break (folds, place, drift);
+        }
+        let grow = ((drift / tol).sqrt() * 1.1).max(1.2);
+        n = ((n as f64 * grow).ceil() as usize).min(MAX_STEPS);
+    };
+    if drift > tol {
+        warnings.push(format!(
+            "piece {}: the folded sheet strays up to {drift:.3} mm from the control curve (tolerance {tol} mm)",
+            piece + 1
+        ));
+    }
+    Ok(PieceFolds {
+        folds,
+        place,
+        drift,
+        length,
+        warnings,
+    })
+}
+
+/// [`piece_folds`] at `n` steps: the folds, the placement and the largest distance of the
+/// folded line from the curve.
+#[allow(clippy::too_many_arguments)]
+fn folds_at_n(
+    piece: usize,
+    n: usize,
+    fitted: &dyn Param,
+    arc: &ArcLength,
+    line: [DVec2; 2],
+    up: Option<DVec3>,
+    tol: f64,
+) -> Result<(Vec<Ruling>, DAffine3, f64), GeodesicError> {
+    let _ = tol;
+    let cerr = |message: String| GeodesicError::Control { piece, message };
+    let [a, b] = line;
+    let len = a.distance(b);
+    let d = (b - a) / len;
+    let dp = d.perp();
+    let length = arc.total();
+    const MAX_STEPS: usize = 200_000;
     if n > MAX_STEPS {
         return Err(cerr(format!(
             "would need {n} rulings at a tolerance of {tol} mm (over {MAX_STEPS}); raise `tolerance` or bend less sharply"
@@ -790,7 +834,7 @@ fn piece_folds(
     let mut at: Vec<(f64, Local)> = Vec::with_capacity(n + 1);
     for k in 0..n {
         let s = if k == 0 { 0.5 * h } else { k as f64 * h };
-        let l = local(&fitted, arc.param(s))
+        let l = local(fitted, arc.param(s))
             .ok_or_else(|| cerr(format!("is singular (zero speed) at s = {s:.2} mm")))?;
         if !(l.omega.is_finite() && l.t.is_finite()) {
             return Err(cerr(format!("is not smooth at s = {s:.2} mm")));
@@ -894,19 +938,7 @@ fn piece_folds(
         let target = fitted.eval(arc.param(s.min(length)))[0];
         drift = drift.max(v.distance(target));
     }
-    if drift > tol {
-        warnings.push(format!(
-            "piece {}: the folded sheet strays up to {drift:.3} mm from the control curve (tolerance {tol} mm)",
-            piece + 1
-        ));
-    }
-    Ok(PieceFolds {
-        folds,
-        place,
-        drift,
-        length,
-        warnings,
-    })
+    Ok((folds, place, drift))
 }
 
 // ---------------------------------------------------------------------------------------------
