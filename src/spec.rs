@@ -1523,7 +1523,10 @@ impl Ctx<'_> {
             return Err(self.invalid(
                 line,
                 key,
-                format!("must be a list of points [[x, y], ...], got {}", v.type_str()),
+                format!(
+                    "must be a list of points [[x, y], ...], got {}",
+                    v.type_str()
+                ),
             ));
         };
         if items.len() < min {
@@ -1612,15 +1615,17 @@ impl Ctx<'_> {
         let oline = self.line(ov.span());
         let outline = match ov.get_ref() {
             toml::Value::Array(a)
-                if a.len() == 2
-                    && a.iter().all(|x| x.is_integer() || x.is_float()) =>
+                if a.len() == 2 && a.iter().all(|x| x.is_integer() || x.is_float()) =>
             {
                 let wh = self.pt2(ov.get_ref(), &ok, oline)?;
                 if !(wh.x > 0.0 && wh.y > 0.0) {
                     return Err(self.invalid(
                         oline,
                         &ok,
-                        format!("width and height must be positive, got [{}, {}]", wh.x, wh.y),
+                        format!(
+                            "width and height must be positive, got [{}, {}]",
+                            wh.x, wh.y
+                        ),
                     ));
                 }
                 vec![
@@ -1646,7 +1651,10 @@ impl Ctx<'_> {
                     return Err(self.invalid(
                         hl,
                         &hk,
-                        format!("must be a list of point lists [[[x, y], ...], ...], got {}", v.type_str()),
+                        format!(
+                            "must be a list of point lists [[[x, y], ...], ...], got {}",
+                            v.type_str()
+                        ),
                     ))
                 }
             }
@@ -1671,7 +1679,10 @@ impl Ctx<'_> {
                 return Err(self.invalid(
                     at,
                     &format!("{pk}line"),
-                    format!("must be exactly two points [[x0, y0], [x1, y1]], got {}", pts.len()),
+                    format!(
+                        "must be exactly two points [[x0, y0], [x1, y1]], got {}",
+                        pts.len()
+                    ),
                 ));
             }
             let control = match (control, handles) {
@@ -1724,9 +1735,7 @@ impl Ctx<'_> {
                     }
                     let get = |k: &str| -> Result<glam::DVec3, SpecError> {
                         match t.get(k) {
-                            Some(toml::Value::Array(a)) => {
-                                self.point(a, &format!("{hk}.{k}"), at)
-                            }
+                            Some(toml::Value::Array(a)) => self.point(a, &format!("{hk}.{k}"), at),
                             _ => Err(self.invalid(
                                 at,
                                 &format!("{hk}.{k}"),
@@ -1785,13 +1794,13 @@ impl Ctx<'_> {
             }
             let items = match pv.get_ref() {
                 toml::Value::Array(items) if !items.is_empty() => items,
-                v => {
-                    return Err(self.invalid(
-                        pl,
-                        &format!("{key}.pieces"),
-                        format!("must be a non-empty list of tables {{ line, control_points }}, got {v}"),
-                    ))
-                }
+                v => return Err(self.invalid(
+                    pl,
+                    &format!("{key}.pieces"),
+                    format!(
+                        "must be a non-empty list of tables {{ line, control_points }}, got {v}"
+                    ),
+                )),
             };
             for (i, it) in items.iter().enumerate() {
                 let pk = format!("{key}.pieces[{}].", i + 1);
@@ -1824,10 +1833,7 @@ impl Ctx<'_> {
                 )?);
             }
         } else {
-            let at = s
-                .line
-                .as_ref()
-                .map_or(header_line, |v| self.line(v.span()));
+            let at = s.line.as_ref().map_or(header_line, |v| self.line(v.span()));
             line_no = at;
             let cl = s
                 .control_points
@@ -2344,7 +2350,10 @@ fold_threshold = 179.5
     fn bad_surface_kind_lists_allowed() {
         let (line, key, message) = invalid("[[surface]]\nkind = \"nurbs\"\npath = \"a.obj\"\n");
         assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
-        assert_eq!(message, "must be one of mesh, strip, bent-sheet, got \"nurbs\"");
+        assert_eq!(
+            message,
+            "must be one of mesh, strip, bent-sheet, got \"nurbs\""
+        );
     }
 
     #[test]

@@ -57,10 +57,11 @@ pub fn write_surface_obj(path: &Path, flats: &[crate::flatten::Flat]) -> Result<
         let m = &f.surface.mesh;
         let base = mesh.vertices.len();
         mesh.vertices.extend_from_slice(&m.vertices);
-        mesh.faces.extend(m.faces.iter().map(|face| crate::geom::mesh::Face {
-            verts: face.verts.iter().map(|v| v + base).collect(),
-            line: face.line,
-        }));
+        mesh.faces
+            .extend(m.faces.iter().map(|face| crate::geom::mesh::Face {
+                verts: face.verts.iter().map(|v| v + base).collect(),
+                line: face.line,
+            }));
         names.push(f.surface.name.clone());
     }
     let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));

@@ -61,7 +61,9 @@
 //!   normals are fitted to the given ones by Levenberg–Marquardt on
 //!   `|N0/|N0| − N̄0|² + |N1/|N1| − N̄1|² + (len/L − 1)² + 0.1·|ΔX/L|²` from a start polygon
 //!   with end tangents perpendicular to the normals (the length term is ours: it keeps the
-//!   re-parameterisation small). A normal missed by more than 1° is a warning.
+//!   re-parameterisation small). A normal missed by more than 1° is a warning, and so is an end
+//!   that the length fit moves more than the tolerance away from its handle (handles whose
+//!   normals do not suit the sheet's length cannot all be met).
 //! - Bend lines: every fold is a ruling and a bend line with its angle (`bend_lines = "all"`),
 //!   none, or one every `spacing` mm along each line carrying the angle accumulated since the
 //!   previous one, as strips do.
@@ -418,7 +420,11 @@ impl<'a> ArcLength<'a> {
     /// The parameter at arc length `s` from the start.
     pub fn param(&self, s: f64) -> f64 {
         let s = s.clamp(0.0, self.total());
-        let j = self.ss.partition_point(|&x| x <= s).clamp(1, self.ss.len() - 1) - 1;
+        let j = self
+            .ss
+            .partition_point(|&x| x <= s)
+            .clamp(1, self.ss.len() - 1)
+            - 1;
         let (u0, u1, s0, s1) = (self.us[j], self.us[j + 1], self.ss[j], self.ss[j + 1]);
         let mut u = if s1 > s0 {
             u0 + (u1 - u0) * (s - s0) / (s1 - s0)
@@ -529,7 +535,7 @@ pub fn handles_curve(
     let q = 0.25 * length;
     let p1 = start + t0 * q;
     let p3 = end - t1 * q;
-    let p2 = 0.5 * (p1 + p3) + (n0 + n1) * (0.125 * length);
+    let p2 = 0.5 * (p1 + p3);
     let init = [p1, p2, p3];
     let pts = |x: &[f64; 9]| -> Vec<DVec3> {
         vec![
@@ -540,77 +546,84 @@ pub fn handles_curve(
             end,
         ]
     };
-    let resid = |x: &[f64; 9]| -> [f64; 16] {
-        let c = pts(x);
-        let (a, b) = end_normals(&c);
-        let (a, b) = (a.normalize_or_zero() - n0, b.normalize_or_zero() - n1);
-        let len = bezier_length(&c) / length - 1.0;
-        let w = 0.1f64.sqrt() / length;
-        let mut r = [0.0; 16];
-        r[..3].copy_from_slice(&a.to_array());
-        r[3..6].copy_from_slice(&b.to_array());
-        r[6] = len;
-        for j in 0..3 {
-            let d = (c[j + 1] - init[j]) * w;
-            r[7 + 3 * j..10 + 3 * j].copy_from_slice(&d.to_array());
-        }
-        r
-    };
     let mut x = [0.0; 9];
     for j in 0..3 {
         x[3 * j..3 * j + 3].copy_from_slice(&init[j].to_array());
     }
-    let cost = |r: &[f64; 16]| r.iter().map(|v| v * v).sum::<f64>();
-    let mut r = resid(&x);
-    let mut mu = 1e-3;
-    for _ in 0..100 {
-        // Numeric Jacobian, 16 × 9.
-        let mut jac = [[0.0; 9]; 16];
-        for i in 0..9 {
-            let e = 1e-6 * length;
-            let mut xp = x;
-            xp[i] += e;
-            let rp = resid(&xp);
-            for (k, row) in jac.iter_mut().enumerate() {
-                row[i] = (rp[k] - r[k]) / e;
+    // The regularisation holds the points near the previous state (§4.1.2: "to ensure a
+    // gradual change"); a few passes, each from the last result, as the interactive updates do.
+    for _pass in 0..6 {
+        let anchor = x;
+        let resid = |x: &[f64; 9]| -> [f64; 16] {
+            let c = pts(x);
+            let (a, b) = end_normals(&c);
+            let (a, b) = (a.normalize_or_zero() - n0, b.normalize_or_zero() - n1);
+            let len = bezier_length(&c) / length - 1.0;
+            let w = 0.1f64.sqrt() / length;
+            let mut r = [0.0; 16];
+            r[..3].copy_from_slice(&a.to_array());
+            r[3..6].copy_from_slice(&b.to_array());
+            r[6] = len;
+            for j in 0..3 {
+                let d = (c[j + 1] - DVec3::from_slice(&anchor[3 * j..3 * j + 3])) * w;
+                r[7 + 3 * j..10 + 3 * j].copy_from_slice(&d.to_array());
             }
-        }
-        let mut jtj = [[0.0; 9]; 9];
-        let mut jtr = [0.0; 9];
-        for row in 0..16 {
+            r
+        };
+        let cost = |r: &[f64; 16]| r.iter().map(|v| v * v).sum::<f64>();
+        let mut r = resid(&x);
+        let mut mu = 1e-3;
+        for _ in 0..100 {
+            // Numeric Jacobian, 16 × 9, by central differences (so that a symmetric problem, a
+            // planar one say, gets no spurious gradient out of its plane).
+            let mut jac = [[0.0; 9]; 16];
             for i in 0..9 {
-                jtr[i] += jac[row][i] * r[row];
-                for j in 0..9 {
-                    jtj[i][j] += jac[row][i] * jac[row][j];
+                let e = 1e-5 * length;
+                let (mut xp, mut xm) = (x, x);
+                xp[i] += e;
+                xm[i] -= e;
+                let (rp, rm) = (resid(&xp), resid(&xm));
+                for (k, row) in jac.iter_mut().enumerate() {
+                    row[i] = (rp[k] - rm[k]) / (2.0 * e);
                 }
             }
-        }
-        let mut improved = false;
-        for _ in 0..10 {
-            let mut a = jtj;
-            for (i, row) in a.iter_mut().enumerate() {
-                row[i] += mu * (1.0 + row[i]);
+            let mut jtj = [[0.0; 9]; 9];
+            let mut jtr = [0.0; 9];
+            for row in 0..16 {
+                for i in 0..9 {
+                    jtr[i] += jac[row][i] * r[row];
+                    for j in 0..9 {
+                        jtj[i][j] += jac[row][i] * jac[row][j];
+                    }
+                }
             }
-            let Some(dx) = solve9(a, jtr) else {
+            let mut improved = false;
+            for _ in 0..10 {
+                let mut a = jtj;
+                for (i, row) in a.iter_mut().enumerate() {
+                    row[i] += mu * (1.0 + row[i]);
+                }
+                let Some(dx) = solve9(a, jtr) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let mut xn = x;
+                for i in 0..9 {
+                    xn[i] -= dx[i];
+                }
+                let rn = resid(&xn);
+                if cost(&rn) < cost(&r) {
+                    x = xn;
+                    r = rn;
+                    mu = (mu * 0.3).max(1e-12);
+                    improved = true;
+                    break;
+                }
                 mu *= 10.0;
-                continue;
-            };
-            let mut xn = x;
-            for i in 0..9 {
-                xn[i] -= dx[i];
             }
-            let rn = resid(&xn);
-            if cost(&rn) < cost(&r) {
-                x = xn;
-                r = rn;
-                mu = (mu * 0.3).max(1e-12);
-                improved = true;
+            if !improved || cost(&r) < 1e-20 {
                 break;
             }
-            mu *= 10.0;
-        }
-        if !improved || cost(&r) < 1e-20 {
-            break;
         }
     }
     let c = pts(&x);
@@ -1114,6 +1127,14 @@ pub fn control_param(
             let (c, m0, m1) =
                 handles_curve(*start, *start_normal, *end, *end_normal, len).map_err(cerr)?;
             let mut w = Vec::new();
+            let got = ArcLength::new(&Spline::bezier(c.clone())).total();
+            let moved = (*end - *start).length() * (len / got - 1.0).abs();
+            if moved > 0.05 {
+                w.push(format!(
+                    "piece {}: the curve through the handles is {got:.1} mm long; fitted to the line's {len:.1} mm its end moves {moved:.1} mm from the end handle (tilt the normals to suit the length)",
+                    piece + 1
+                ));
+            }
             if m0.max(m1) > 1.0 {
                 w.push(format!(
                     "piece {}: the handles' normals are met to {m0:.1}° (start) and {m1:.1}° (end)",
@@ -1164,6 +1185,9 @@ pub fn bend_with(
         return Err(oerr("a point is not finite".into()));
     }
     let outer = clean_ring(&spec.outline, true);
+    if outer.len() >= 3 && !polygon::is_simple_ring(&outer) {
+        return Err(oerr("crosses itself".into()));
+    }
     if outer.len() < 3 || polygon::signed_area(&outer) < 1e-6 {
         return Err(oerr(
             "needs at least 3 points enclosing an area (rectangle `[width, height]` or a list of points)"
@@ -1301,7 +1325,11 @@ pub fn bend_with(
     }
     // Holes no ruling crosses get a zero-angle cut line.
     for h in 1..rings.len() {
-        if chains.iter().flatten().any(|(c0, c1)| c0.ring == h || c1.ring == h) {
+        if chains
+            .iter()
+            .flatten()
+            .any(|(c0, c1)| c0.ring == h || c1.ring == h)
+        {
             continue;
         }
         let hole = &rings[h];
@@ -1330,9 +1358,8 @@ pub fn bend_with(
                 continue;
             };
             let clash = rulings.iter().any(|r| {
-                meet(centre, dir, r.point, r.dir).is_some_and(|(ta, tb)| {
-                    ta > ext.0 - 1e-6 && ta < ext.1 + 1e-6 && inside(r, tb)
-                })
+                meet(centre, dir, r.point, r.dir)
+                    .is_some_and(|(ta, tb)| ta > ext.0 - 1e-6 && ta < ext.1 + 1e-6 && inside(r, tb))
             });
             if clash || !ch.iter().any(|(a, b)| a.ring == h || b.ring == h) {
                 continue;
@@ -1604,7 +1631,11 @@ pub fn bend_with(
 fn signed_deg(r: &Ruling, forward_left: bool) -> f64 {
     // The sheet just beyond the ruling, turned by the fold, goes below the printed side's
     // plane for a mountain.
-    let m = if forward_left { r.dir.perp() } else { -r.dir.perp() };
+    let m = if forward_left {
+        r.dir.perp()
+    } else {
+        -r.dir.perp()
+    };
     let rot = glam::DQuat::from_axis_angle(DVec3::new(r.dir.x, r.dir.y, 0.0), r.angle);
     let z = (rot * DVec3::new(m.x, m.y, 0.0)).z;
     let deg = r.angle.to_degrees();
