@@ -6,7 +6,7 @@
 //! device = "hpgl-pens"     # optional device profile name
 //!
 //! [[surface]]              # one or more
-//! kind = "mesh"            # required: "mesh" or "strip"
+//! kind = "mesh"            # required: "mesh", "strip" or "bent-sheet" (see below)
 //! path = "cube.obj"        # required for mesh; relative to the spec file's directory
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
@@ -88,6 +88,19 @@
 //! spec is read (errors name `surface[k].p.radius` and the line of `p`), the curves are
 //! sampled there too, and `q` equal to `p` is an error. A strip in a spec is developed as
 //! given; the neutral-surface shift of sheet metal is the `fitting` command's.
+//!
+//! # Bent sheets (issue 5)
+//!
+//! A `kind = "bent-sheet"` surface is a flat sheet bent along a control curve (see
+//! `surface::geodesic`): `outline` (required: `[width, height]` from the origin, or a list of
+//! `[x, y]` points), `holes` (optional list of point lists), `line` (required: two points on the
+//! sheet), exactly one of `control_points` (a list of `[x, y, z]` Bézier control points, or a
+//! curve table of kind `bezier` or `bspline`) and `handles` (`{ start, start_normal, end,
+//! end_normal }`), `length_fit` ("scale" default, "trim"), `tolerance` (mm, default 0.05),
+//! `bend_lines` (as strips) and `name`. Several curved pieces: `pieces = [{ line, control_points
+//! | handles, length_fit }, ...]` instead of the top-level keys. Errors about the geometry (a
+//! point off the sheet, the curve of regression on the sheet) name the line of `line` (or of
+//! `pieces`).
 
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
@@ -1794,13 +1807,15 @@ impl Ctx<'_> {
             }
             let items = match pv.get_ref() {
                 toml::Value::Array(items) if !items.is_empty() => items,
-                v => return Err(self.invalid(
-                    pl,
-                    &format!("{key}.pieces"),
-                    format!(
+                v => {
+                    return Err(self.invalid(
+                        pl,
+                        &format!("{key}.pieces"),
+                        format!(
                         "must be a non-empty list of tables {{ line, control_points }}, got {v}"
                     ),
-                )),
+                    ))
+                }
             };
             for (i, it) in items.iter().enumerate() {
                 let pk = format!("{key}.pieces[{}].", i + 1);

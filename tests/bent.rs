@@ -454,7 +454,7 @@ fn bent_hole_beside_the_rulings_and_two_pieces() {
                 vec![
                     DVec3::new(0.0, 0.0, 0.0),
                     DVec3::new(50.0, 0.0, 0.0),
-                    DVec3::new(90.0, 0.0, -30.0),
+                    DVec3::new(90.0, 0.0, 30.0),
                 ],
             ),
         ],
@@ -486,6 +486,20 @@ fn bent_hole_beside_the_rulings_and_two_pieces() {
     };
     let flat = flatcut::flatten::unfold(surface, &Default::default()).unwrap();
     assert_eq!(flat.islands.len(), 1);
+    // Each bend line's angle (mountain positive) is the dihedral angle the flatten stage sees.
+    for b in &bent.bends {
+        let key = [b.verts[0].min(b.verts[1]), b.verts[0].max(b.verts[1])];
+        let e = flat
+            .topology
+            .edges
+            .iter()
+            .position(|e| e.verts == key)
+            .expect("bend line is a mesh edge");
+        let d = flat.dihedral[e].to_degrees();
+        assert!((d - b.angle_deg).abs() < 1e-6, "{d} vs {}", b.angle_deg);
+    }
+    assert!(bent.bends.iter().any(|b| b.angle_deg > 0.0));
+    assert!(bent.bends.iter().any(|b| b.angle_deg < 0.0));
     // Area kept: 300 × 100 less the 20 × 20 hole.
     let area: f64 = (0..bent.mesh.faces.len())
         .map(|f| bent.mesh.face_area(f))
@@ -668,5 +682,71 @@ fn bent_bad_input_exits_1_naming_the_key() {
         &dir,
         &format!("{head}outline = [[0, 0], [100, 100], [100, 0], [0, 100]]\nline = [[10, 50], [90, 50]]\n{ok_ctrl}"),
         &["crosses itself"],
+    );
+}
+
+#[test]
+fn bent_pieces_in_a_spec_and_flatten_writes_the_surface_obj() {
+    let dir = scratch("bent-pieces");
+    let spec = write_spec(
+        &dir,
+        "two.toml",
+        r#"
+name = "two"
+[[surface]]
+kind = "bent-sheet"
+outline = [300, 100]
+holes = [[[140, 40], [160, 40], [160, 60], [140, 60]]]
+bend_lines = "none"
+pieces = [
+  { line = [[0, 50], [100, 50]], control_points = [[0, 0, 0], [40, 0, 30], [90, 0, 20]] },
+  { line = [[200, 50], [300, 50]], control_points = { kind = "bspline", degree = 2, control = [[0, 0, 0], [50, 0, 0], [70, 0, -10], [90, 0, -30]] }, length_fit = "scale" },
+]
+[sheet]
+width = 420
+height = 297
+"#,
+    );
+    let obj = dir.join("two.obj");
+    let o = flatcut(&[
+        "flatten",
+        &spec,
+        "-o",
+        dir.to_str().unwrap(),
+        "--surface-obj",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert!(text.starts_with("# flatcut surface mesh (mm)"));
+    assert!(text.lines().filter(|l| l.starts_with("f ")).count() > 20);
+    // No score lines when bend_lines = "none".
+    let out = dir.join("cut");
+    let o = flatcut(&[
+        "cut",
+        &spec,
+        "--device",
+        "hpgl-pens",
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plt = std::fs::read_to_string(out.join("two.plt")).unwrap();
+    let strokes = hpgl::parse(&plt).unwrap();
+    assert!(strokes.iter().all(|s| s.pen != 2));
+    assert_eq!(cut_contours(&plt).len(), 2, "outline and hole");
+    // A key of a piece at the top level as well is an error.
+    let bad = write_spec(
+        &dir,
+        "bad.toml",
+        "[[surface]]\nkind = \"bent-sheet\"\noutline = [300, 100]\nline = [[0, 50], [100, 50]]\npieces = [{ line = [[0, 50], [100, 50]], control_points = [[0, 0, 0], [40, 0, 30], [90, 0, 20]] }]\n",
+    );
+    let o = flatcut(&["cut", &bad, "--dry-run", "-o", dir.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("goes into each entry of `pieces`"),
+        "{}",
+        stderr(&o)
     );
 }

@@ -247,9 +247,9 @@ impl Param for Spline {
         let nd = 3.min(p);
         let ders = ders_basis(k, u, p, nd, &self.knots);
         let mut out = [DVec3::ZERO; 4];
-        for (d, o) in out.iter_mut().enumerate().take(nd + 1) {
-            for j in 0..=p {
-                *o += self.control[k - p + j] * ders[d][j];
+        for (o, row) in out.iter_mut().zip(&ders) {
+            for (c, w) in self.control[k - p..=k].iter().zip(row) {
+                *o += *c * *w;
             }
         }
         out
@@ -641,10 +641,11 @@ fn solve9(mut a: [[f64; 9]; 9], mut b: [f64; 9]) -> Option<[f64; 9]> {
         }
         a.swap(col, piv);
         b.swap(col, piv);
+        let pivot = a[col];
         for row in col + 1..9 {
-            let f = a[row][col] / a[col][col];
-            for k in col..9 {
-                a[row][k] -= f * a[col][k];
+            let f = a[row][col] / pivot[col];
+            for (v, pv) in a[row][col..].iter_mut().zip(&pivot[col..]) {
+                *v -= f * pv;
             }
             b[row] -= f * b[col];
         }
@@ -943,7 +944,7 @@ fn folds_at_n(
         let s = k as f64 * h;
         while fi < folds.len() && folds[fi].s < s - 0.5 * h {
             let f = &folds[fi];
-            m = m * fold_map(f.point, f.dir, f.angle);
+            m *= fold_map(f.point, f.dir, f.angle);
             fi += 1;
         }
         let flat_pt = a + d * s;
@@ -1077,11 +1078,11 @@ pub struct Bent {
     pub warnings: Vec<String>,
 }
 
+/// A piece's control curve to evaluate, the surface normal hint (handles) and warnings.
+pub type ControlParam = (Box<dyn Param>, Option<DVec3>, Vec<String>);
+
 /// The control curve of a piece as something to evaluate, and the normal hint for handles.
-pub fn control_param(
-    piece: usize,
-    spec: &PieceSpec,
-) -> Result<(Box<dyn Param>, Option<DVec3>, Vec<String>), GeodesicError> {
+pub fn control_param(piece: usize, spec: &PieceSpec) -> Result<ControlParam, GeodesicError> {
     let cerr = |message: String| GeodesicError::Control { piece, message };
     let len = spec.line[0].distance(spec.line[1]);
     let finite = |c: &[DVec3]| c.iter().all(|p| p.is_finite());
@@ -1287,13 +1288,39 @@ pub fn bend_with(
     }
     // Admissibility: neighbours within a piece, every pair across pieces.
     let inside = |r: &Ruling, t: f64| t > r.extent.0 + 1e-9 && t < r.extent.1 - 1e-9;
-    for k in 0..rulings.len() {
-        for j in k + 1..rulings.len() {
-            let (a, b) = (&rulings[k], &rulings[j]);
-            let neighbours = a.piece == b.piece && j == k + 1;
-            if a.piece == b.piece && !neighbours {
-                continue;
+    // Pairs to test: each ruling with the next of its piece; across pieces every pair, or
+    // only the end rulings (§4.3) when there are very many.
+    let mut pairs: Vec<(usize, usize)> = (1..rulings.len())
+        .filter(|&j| rulings[j].piece == rulings[j - 1].piece)
+        .map(|j| (j - 1, j))
+        .collect();
+    let groups: Vec<Vec<usize>> = (0..spec.pieces.len())
+        .map(|p| {
+            (0..rulings.len())
+                .filter(|&k| rulings[k].piece == Some(p))
+                .collect()
+        })
+        .collect();
+    for (gi, ga) in groups.iter().enumerate() {
+        for gb in &groups[gi + 1..] {
+            let ends = |g: &Vec<usize>| -> Vec<usize> {
+                if ga.len().saturating_mul(gb.len()) <= 4_000_000 {
+                    g.clone()
+                } else {
+                    g.first().into_iter().chain(g.last()).copied().collect()
+                }
+            };
+            for &k in &ends(ga) {
+                for &j in &ends(gb) {
+                    pairs.push((k, j));
+                }
             }
+        }
+    }
+    for (k, j) in pairs {
+        {
+            let (a, b) = (&rulings[k], &rulings[j]);
+            let neighbours = a.piece == b.piece;
             let Some((ta, tb)) = meet(a.point, a.dir, b.point, b.dir) else {
                 continue;
             };
@@ -1578,6 +1605,20 @@ pub fn bend_with(
             let area = (pos[tri[1]] - pos[tri[0]]).perp_dot(pos[tri[2]] - pos[tri[0]]);
             if area > 1e-12 {
                 triangles.push(tri);
+            }
+        }
+    }
+    // Every triangle must be the flat one moved rigidly; rulings meeting where the checks
+    // above do not look (around holes, in concave corners) would break that.
+    for t in &triangles {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            let (l2, l3) = (pos[a].distance(pos[b]), vert3[a].distance(vert3[b]));
+            if !((l3 - l2).abs() <= 1e-7 * l2.max(1.0)) {
+                return Err(GeodesicError::Mesh(format!(
+                    "the rulings cross on the sheet near ({:.2}, {:.2}): the sheet cannot bend this way without creasing; bend less there",
+                    pos[a].x, pos[a].y
+                )));
             }
         }
     }
