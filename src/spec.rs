@@ -6,7 +6,7 @@
 //! device = "hpgl-pens"     # optional device profile name
 //!
 //! [[surface]]              # one or more
-//! kind = "mesh"            # required: "mesh" or "strip"
+//! kind = "mesh"            # required: "mesh", "strip" or "bent-sheet" (see below)
 //! path = "cube.obj"        # required for mesh; relative to the spec file's directory
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
@@ -93,6 +93,19 @@
 //! surface the curves describe ("outside" default: the neutral surface is (1 − K)·t inside
 //! them; "inside": K·t outside; "neutral": as given) and `k_factor` is K (0 to 1, default 0.4,
 //! FreeCAD SheetMetal's). Paper and fabric strips are developed as given.
+//!
+//! # Bent sheets (issue 5)
+//!
+//! A `kind = "bent-sheet"` surface is a flat sheet bent along a control curve (see
+//! `surface::geodesic`): `outline` (required: `[width, height]` from the origin, or a list of
+//! `[x, y]` points), `holes` (optional list of point lists), `line` (required: two points on the
+//! sheet), exactly one of `control_points` (a list of `[x, y, z]` Bézier control points, or a
+//! curve table of kind `bezier` or `bspline`) and `handles` (`{ start, start_normal, end,
+//! end_normal }`), `length_fit` ("scale" default, "trim"), `tolerance` (mm, default 0.05),
+//! `bend_lines` (as strips) and `name`. Several curved pieces: `pieces = [{ line, control_points
+//! | handles, length_fit }, ...]` instead of the top-level keys. Errors about the geometry (a
+//! point off the sheet, the curve of regression on the sheet) name the line of `line` (or of
+//! `pieces`).
 
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
@@ -138,7 +151,12 @@ pub struct SurfaceSpec {
     pub line: usize,
     /// The curves and settings of a [`SurfaceKind::Strip`]; `None` for other kinds.
     pub strip: Option<StripSpec>,
+    /// The sheet, lines and control curves of a [`SurfaceKind::BentSheet`]; `None` for others.
+    pub bent: Option<BentSpec>,
 }
+
+/// A bent sheet (`kind = "bent-sheet"`), see `surface::geodesic`.
+pub use crate::surface::geodesic::BentSpec;
 
 /// A strip between two boundary curves (`kind = "strip"`, or built by `flatcut fitting`).
 #[derive(Debug, Clone, PartialEq)]
@@ -216,6 +234,8 @@ pub enum SurfaceKind {
     Mesh,
     /// A developable strip between two boundary curves.
     Strip,
+    /// A flat sheet bent along a control curve (Bo–Wang, `surface::geodesic`).
+    BentSheet,
 }
 
 /// Length units of a surface's source coordinates.
@@ -317,13 +337,17 @@ fn pick<T: Copy>(s: &str, table: &[(&str, T)]) -> Result<T, String> {
 }
 
 impl SurfaceKind {
-    const NAMES: [(&'static str, SurfaceKind); 2] =
-        [("mesh", SurfaceKind::Mesh), ("strip", SurfaceKind::Strip)];
+    const NAMES: [(&'static str, SurfaceKind); 3] = [
+        ("mesh", SurfaceKind::Mesh),
+        ("strip", SurfaceKind::Strip),
+        ("bent-sheet", SurfaceKind::BentSheet),
+    ];
 
     pub fn as_str(self) -> &'static str {
         match self {
             SurfaceKind::Mesh => "mesh",
             SurfaceKind::Strip => "strip",
+            SurfaceKind::BentSheet => "bent-sheet",
         }
     }
 }
@@ -488,6 +512,7 @@ impl Spec {
                 name,
                 line: 0,
                 strip: None,
+                bent: None,
             }],
             material: Material::default(),
             sheet: SheetSpec::default(),
@@ -555,6 +580,13 @@ struct RawSurface {
     tolerance: Option<Spanned<Val>>,
     side: Option<Spanned<Val>>,
     k_factor: Option<Spanned<Val>>,
+    outline: Option<Spanned<toml::Value>>,
+    holes: Option<Spanned<toml::Value>>,
+    line: Option<Spanned<toml::Value>>,
+    control_points: Option<Spanned<toml::Value>>,
+    handles: Option<Spanned<toml::Value>>,
+    length_fit: Option<Spanned<toml::Value>>,
+    pieces: Option<Spanned<toml::Value>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -966,11 +998,15 @@ impl Ctx<'_> {
                         &kind_key,
                         format!(
                             "missing: each [[surface]] needs a `kind`, {}",
-                            one_of(&["mesh", "strip"])
+                            one_of(&["mesh", "strip", "bent-sheet"])
                         ),
                     )
                 })?;
+            if kind != SurfaceKind::BentSheet {
+                self.no_bent_keys(s, &key)?;
+            }
             match kind {
+                SurfaceKind::BentSheet => out.push(self.bent_surface(s, &key, header_line, dir)?),
                 SurfaceKind::Strip => out.push(self.strip_surface(s, &key, header_line, dir)?),
                 SurfaceKind::Mesh => {
                     let path_key = format!("{key}.path");
@@ -1014,6 +1050,7 @@ impl Ctx<'_> {
                         name,
                         line,
                         strip: None,
+                        bent: None,
                     });
                 }
             }
@@ -1262,6 +1299,7 @@ impl Ctx<'_> {
                 neutral_offset: 0.0,
                 sheet: Some((side, k_factor)),
             }),
+            bent: None,
         })
     }
 
@@ -1494,6 +1532,433 @@ impl Ctx<'_> {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Bent sheets (issue 5): `kind = "bent-sheet"`
+// ---------------------------------------------------------------------------------------------
+//
+// ```toml
+// [[surface]]
+// kind = "bent-sheet"
+// outline = [210, 297]              # width × height from (0, 0), or [[x, y], ...]
+// holes = [[[80, 120], [130, 120], [130, 170], [80, 170]]]   # optional
+// line = [[105, 0], [105, 297]]     # a straight line on the sheet, start to end
+// control_points = [[0, 0, 0], [0, 100, 60], [0, 200, -60], [0, 297, 0]]   # a Bézier, or
+// control_points = { kind = "bspline", control = [...], degree = 3 }
+// handles = { start = [0, 0, 0], start_normal = [0, 0, 1], end = [0, 250, 0], end_normal = [0, 0, 1] }
+// length_fit = "scale"              # or "trim" (§4.1.3)
+// tolerance = 0.05                  # mm
+// bend_lines = "all"                # "none" or a spacing in mm
+// pieces = [{ line = ..., control_points = ... }, ...]   # several curved pieces instead
+// ```
+
+impl Ctx<'_> {
+    /// Keys only a bent sheet takes are errors on other kinds.
+    fn no_bent_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        for (k, v) in [
+            ("outline", &s.outline),
+            ("holes", &s.holes),
+            ("line", &s.line),
+            ("control_points", &s.control_points),
+            ("handles", &s.handles),
+            ("length_fit", &s.length_fit),
+            ("pieces", &s.pieces),
+        ] {
+            if let Some(v) = v {
+                return Err(self.invalid(
+                    self.line(v.span()),
+                    &format!("{key}.{k}"),
+                    "is for bent sheets (kind = \"bent-sheet\")".to_string(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A 2D point `[x, y]`.
+    fn pt2(&self, v: &toml::Value, key: &str, line: usize) -> Result<glam::DVec2, SpecError> {
+        let nums: Option<Vec<f64>> = match v {
+            toml::Value::Array(a) => a
+                .iter()
+                .map(|x| match x {
+                    toml::Value::Integer(i) => Some(*i as f64),
+                    toml::Value::Float(f) if f.is_finite() => Some(*f),
+                    _ => None,
+                })
+                .collect(),
+            _ => None,
+        };
+        match nums {
+            Some(n) if n.len() == 2 => Ok(glam::DVec2::new(n[0], n[1])),
+            _ => Err(self.invalid(
+                line,
+                key,
+                format!("must be a point on the sheet [x, y] of finite numbers (mm), got {v}"),
+            )),
+        }
+    }
+
+    /// A list of 2D points with at least `min` entries.
+    fn pts2(
+        &self,
+        v: &toml::Value,
+        key: &str,
+        line: usize,
+        min: usize,
+    ) -> Result<Vec<glam::DVec2>, SpecError> {
+        let toml::Value::Array(items) = v else {
+            return Err(self.invalid(
+                line,
+                key,
+                format!(
+                    "must be a list of points [[x, y], ...], got {}",
+                    v.type_str()
+                ),
+            ));
+        };
+        if items.len() < min {
+            return Err(self.invalid(
+                line,
+                key,
+                format!("needs at least {min} points, got {}", items.len()),
+            ));
+        }
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, it)| self.pt2(it, &format!("{key}[{}]", i + 1), line))
+            .collect()
+    }
+
+    /// One `kind = "bent-sheet"` entry.
+    fn bent_surface(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        header_line: usize,
+        dir: &Path,
+    ) -> Result<SurfaceSpec, SpecError> {
+        use crate::surface::geodesic::{Control, LengthFit, PieceSpec};
+        use crate::surface::strip::BendLines;
+        for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
+            if let Some(v) = v {
+                return Err(self.invalid(
+                    self.line(v.span()),
+                    &format!("{key}.{k}"),
+                    "is for mesh surfaces; a bent sheet takes `outline`, `line` and `control_points` or `handles`".to_string(),
+                ));
+            }
+        }
+        for (k, v) in [("p", &s.p), ("q", &s.q)] {
+            if let Some(v) = v {
+                return Err(self.invalid(
+                    self.line(v.span()),
+                    &format!("{key}.{k}"),
+                    "is for strips; a bent sheet takes `line` and `control_points` or `handles`"
+                        .to_string(),
+                ));
+            }
+        }
+        if let Some(v) = &s.method {
+            return Err(self.invalid(
+                self.line(v.span()),
+                &format!("{key}.method"),
+                "is for strips".to_string(),
+            ));
+        }
+        let tolerance = self
+            .number(
+                &s.tolerance,
+                &format!("{key}.tolerance"),
+                MM_POSITIVE,
+                |v| v > 0.0,
+            )?
+            .map_or(crate::geom::curve::DEFAULT_TOLERANCE, |(v, _)| v);
+        let bend_lines = match &s.bend_lines {
+            None => BendLines::All,
+            Some(v) => match v.get_ref() {
+                Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => BendLines::All,
+                Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => BendLines::None,
+                Val::Num(x) if x.is_finite() && *x > 0.0 => BendLines::Spacing(*x),
+                _ => {
+                    return Err(self.expected(
+                        v,
+                        &format!("{key}.bend_lines"),
+                        "\"all\", \"none\" or a positive spacing in millimetres",
+                    ))
+                }
+            },
+        };
+        // Outline: [width, height] or a list of points.
+        let ok = format!("{key}.outline");
+        let ov = s.outline.as_ref().ok_or_else(|| {
+            self.invalid(
+                header_line,
+                &ok,
+                "missing: a bent sheet needs its flat `outline`, [width, height] or [[x, y], ...]"
+                    .to_string(),
+            )
+        })?;
+        let oline = self.line(ov.span());
+        let outline = match ov.get_ref() {
+            toml::Value::Array(a)
+                if a.len() == 2 && a.iter().all(|x| x.is_integer() || x.is_float()) =>
+            {
+                let wh = self.pt2(ov.get_ref(), &ok, oline)?;
+                if !(wh.x > 0.0 && wh.y > 0.0) {
+                    return Err(self.invalid(
+                        oline,
+                        &ok,
+                        format!(
+                            "width and height must be positive, got [{}, {}]",
+                            wh.x, wh.y
+                        ),
+                    ));
+                }
+                vec![
+                    glam::DVec2::ZERO,
+                    glam::DVec2::new(wh.x, 0.0),
+                    wh,
+                    glam::DVec2::new(0.0, wh.y),
+                ]
+            }
+            v => self.pts2(v, &ok, oline, 3)?,
+        };
+        let mut holes = Vec::new();
+        if let Some(hv) = &s.holes {
+            let hl = self.line(hv.span());
+            let hk = format!("{key}.holes");
+            match hv.get_ref() {
+                toml::Value::Array(items) => {
+                    for (i, it) in items.iter().enumerate() {
+                        holes.push(self.pts2(it, &format!("{hk}[{}]", i + 1), hl, 3)?);
+                    }
+                }
+                v => {
+                    return Err(self.invalid(
+                        hl,
+                        &hk,
+                        format!(
+                            "must be a list of point lists [[[x, y], ...], ...], got {}",
+                            v.type_str()
+                        ),
+                    ))
+                }
+            }
+        }
+        // One piece from a table of keys (the surface itself or an entry of `pieces`).
+        let piece = |pk: &str,
+                     line: Option<&toml::Value>,
+                     control: Option<&toml::Value>,
+                     handles: Option<&toml::Value>,
+                     fit: Option<&toml::Value>,
+                     at: usize|
+         -> Result<PieceSpec, SpecError> {
+            let lv = line.ok_or_else(|| {
+                self.invalid(
+                    at,
+                    &format!("{pk}line"),
+                    "missing: the straight line on the sheet the control curve bends, [[x0, y0], [x1, y1]]".to_string(),
+                )
+            })?;
+            let pts = self.pts2(lv, &format!("{pk}line"), at, 2)?;
+            if pts.len() != 2 {
+                return Err(self.invalid(
+                    at,
+                    &format!("{pk}line"),
+                    format!(
+                        "must be exactly two points [[x0, y0], [x1, y1]], got {}",
+                        pts.len()
+                    ),
+                ));
+            }
+            let control = match (control, handles) {
+                (Some(_), Some(_)) | (None, None) => {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{pk}control_points"),
+                        "a bent sheet needs exactly one of `control_points` and `handles`"
+                            .to_string(),
+                    ))
+                }
+                (Some(cv), None) => {
+                    let ck = format!("{pk}control_points");
+                    let c = self.curve(cv, &ck, at, dir)?;
+                    match c {
+                        crate::geom::curve::Curve::Points { points, .. } => {
+                            Control::Curve(crate::geom::curve::Curve::Bezier { control: points })
+                        }
+                        c @ (crate::geom::curve::Curve::Bezier { .. }
+                        | crate::geom::curve::Curve::BSpline { .. }) => Control::Curve(c),
+                        _ => {
+                            return Err(self.invalid(
+                                at,
+                                &ck,
+                                "must be Bézier control points [[x, y, z], ...] or a table with kind = \"bezier\" or \"bspline\"".to_string(),
+                            ))
+                        }
+                    }
+                }
+                (None, Some(hv)) => {
+                    let hk = format!("{pk}handles");
+                    let toml::Value::Table(t) = hv else {
+                        return Err(self.invalid(
+                            at,
+                            &hk,
+                            "must be a table { start, start_normal, end, end_normal }".to_string(),
+                        ));
+                    };
+                    for k in t.keys() {
+                        if !["start", "start_normal", "end", "end_normal"].contains(&k.as_str()) {
+                            return Err(self.invalid(
+                                at,
+                                &format!("{hk}.{k}"),
+                                format!(
+                                    "unknown key; expected {}",
+                                    one_of(&["start", "start_normal", "end", "end_normal"])
+                                ),
+                            ));
+                        }
+                    }
+                    let get = |k: &str| -> Result<glam::DVec3, SpecError> {
+                        match t.get(k) {
+                            Some(toml::Value::Array(a)) => self.point(a, &format!("{hk}.{k}"), at),
+                            _ => Err(self.invalid(
+                                at,
+                                &format!("{hk}.{k}"),
+                                "missing or not a point [x, y, z]".to_string(),
+                            )),
+                        }
+                    };
+                    Control::Handles {
+                        start: get("start")?,
+                        start_normal: get("start_normal")?,
+                        end: get("end")?,
+                        end_normal: get("end_normal")?,
+                    }
+                }
+            };
+            let fit = match fit {
+                None => LengthFit::default(),
+                Some(toml::Value::String(f)) => match pick(f, &LengthFit::NAMES) {
+                    Ok(f) => f,
+                    Err(m) => {
+                        return Err(self.invalid(at, &format!("{pk}length_fit"), m));
+                    }
+                },
+                Some(v) => {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{pk}length_fit"),
+                        format!("must be \"scale\" or \"trim\", got {v}"),
+                    ))
+                }
+            };
+            Ok(PieceSpec {
+                line: [pts[0], pts[1]],
+                control,
+                fit,
+            })
+        };
+        let mut pieces = Vec::new();
+        let line_no;
+        if let Some(pv) = &s.pieces {
+            let pl = self.line(pv.span());
+            line_no = pl;
+            for (k, v) in [
+                ("line", &s.line),
+                ("control_points", &s.control_points),
+                ("handles", &s.handles),
+                ("length_fit", &s.length_fit),
+            ] {
+                if let Some(v) = v {
+                    return Err(self.invalid(
+                        self.line(v.span()),
+                        &format!("{key}.{k}"),
+                        "goes into each entry of `pieces` when `pieces` is given".to_string(),
+                    ));
+                }
+            }
+            let items = match pv.get_ref() {
+                toml::Value::Array(items) if !items.is_empty() => items,
+                v => {
+                    return Err(self.invalid(
+                        pl,
+                        &format!("{key}.pieces"),
+                        format!(
+                        "must be a non-empty list of tables {{ line, control_points }}, got {v}"
+                    ),
+                    ))
+                }
+            };
+            for (i, it) in items.iter().enumerate() {
+                let pk = format!("{key}.pieces[{}].", i + 1);
+                let toml::Value::Table(t) = it else {
+                    return Err(self.invalid(
+                        pl,
+                        pk.trim_end_matches('.'),
+                        "must be a table { line, control_points } or { line, handles }".to_string(),
+                    ));
+                };
+                for k in t.keys() {
+                    if !["line", "control_points", "handles", "length_fit"].contains(&k.as_str()) {
+                        return Err(self.invalid(
+                            pl,
+                            &format!("{pk}{k}"),
+                            format!(
+                                "unknown key; expected {}",
+                                one_of(&["line", "control_points", "handles", "length_fit"])
+                            ),
+                        ));
+                    }
+                }
+                pieces.push(piece(
+                    &pk,
+                    t.get("line"),
+                    t.get("control_points"),
+                    t.get("handles"),
+                    t.get("length_fit"),
+                    pl,
+                )?);
+            }
+        } else {
+            let at = s.line.as_ref().map_or(header_line, |v| self.line(v.span()));
+            line_no = at;
+            let cl = s
+                .control_points
+                .as_ref()
+                .or(s.handles.as_ref())
+                .map_or(at, |v| self.line(v.span()));
+            pieces.push(piece(
+                &format!("{key}."),
+                s.line.as_ref().map(|v| v.get_ref()),
+                s.control_points.as_ref().map(|v| v.get_ref()),
+                s.handles.as_ref().map(|v| v.get_ref()),
+                s.length_fit.as_ref().map(|v| v.get_ref()),
+                if s.line.is_some() { cl } else { at },
+            )?);
+        }
+        let name = self
+            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .unwrap_or_else(|| format!("sheet{}", key.trim_start_matches("surface")));
+        Ok(SurfaceSpec {
+            kind: SurfaceKind::BentSheet,
+            path: self.path.to_path_buf(),
+            scale: 1.0,
+            units: Units::Mm,
+            name,
+            line: line_no,
+            strip: None,
+            bent: Some(BentSpec {
+                outline,
+                holes,
+                pieces,
+                tolerance,
+                bend_lines,
+            }),
+        })
+    }
+}
+
 /// Joins a multi-line message into one line.
 fn one_line(s: &str) -> String {
     s.lines()
@@ -1601,6 +2066,7 @@ fold_threshold = 1.0
                     name: "box".into(),
                     line: 6,
                     strip: None,
+                    bent: None,
                 }],
                 material: Material {
                     kind: MaterialKind::Paper,
@@ -1696,6 +2162,7 @@ fold_threshold = 179.5
                 name: "lamp".into(),
                 line: 3,
                 strip: None,
+                bent: None,
             }]
         );
         assert_eq!(
@@ -1971,7 +2438,10 @@ fold_threshold = 179.5
     fn bad_surface_kind_lists_allowed() {
         let (line, key, message) = invalid("[[surface]]\nkind = \"nurbs\"\npath = \"a.obj\"\n");
         assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
-        assert_eq!(message, "must be one of mesh, strip, got \"nurbs\"");
+        assert_eq!(
+            message,
+            "must be one of mesh, strip, bent-sheet, got \"nurbs\""
+        );
     }
 
     #[test]
@@ -2073,6 +2543,7 @@ fold_threshold = 179.5
                     name: "Cube".into(),
                     line: 0,
                     strip: None,
+                    bent: None,
                 }]
             );
             assert_eq!(

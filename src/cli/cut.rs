@@ -43,6 +43,30 @@ pub struct CutArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Also write the 3D surface mesh (all surfaces, mm) as a Wavefront OBJ file, to look at in
+    /// a 3D viewer.
+    #[arg(long, value_name = "FILE")]
+    pub surface_obj: Option<PathBuf>,
+}
+
+/// Write the surfaces' meshes into one OBJ file (`--surface-obj`), atomically.
+pub fn write_surface_obj(path: &Path, flats: &[crate::flatten::Flat]) -> Result<(), Error> {
+    let mut mesh = crate::geom::mesh::Mesh::default();
+    let mut names = Vec::new();
+    for f in flats {
+        let m = &f.surface.mesh;
+        let base = mesh.vertices.len();
+        mesh.vertices.extend_from_slice(&m.vertices);
+        mesh.faces
+            .extend(m.faces.iter().map(|face| crate::geom::mesh::Face {
+                verts: face.verts.iter().map(|v| v + base).collect(),
+                line: face.line,
+            }));
+        names.push(f.surface.name.clone());
+    }
+    let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));
+    let text = crate::output::obj::write(&mesh, None, &comment).unwrap_or_default();
+    write_atomic(path, text.as_bytes())
 }
 
 /// Flags of the toolpath stage (ordering, folds, weeding, drag knife).
@@ -224,6 +248,9 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         }
     })?;
     let machine = machine_job(&job, &profile, &spec);
+    if let Some(p) = &a.surface_obj {
+        write_surface_obj(p, &flats)?;
+    }
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;

@@ -233,6 +233,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             name,
             line: 0,
             strip: Some(strip),
+            bent: None,
         }],
         material: Material {
             kind,
@@ -265,6 +266,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         dry_run: a.dry_run,
         link: a.link.clone(),
         quiet: a.quiet,
+        surface_obj: None,
     };
     run_spec(spec, &cut)
 }

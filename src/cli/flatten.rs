@@ -25,6 +25,9 @@ pub struct FlattenArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Also write the 3D surface mesh (all surfaces, mm) as a Wavefront OBJ file.
+    #[arg(long, value_name = "FILE")]
+    pub surface_obj: Option<PathBuf>,
 }
 
 /// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
@@ -50,6 +53,9 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
     }
     a.pattern.apply(&mut spec)?;
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
+    if let Some(p) = &a.surface_obj {
+        super::cut::write_surface_obj(p, &flats)?;
+    }
     // One strip wide enough for the widest piece: the pieces, not the sheets, are the result.
     let widest = pieces
         .iter()

@@ -442,6 +442,7 @@ mod tests {
             name: f.kind().into(),
             line: 0,
             strip: Some(f.strip_spec(opts).unwrap()),
+            bent: None,
         };
         crate::surface::build(&spec).unwrap()
     }

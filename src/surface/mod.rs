@@ -7,6 +7,7 @@
 //! and geodesic developables will add files here (see shared/seeds/README.md).
 
 pub mod fittings;
+pub mod geodesic;
 pub mod obj;
 pub mod solids;
 pub mod strip;
@@ -80,6 +81,11 @@ pub enum SurfaceError {
     },
     #[error("surface `{surface}`: {message}")]
     Strip { surface: String, message: String },
+    #[error("surface `{surface}`: {source}")]
+    Bent {
+        surface: String,
+        source: geodesic::GeodesicError,
+    },
     #[error("{}{}: the mesh is not orientable (a Möbius-like band): its faces cannot all be wound the same way", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     NonOrientable { path: PathBuf, line: Option<usize> },
 }
@@ -101,6 +107,7 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             })
         }
         SurfaceKind::Strip => build_strip(spec),
+        SurfaceKind::BentSheet => build_bent(spec),
     }
 }
 
@@ -161,5 +168,31 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         warnings,
         bends: Some(s.bends(&steps, st.bend_lines)),
         charts: None,
+    })
+}
+
+/// A [`geodesic`] bent sheet: the outline folded along the rulings of its control curves.
+fn build_bent(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
+    let err = |source| SurfaceError::Bent {
+        surface: spec.name.clone(),
+        source,
+    };
+    let b = spec.bent.as_ref().ok_or_else(|| {
+        err(geodesic::GeodesicError::Mesh(
+            "a bent sheet needs `outline`, `line` and a control curve".into(),
+        ))
+    })?;
+    let bent = geodesic::bend(b).map_err(err)?;
+    Ok(Surface {
+        name: spec.name.clone(),
+        source: spec.path.clone(),
+        mesh: bent.mesh,
+        warnings: bent
+            .warnings
+            .into_iter()
+            .map(|w| format!("surface `{}`: {w}", spec.name))
+            .collect(),
+        bends: Some(bent.bends),
+        ..Default::default()
     })
 }
