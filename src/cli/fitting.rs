@@ -233,6 +233,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             name,
             line: 0,
             strip: Some(strip),
+            boundary: None,
         }],
         material: Material {
             kind,
