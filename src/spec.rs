@@ -1549,12 +1549,20 @@ impl Ctx<'_> {
             ));
         }
         if let Some(v) = &s.loop_ {
-            raw_loops.push((v.get_ref().clone(), format!("{key}.loop"), self.line(v.span())));
+            raw_loops.push((
+                v.get_ref().clone(),
+                format!("{key}.loop"),
+                self.line(v.span()),
+            ));
         }
         if let Some(v) = &s.loop_csv {
             let k = format!("{key}.loop_csv");
             let path = self
-                .string(&s.loop_csv, &k, "a non-empty string naming a CSV file of x,y,z points")?
+                .string(
+                    &s.loop_csv,
+                    &k,
+                    "a non-empty string naming a CSV file of x,y,z points",
+                )?
                 .unwrap_or_default();
             let mut t = toml::map::Map::new();
             t.insert("kind".into(), Value::String("csv".into()));
@@ -1612,13 +1620,18 @@ impl Ctx<'_> {
                         ));
                     }
                 }
-                let at = match t.get("at") {
-                    Some(Value::Integer(n)) if *n >= 1 => (*n - 1) as usize,
-                    _ => return Err(bad("`at` must be the number (from 1) of the loop point the dart starts at")),
-                };
+                let at =
+                    match t.get("at") {
+                        Some(Value::Integer(n)) if *n >= 1 => (*n - 1) as usize,
+                        _ => return Err(bad(
+                            "`at` must be the number (from 1) of the loop point the dart starts at",
+                        )),
+                    };
                 let points = match t.get("points") {
                     Some(Value::Array(p)) => self.points(p, &format!("{dk}.points"), darts_line)?,
-                    _ => return Err(bad("`points` must be the dart's points [[x, y, z], ...], ending at its tip")),
+                    _ => return Err(bad(
+                        "`points` must be the dart's points [[x, y, z], ...], ending at its tip",
+                    )),
                 };
                 let width = match t.get("width") {
                     None => None,
@@ -1634,7 +1647,8 @@ impl Ctx<'_> {
         if let Some(v) = &s.rulings {
             rulings_line = self.line(v.span());
             let k = format!("{key}.rulings");
-            let msg = "must be a list of point-number pairs [[i, j], ...] (points of the loop, from 1)";
+            let msg =
+                "must be a list of point-number pairs [[i, j], ...] (points of the loop, from 1)";
             let Value::Array(items) = v.get_ref() else {
                 return Err(self.invalid(rulings_line, &k, msg.into()));
             };
@@ -1745,10 +1759,12 @@ impl Ctx<'_> {
                 crate::geom::curve::read_csv(path)
                     .map_err(|e| self.invalid(line, key, e.to_string()))?,
             ),
-            other => other
-                .sample(tol)
-                .map_err(|e| self.invalid(line, key, e.to_string()))?
-                .points,
+            other => {
+                other
+                    .sample(tol)
+                    .map_err(|e| self.invalid(line, key, e.to_string()))?
+                    .points
+            }
         };
         if smooth && pts.len() >= 4 {
             pts = Curve::BSpline {

@@ -43,9 +43,9 @@ pub fn hull(points: &[DVec3]) -> Option<Hull> {
     if points.len() < 3 || points.iter().any(|p| !p.is_finite()) {
         return None;
     }
-    let (lo, hi) = points
-        .iter()
-        .fold((points[0], points[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let (lo, hi) = points.iter().fold((points[0], points[0]), |(lo, hi), p| {
+        (lo.min(*p), hi.max(*p))
+    });
     let scale = (hi - lo).length();
     if scale <= 0.0 {
         return None;
@@ -108,9 +108,7 @@ pub fn hull(points: &[DVec3]) -> Option<Hull> {
             continue;
         }
         let visible: Vec<usize> = (0..faces.len())
-            .filter(|&f| {
-                faces[f].is_some_and(|t| units[f].dot(p - points[t[0]]) > eps)
-            })
+            .filter(|&f| faces[f].is_some_and(|t| units[f].dot(p - points[t[0]]) > eps))
             .collect();
         if visible.is_empty() {
             continue;
@@ -178,7 +176,10 @@ fn with_adjacency(faces: Vec<[usize; 3]>, planar: Option<DVec3>, ring: Vec<usize
 fn planar(points: &[DVec3], n: DVec3) -> Hull {
     let u = n.any_orthonormal_vector();
     let v = n.cross(u);
-    let q: Vec<DVec2> = points.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
+    let q: Vec<DVec2> = points
+        .iter()
+        .map(|p| DVec2::new(p.dot(u), p.dot(v)))
+        .collect();
     let mut idx: Vec<usize> = (0..q.len()).collect();
     idx.sort_by(|&a, &b| {
         q[a].x
@@ -200,7 +201,8 @@ fn planar(points: &[DVec3], n: DVec3) -> Hull {
             Box::new(idx.iter().rev())
         };
         for &i in it {
-            while ring.len() >= start + 2 && cross(ring[ring.len() - 2], ring[ring.len() - 1], i) <= tol
+            while ring.len() >= start + 2
+                && cross(ring[ring.len() - 2], ring[ring.len() - 1], i) <= tol
             {
                 ring.pop();
             }
@@ -327,7 +329,10 @@ mod tests {
         for fi in 0..f {
             let n = h.normal(p, fi);
             for q in p {
-                assert!(n.dot(*q - p[h.faces[fi][0]]) <= scale, "point above facet {fi}");
+                assert!(
+                    n.dot(*q - p[h.faces[fi][0]]) <= scale,
+                    "point above facet {fi}"
+                );
             }
         }
     }
@@ -360,13 +365,13 @@ mod tests {
     fn hull_of_random_sphere_points_is_closed_and_convex() {
         let mut s: u64 = 7;
         let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let p: Vec<DVec3> = (0..300)
-            .map(|_| {
-                DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize() * (50.0 + rnd())
-            })
+            .map(|_| DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize() * (50.0 + rnd()))
             .collect();
         let h = hull(&p).unwrap();
         check_closed_convex(&p, &h);

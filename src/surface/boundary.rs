@@ -62,9 +62,13 @@
 //!   separately, and do not count as polyline edges for charts (§6.1). The paper's first
 //!   choice, hull charts connecting loops, is not implemented.
 //! - Alternatives: every distinct complete triangulation met is kept; the N best are returned.
+//! - The radial offset is skipped when it leaves fewer loop edges on the hull than the input
+//!   points do (a scalloped edge near the centre of mass sinks inside its hull when pushed).
 //! - When no smooth triangulation exists within the limits, the search is run again with the
 //!   thresholds relaxed (180°, no area limit) and a warning says so; if even that finds
-//!   nothing in `max_iterations`, the fan from the first vertex is used, with a warning.
+//!   nothing in `max_iterations`, the cover is completed depth first (the largest chart of
+//!   each subloop without envelopes, at most n steps), with a warning; a fan from the first
+//!   vertex is the last resort (a subloop whose hull is flat but folded over itself).
 
 use crate::geom::hull::{self, segment_on_hull};
 use crate::geom::mesh::{Face, Mesh};
@@ -313,7 +317,12 @@ fn check_crossings(
     // Bounding boxes to skip far pairs cheaply.
     let boxes: Vec<(DVec3, DVec3)> = segs
         .iter()
-        .map(|s| (s.2.min(s.3) - DVec3::splat(tol), s.2.max(s.3) + DVec3::splat(tol)))
+        .map(|s| {
+            (
+                s.2.min(s.3) - DVec3::splat(tol),
+                s.2.max(s.3) + DVec3::splat(tol),
+            )
+        })
         .collect();
     for x in 0..segs.len() {
         for y in x + 1..segs.len() {
@@ -394,16 +403,15 @@ fn insert_darts(
         let mut prev = pts[d.at];
         for (i, p) in d.points.iter().enumerate() {
             if p.distance(prev) <= 1e-9 * size(pts) {
-                return Err(err(format!(
-                    "point {} repeats the point before it",
-                    i + 1
-                )));
+                return Err(err(format!("point {} repeats the point before it", i + 1)));
             }
             prev = *p;
         }
         if let Some(w) = d.width {
             if !(w.is_finite() && w > 0.0) {
-                return Err(err(format!("width must be a positive number of mm, got {w}")));
+                return Err(err(format!(
+                    "width must be a positive number of mm, got {w}"
+                )));
             }
         }
         by_at[d.at] = Some(k);
@@ -617,8 +625,9 @@ fn search(
             .collect();
         let res = solve(&pts, &orig, opts, &mut warnings);
         iterations += res.iterations;
-        let to_global =
-            |t: &Vec<[usize; 3]>| -> Vec<[usize; 3]> { t.iter().map(|f| f.map(|x| g[x])).collect() };
+        let to_global = |t: &Vec<[usize; 3]>| -> Vec<[usize; 3]> {
+            t.iter().map(|f| f.map(|x| g[x])).collect()
+        };
         best.push(to_global(&res.best));
         alts.push(res.alternatives.iter().map(to_global).collect());
     }
@@ -730,7 +739,10 @@ fn figures(
             continue;
         }
         fig.interior_edges += 1;
-        let th = angle(unit_normal(verts, faces[fs[0]]), unit_normal(verts, faces[fs[1]]));
+        let th = angle(
+            unit_normal(verts, faces[fs[0]]),
+            unit_normal(verts, faces[fs[1]]),
+        );
         fig.largest_dihedral_deg = fig.largest_dihedral_deg.max(th.to_degrees());
         fig.fairness += th * th;
         let (a, b) = e;
@@ -767,17 +779,27 @@ fn solve(pts: &[DVec3], orig: &[bool], opts: &Options, warnings: &mut Vec<String
             iterations: 0,
         };
     }
-    // §7 radial offset for the hulls.
+    // §7 radial offset for the hulls, unless it takes more loop edges off the hull than the
+    // points as given (a scalloped edge near the centre of mass can sink inside).
     let c = pts.iter().copied().sum::<DVec3>() / m as f64;
     let mean = pts.iter().map(|p| p.distance(c)).sum::<f64>() / m as f64;
-    let hpts: Vec<DVec3> = pts
+    let mut hpts: Vec<DVec3> = pts
         .iter()
         .map(|p| *p + (*p - c).normalize_or_zero() * opts.offset * mean)
         .collect();
-    let mut s = Search::new(pts, hpts, orig, opts.max_dihedral_deg.to_radians(), opts.min_chart_area);
+    if opts.offset != 0.0 && loop_edges_on_hull(pts) > loop_edges_on_hull(&hpts) {
+        hpts = pts.to_vec();
+    }
+    let mut s = Search::new(
+        pts,
+        hpts,
+        orig,
+        opts.max_dihedral_deg.to_radians(),
+        opts.min_chart_area,
+    );
     let mut r = s.run(opts);
+    let mut relaxed = Search::new(pts, s.h.clone(), orig, std::f64::consts::PI, 0.0);
     if r.best.is_none() {
-        let mut relaxed = Search::new(pts, s.h.clone(), orig, std::f64::consts::PI, 0.0);
         let r2 = relaxed.run(opts);
         warnings.push(format!(
             "no triangulation with every dihedral angle under {}° and charts over {} % of their hull: the limits were relaxed",
@@ -790,12 +812,20 @@ fn solve(pts: &[DVec3], orig: &[bool], opts: &Options, warnings: &mut Vec<String
     }
     let best = match r.best {
         Some((t, _)) => t,
-        None => {
-            warnings.push(
-                "no boundary triangulation found in the iteration limit: a fan from the first point is used".into(),
-            );
-            (1..m - 1).map(|k| [0, k, k + 1]).collect()
-        }
+        None => match relaxed.dive() {
+            Some(t) => {
+                warnings.push(
+                    "the search ran out of iterations: the triangulation was completed by taking the largest chart of each open subloop".into(),
+                );
+                t
+            }
+            None => {
+                warnings.push(
+                    "no boundary triangulation found: a fan from the first point is used".into(),
+                );
+                (1..m - 1).map(|k| [0, k, k + 1]).collect()
+            }
+        },
     };
     let mut found = r.found;
     found.sort_by(|a, b| {
@@ -812,6 +842,29 @@ fn solve(pts: &[DVec3], orig: &[bool], opts: &Options, warnings: &mut Vec<String
         best,
         iterations: r.iterations,
     }
+}
+
+/// How many loop edges `k → k+1` are edges of the convex hull of the points (all of them when
+/// the points are planar: the loop is then filled in its plane).
+fn loop_edges_on_hull(p: &[DVec3]) -> usize {
+    let m = p.len();
+    let Some(h) = hull::hull(p) else { return 0 };
+    if h.planar.is_some() {
+        return m;
+    }
+    let mut edges: HashSet<(usize, usize)> = HashSet::new();
+    for f in &h.faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            edges.insert((a.min(b), a.max(b)));
+        }
+    }
+    (0..m)
+        .filter(|&k| {
+            let (a, b) = (k, (k + 1) % m);
+            edges.contains(&(a.min(b), a.max(b)))
+        })
+        .count()
 }
 
 struct Chart {
@@ -928,7 +981,9 @@ impl<'a> Search<'a> {
             while cur != start && guard <= m {
                 guard += 1;
                 lp.push(cur);
-                let Some(cands) = out.get_mut(&cur) else { break };
+                let Some(cands) = out.get_mut(&cur) else {
+                    break;
+                };
                 let lim = off(prev, cur);
                 let pick = cands
                     .iter()
@@ -986,7 +1041,11 @@ impl<'a> Search<'a> {
         }
         let area = tris
             .iter()
-            .map(|t| 0.5 * (self.p[t[1]] - self.p[t[0]]).cross(self.p[t[2]] - self.p[t[0]]).length())
+            .map(|t| {
+                0.5 * (self.p[t[1]] - self.p[t[0]])
+                    .cross(self.p[t[2]] - self.p[t[0]])
+                    .length()
+            })
             .sum();
         let id = self.charts.len();
         self.charts.push(Chart {
@@ -1056,7 +1115,7 @@ impl<'a> Search<'a> {
         let mut edge_seen = 0;
         for (f, t) in hull.faces.iter().enumerate() {
             let [i, j, l] = *t;
-            sense[f] = (i < j && j < l) || (j < l && l < i) || (l < i && i < j);
+            sense[f] = u8::from(i < j) + u8::from(j < l) + u8::from(l < i) == 2;
             for k in 0..3 {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
                 if is_sub_edge(x, y) {
@@ -1123,7 +1182,11 @@ impl<'a> Search<'a> {
             let tris: Vec<[usize; 3]> = part.iter().map(|&f| sorted(hull.faces[f])).collect();
             let area: f64 = part
                 .iter()
-                .map(|&f| 0.5 * (hp[hull.faces[f][1]] - hp[hull.faces[f][0]]).cross(hp[hull.faces[f][2]] - hp[hull.faces[f][0]]).length())
+                .map(|&f| {
+                    0.5 * (hp[hull.faces[f][1]] - hp[hull.faces[f][0]])
+                        .cross(hp[hull.faces[f][2]] - hp[hull.faces[f][0]])
+                        .length()
+                })
                 .sum();
             if area < self.min_area * hull_area || !Self::non_crossing(&tris) {
                 continue;
@@ -1137,11 +1200,11 @@ impl<'a> Search<'a> {
                     }
                     let inside = part.contains(&g);
                     let interior_face = !has_edge[g];
-                    if inside || interior_face {
-                        if self.dihedral(tris[k], sorted(hull.faces[g])) >= self.thr {
-                            smooth = false;
-                            break 'check;
-                        }
+                    if (inside || interior_face)
+                        && self.dihedral(tris[k], sorted(hull.faces[g])) >= self.thr
+                    {
+                        smooth = false;
+                        break 'check;
                     }
                 }
             }
@@ -1262,6 +1325,41 @@ impl<'a> Search<'a> {
         Some(q)
     }
 
+    /// Depth first, no bounds: while some subloop has no envelopes, add its largest chart;
+    /// then take the best envelopes. Ends: each step removes at least one triangle's worth.
+    fn dive(&mut self) -> Option<Vec<[usize; 3]>> {
+        let mut cover: Vec<usize> = Vec::new();
+        for _ in 0..self.m {
+            let (tris, _) = self.cover_tris(&cover);
+            let subs = self.subtract(&tris);
+            let infos: Vec<Rc<Sub>> = subs.iter().map(|s| self.analyse(s)).collect();
+            if let Some(k) = infos.iter().position(|i| i.envelopes.is_empty()) {
+                let ch = infos[k]
+                    .charts
+                    .iter()
+                    .copied()
+                    .max_by(|a, b| self.charts[*a].area.total_cmp(&self.charts[*b].area))?;
+                cover.push(ch);
+                cover.sort_unstable();
+                continue;
+            }
+            let em = Self::edge_map(&tris);
+            let mut all = tris.clone();
+            for info in &infos {
+                let pick = info
+                    .envelopes
+                    .iter()
+                    .filter_map(|env| self.added(&em, &tris, env).map(|q| (env, q)))
+                    .reduce(|a, b| if b.1.better(&a.1) { b } else { a })
+                    .map_or(&info.envelopes[0], |(env, _)| env);
+                all.extend_from_slice(pick);
+            }
+            all.sort_unstable();
+            return (all.len() == self.m - 2).then_some(all);
+        }
+        None
+    }
+
     fn run(&mut self, opts: &Options) -> Run {
         let mut run = Run {
             best: None,
@@ -1281,9 +1379,12 @@ impl<'a> Search<'a> {
             (Vec::new(), Quality::default()),
         );
         seen_cover.insert(Vec::new());
-        let good = |q: &Quality| q.interior <= opts.good_interior && q.fairness <= opts.good_fairness;
+        let good =
+            |q: &Quality| q.interior <= opts.good_interior && q.fairness <= opts.good_fairness;
         while let Some((_, (cover, _))) = queue.pop_first() {
-            if run.best.as_ref().is_some_and(|b| good(&b.1)) || run.iterations >= opts.max_iterations {
+            if run.best.as_ref().is_some_and(|b| good(&b.1))
+                || run.iterations >= opts.max_iterations
+            {
                 break;
             }
             run.iterations += 1;
@@ -1375,10 +1476,7 @@ impl<'a> Search<'a> {
                         }
                     }
                     seq += 1;
-                    let area = n
-                        .iter()
-                        .map(|&c| self.charts[c].area)
-                        .fold(0.0, f64::max);
+                    let area = n.iter().map(|&c| self.charts[c].area).fold(0.0, f64::max);
                     queue.insert(
                         Key {
                             charts: n.len(),
@@ -1416,16 +1514,29 @@ mod tests {
         assert_eq!(subs, vec![vec![0, 1, 2, 4, 6, 7]]);
         // Interior triangle 0-3-6: three subloops.
         let subs = s.subtract(&[[0, 3, 6]]);
-        assert_eq!(subs, vec![vec![0, 1, 2, 3], vec![0, 6, 7], vec![3, 4, 5, 6]]);
+        assert_eq!(
+            subs,
+            vec![vec![0, 1, 2, 3], vec![0, 6, 7], vec![3, 4, 5, 6]]
+        );
         assert!(Search::non_crossing(&[[0, 1, 2], [0, 2, 5]]));
         assert!(!Search::non_crossing(&[[0, 1, 3], [2, 3, 5]]));
     }
 
     #[test]
     fn segment_distance_cases() {
-        let (d, _) = segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(0.5, -1.0, 1.0), DVec3::new(0.5, 1.0, 1.0));
+        let (d, _) = segment_distance(
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, -1.0, 1.0),
+            DVec3::new(0.5, 1.0, 1.0),
+        );
         assert!((d - 1.0).abs() < 1e-12);
-        let (d, _) = segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0), DVec3::new(3.0, 0.0, 0.0));
+        let (d, _) = segment_distance(
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(3.0, 0.0, 0.0),
+        );
         assert!((d - 1.0).abs() < 1e-12);
     }
 }
