@@ -265,6 +265,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),
+        alternatives: None,
         quiet: a.quiet,
     };
     run_spec(spec, &cut)

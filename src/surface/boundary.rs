@@ -1082,17 +1082,27 @@ impl<'a> Search<'a> {
             g.sort_unstable();
             g
         };
-        if let Some(n) = hull.planar {
-            let u = n.any_orthonormal_vector();
-            let v = n.cross(u);
-            let ring: Vec<DVec2> = hp.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
-            if crate::geom::polygon::is_simple_ring(&ring) {
-                let tris: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&ring)
-                    .into_iter()
-                    .map(sorted)
-                    .collect();
-                if tris.len() == q - 2 && Self::non_crossing(&tris) {
-                    out.envelopes.push(tris);
+        if hull.planar.is_some() {
+            // A flat subloop: ear clipping in its plane, on the input points (the offset ones
+            // if those fold over), one envelope since both sides are the same.
+            let op: Vec<DVec3> = sub.iter().map(|&v| self.p[v]).collect();
+            for pts in [&op, &hp] {
+                let n = newell(pts).normalize_or_zero();
+                if n == DVec3::ZERO {
+                    continue;
+                }
+                let u = n.any_orthonormal_vector();
+                let v = n.cross(u);
+                let ring: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
+                if crate::geom::polygon::is_simple_ring(&ring) {
+                    let tris: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&ring)
+                        .into_iter()
+                        .map(sorted)
+                        .collect();
+                    if tris.len() == q - 2 && Self::non_crossing(&tris) {
+                        out.envelopes.push(tris);
+                        break;
+                    }
                 }
             }
             return out;
