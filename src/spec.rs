@@ -2259,7 +2259,10 @@ fold_threshold = 179.5
     fn bad_surface_kind_lists_allowed() {
         let (line, key, message) = invalid("[[surface]]\nkind = \"nurbs\"\npath = \"a.obj\"\n");
         assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
-        assert_eq!(message, "must be one of mesh, strip, got \"nurbs\"");
+        assert_eq!(
+            message,
+            "must be one of mesh, strip, boundary, got \"nurbs\""
+        );
     }
 
     #[test]
@@ -2399,5 +2402,48 @@ fold_threshold = 179.5
             assert!(shown.starts_with("patterns/lamp.toml:"), "{shown}");
             assert_single_line(&shown);
         }
+    }
+
+    #[test]
+    fn boundary_spec_parses_loops_darts_rulings_and_settings() {
+        let spec = p(r#"
+[[surface]]
+kind = "boundary"
+name = "panel"
+loop = [[0, 0, 0], [100, 0, 0], [100, 80, 10], [50, 100, 5], [0, 80, 10], [0, 0, 0]]
+darts = [{ at = 1, points = [[20, 30, 2]], width = 4 }]
+rulings = [[2, 5]]
+max_dihedral = 45
+min_chart_area = 3
+max_iterations = 200
+"#)
+        .unwrap();
+        let s = &spec.surfaces[0];
+        assert_eq!(s.kind, SurfaceKind::Boundary);
+        assert_eq!(s.name, "panel");
+        assert_eq!(s.line, 5);
+        let b = s.boundary.as_ref().unwrap();
+        assert_eq!(b.input.loops.len(), 1);
+        assert_eq!(
+            b.input.loops[0].len(),
+            5,
+            "the repeated closing point is dropped"
+        );
+        assert_eq!(b.input.darts[0].at, 0);
+        assert_eq!(b.input.darts[0].width, Some(4.0));
+        assert_eq!(b.input.rulings, vec![[1, 4]]);
+        assert_eq!(b.options.max_dihedral_deg, 45.0);
+        assert!((b.options.min_chart_area - 0.03).abs() < 1e-15);
+        assert_eq!(b.options.max_iterations, 200);
+        // A closed curve table is sampled; two loops.
+        let spec = p(r#"
+[[surface]]
+kind = "boundary"
+loops = [{ kind = "ellipse", center = [0, 0, 0], rx = 100, ry = 60 }, [[-10, -10, 0], [10, -10, 0], [0, 10, 0]]]
+"#)
+        .unwrap();
+        let b = spec.surfaces[0].boundary.as_ref().unwrap();
+        assert_eq!(b.input.loops.len(), 2);
+        assert!(b.input.loops[0].len() > 8);
     }
 }
