@@ -557,3 +557,28 @@ fn bad_boundaries_exit_1_naming_the_problem_and_where() {
     );
     expect_user_error(head, &["surface[1].loop", "exactly one of"]);
 }
+
+#[test]
+fn exhausted_search_still_gives_a_boundary_triangulation() {
+    // One iteration and a 1° limit: the relaxed run and the depth-first completion take over.
+    let pts = csv("gazebo-roof");
+    let n = pts.len();
+    let out = triangulate(
+        &Input {
+            loops: vec![pts],
+            ..Default::default()
+        },
+        &Options {
+            max_iterations: 1,
+            max_dihedral_deg: 1.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(!out.warnings.is_empty());
+    check_boundary_triangulation(&out.mesh, &one_loop(n));
+    for f in 0..out.mesh.faces.len() {
+        assert!(out.mesh.face_area(f) > 1e-6, "face {f} is degenerate");
+    }
+    check_unfolds(&out.mesh);
+}
