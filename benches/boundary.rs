@@ -1,6 +1,7 @@
 //! Rose et al. boundary triangulation (issue 6): a smooth, non-planar closed boundary of 200
 //! points (a taco-like ellipse folded up at both ends, with a gentle three-lobed wave), the
-//! whole search (hulls, charts, branch and bound). Target: under 1 s.
+//! whole search (hulls, charts, branch and bound). Target: under 1 s. Also the gazebo roof
+//! pattern, which runs the full 1000 iterations.
 //! Run: `cargo bench --bench boundary`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -40,6 +41,19 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("smooth_200", |b| {
         b.iter(|| triangulate(std::hint::black_box(&input), &opts).expect("triangulates"))
+    });
+    // A branch-and-bound heavy one: the gazebo roof pattern (60 points, the full 1000
+    // iterations), for reference.
+    let gazebo = flatcut::geom::curve::read_csv(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("patterns/gazebo-roof.csv"),
+    )
+    .expect("patterns/gazebo-roof.csv");
+    let gazebo = Input {
+        loops: vec![gazebo],
+        ..Default::default()
+    };
+    g.bench_function("gazebo_roof_60", |b| {
+        b.iter(|| triangulate(std::hint::black_box(&gazebo), &opts).expect("triangulates"))
     });
     g.finish();
 }

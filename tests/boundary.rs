@@ -582,3 +582,25 @@ fn exhausted_search_still_gives_a_boundary_triangulation() {
     }
     check_unfolds(&out.mesh);
 }
+
+#[test]
+fn same_boundary_gives_the_same_triangulation() {
+    let input = Input {
+        loops: vec![csv("dress-panel")],
+        darts: vec![Dart {
+            at: 0,
+            points: vec![DVec3::new(0.0, 80.0, -0.36)],
+            width: None,
+        }],
+        ..Default::default()
+    };
+    let opts = Options {
+        alternatives: 3,
+        ..Default::default()
+    };
+    let a = triangulate(&input, &opts).unwrap();
+    let b = triangulate(&input, &opts).unwrap();
+    assert_eq!(a.mesh, b.mesh);
+    assert_eq!(a.alternatives, b.alternatives);
+    assert_eq!(a.figures.iterations, b.figures.iterations);
+}

@@ -917,7 +917,8 @@ struct Search<'a> {
     subs: HashMap<Vec<usize>, Rc<Sub>>,
 }
 
-type EdgeMap = HashMap<(usize, usize), Vec<usize>>;
+/// Edge → triangles; ordered, so that sums of angles come out the same on every run.
+type EdgeMap = BTreeMap<(usize, usize), Vec<usize>>;
 
 impl<'a> Search<'a> {
     fn new(p: &'a [DVec3], h: Vec<DVec3>, orig: &'a [bool], thr: f64, min_area: f64) -> Self {
@@ -1239,7 +1240,7 @@ impl<'a> Search<'a> {
     }
 
     fn edge_map(tris: &[[usize; 3]]) -> EdgeMap {
-        let mut e: EdgeMap = HashMap::new();
+        let mut e: EdgeMap = BTreeMap::new();
         for (i, t) in tris.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -1408,7 +1409,7 @@ impl<'a> Search<'a> {
             let em = Self::edge_map(&tris);
             // Stage 2: envelopes.
             if infos.iter().all(|i| !i.envelopes.is_empty()) {
-                let own = self.added(&HashMap::new(), &[], &tris);
+                let own = self.added(&BTreeMap::new(), &[], &tris);
                 let mut total = own;
                 let mut all = tris.clone();
                 for info in &infos {
