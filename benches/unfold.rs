@@ -19,6 +19,7 @@ fn fandisk() -> Surface {
         warnings,
         bends: None,
         charts: None,
+        ..Default::default()
     }
 }
 

@@ -106,6 +106,21 @@
 //! | handles, length_fit }, ...]` instead of the top-level keys. Errors about the geometry (a
 //! point off the sheet, the curve of regression on the sheet) name the line of `line` (or of
 //! `pieces`).
+//!
+//! # Boundaries (issue 6)
+//!
+//! A `kind = "boundary"` surface is the developable boundary triangulation of a closed 3D
+//! polyline (see `surface::boundary`, Rose et al.). Exactly one of: `loop` (an inline list of
+//! points, closed by itself, or a closed curve table as above), `loop_csv` (a CSV file of
+//! points) or `loops` (a list of loops, the first the outer one, the others holes). Optional:
+//! `darts = [{ at = 12, points = [[x, y, z], ...], width = 2 }]` (from loop point `at`,
+//! counted from 1, to the tip, the last point; `width` the opening at the mouth in mm),
+//! `rulings = [[i, j], ...]` (edges between loop points, counted from 1, that the surface
+//! must contain), `max_dihedral` (degrees, default 60), `min_chart_area` (percent of the hull,
+//! default 2), `max_iterations` (default 1000), `smooth` (resample a B-spline through the
+//! points, default false) and `tolerance` (chordal, for curves and smoothing, default 0.5 mm).
+//! Open polylines, fewer than three points, repeated consecutive points and loops that cross
+//! themselves are errors naming the loop and point.
 
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
@@ -153,6 +168,16 @@ pub struct SurfaceSpec {
     pub strip: Option<StripSpec>,
     /// The sheet, lines and control curves of a [`SurfaceKind::BentSheet`]; `None` for others.
     pub bent: Option<BentSpec>,
+    /// The loops and settings of a [`SurfaceKind::Boundary`]; `None` for other kinds.
+    pub boundary: Option<BoundarySpec>,
+}
+
+/// A developable from a closed 3D boundary (`kind = "boundary"`, Rose et al.): the loops as
+/// sampled (and smoothed when asked), darts, rulings and the search settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundarySpec {
+    pub input: crate::surface::boundary::Input,
+    pub options: crate::surface::boundary::Options,
 }
 
 /// A bent sheet (`kind = "bent-sheet"`), see `surface::geodesic`.
@@ -236,6 +261,8 @@ pub enum SurfaceKind {
     Strip,
     /// A flat sheet bent along a control curve (Bo–Wang, `surface::geodesic`).
     BentSheet,
+    /// A developable from a closed 3D boundary polyline (Rose et al.).
+    Boundary,
 }
 
 /// Length units of a surface's source coordinates.
@@ -337,10 +364,11 @@ fn pick<T: Copy>(s: &str, table: &[(&str, T)]) -> Result<T, String> {
 }
 
 impl SurfaceKind {
-    const NAMES: [(&'static str, SurfaceKind); 3] = [
+    const NAMES: [(&'static str, SurfaceKind); 4] = [
         ("mesh", SurfaceKind::Mesh),
         ("strip", SurfaceKind::Strip),
         ("bent-sheet", SurfaceKind::BentSheet),
+        ("boundary", SurfaceKind::Boundary),
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -348,6 +376,7 @@ impl SurfaceKind {
             SurfaceKind::Mesh => "mesh",
             SurfaceKind::Strip => "strip",
             SurfaceKind::BentSheet => "bent-sheet",
+            SurfaceKind::Boundary => "boundary",
         }
     }
 }
@@ -513,6 +542,7 @@ impl Spec {
                 line: 0,
                 strip: None,
                 bent: None,
+                boundary: None,
             }],
             material: Material::default(),
             sheet: SheetSpec::default(),
@@ -587,6 +617,16 @@ struct RawSurface {
     handles: Option<Spanned<toml::Value>>,
     length_fit: Option<Spanned<toml::Value>>,
     pieces: Option<Spanned<toml::Value>>,
+    #[serde(rename = "loop")]
+    loop_: Option<Spanned<toml::Value>>,
+    loop_csv: Option<Spanned<Val>>,
+    loops: Option<Spanned<toml::Value>>,
+    darts: Option<Spanned<toml::Value>>,
+    rulings: Option<Spanned<toml::Value>>,
+    max_dihedral: Option<Spanned<Val>>,
+    min_chart_area: Option<Spanned<Val>>,
+    max_iterations: Option<Spanned<Val>>,
+    smooth: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -998,7 +1038,7 @@ impl Ctx<'_> {
                         &kind_key,
                         format!(
                             "missing: each [[surface]] needs a `kind`, {}",
-                            one_of(&["mesh", "strip", "bent-sheet"])
+                            one_of(&["mesh", "strip", "bent-sheet", "boundary"])
                         ),
                     )
                 })?;
@@ -1008,6 +1048,9 @@ impl Ctx<'_> {
             match kind {
                 SurfaceKind::BentSheet => out.push(self.bent_surface(s, &key, header_line, dir)?),
                 SurfaceKind::Strip => out.push(self.strip_surface(s, &key, header_line, dir)?),
+                SurfaceKind::Boundary => {
+                    out.push(self.boundary_surface(s, &key, header_line, dir)?)
+                }
                 SurfaceKind::Mesh => {
                     let path_key = format!("{key}.path");
                     let rel = self.string(
@@ -1051,6 +1094,7 @@ impl Ctx<'_> {
                         line,
                         strip: None,
                         bent: None,
+                        boundary: None,
                     });
                 }
             }
@@ -1300,6 +1344,7 @@ impl Ctx<'_> {
                 sheet: Some((side, k_factor)),
             }),
             bent: None,
+            boundary: None,
         })
     }
 
@@ -1948,6 +1993,7 @@ impl Ctx<'_> {
             name,
             line: line_no,
             strip: None,
+            boundary: None,
             bent: Some(BentSpec {
                 outline,
                 holes,
@@ -1956,6 +2002,319 @@ impl Ctx<'_> {
                 bend_lines,
             }),
         })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Boundaries (issue 6): `kind = "boundary"` with `loop`, `loop_csv` or `loops`
+// ---------------------------------------------------------------------------------------------
+
+impl Ctx<'_> {
+    /// One `kind = "boundary"` entry.
+    fn boundary_surface(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        header_line: usize,
+        dir: &Path,
+    ) -> Result<SurfaceSpec, SpecError> {
+        use crate::surface::boundary::{self, BoundaryError, Dart, Input, Options};
+        use toml::Value;
+        let other = [
+            ("path", s.path.as_ref().map(|v| v.span())),
+            ("scale", s.scale.as_ref().map(|v| v.span())),
+            ("units", s.units.as_ref().map(|v| v.span())),
+            ("method", s.method.as_ref().map(|v| v.span())),
+            ("bend_lines", s.bend_lines.as_ref().map(|v| v.span())),
+            ("p", s.p.as_ref().map(|v| v.span())),
+            ("q", s.q.as_ref().map(|v| v.span())),
+        ];
+        for (k, span) in other {
+            if let Some(span) = span {
+                return Err(self.invalid(
+                    self.line(span),
+                    &format!("{key}.{k}"),
+                    "is not a boundary key; a boundary takes `loop`, `loop_csv` or `loops`"
+                        .to_string(),
+                ));
+            }
+        }
+        let tolerance = self
+            .number(
+                &s.tolerance,
+                &format!("{key}.tolerance"),
+                MM_POSITIVE,
+                |v| v > 0.0,
+            )?
+            .map_or(0.5, |(v, _)| v);
+        let smooth = self
+            .boolean(&s.smooth, &format!("{key}.smooth"))?
+            .unwrap_or(false);
+        let mut options = Options::default();
+        if let Some((v, _)) = self.number(
+            &s.max_dihedral,
+            &format!("{key}.max_dihedral"),
+            "an angle in degrees, more than 0 and at most 180",
+            |v| v > 0.0 && v <= 180.0,
+        )? {
+            options.max_dihedral_deg = v;
+        }
+        if let Some((v, _)) = self.number(
+            &s.min_chart_area,
+            &format!("{key}.min_chart_area"),
+            "a percentage of the hull's area, from 0 to less than 100",
+            |v| (0.0..100.0).contains(&v),
+        )? {
+            options.min_chart_area = v / 100.0;
+        }
+        if let Some((v, _)) = self.number(
+            &s.max_iterations,
+            &format!("{key}.max_iterations"),
+            "a whole number, 1 or more",
+            |v| v >= 1.0 && v.fract() == 0.0 && v <= 1e9,
+        )? {
+            options.max_iterations = v as usize;
+        }
+        // Loops: exactly one of `loop`, `loop_csv`, `loops`.
+        let mut raw_loops: Vec<(Value, String, usize)> = Vec::new();
+        let given = [s.loop_.is_some(), s.loop_csv.is_some(), s.loops.is_some()];
+        if given.iter().filter(|g| **g).count() != 1 {
+            return Err(self.invalid(
+                header_line,
+                &format!("{key}.loop"),
+                "a boundary needs exactly one of `loop` (points or a closed curve), `loop_csv` (a CSV file) or `loops` (a list of loops, the first the outer one)".to_string(),
+            ));
+        }
+        if let Some(v) = &s.loop_ {
+            raw_loops.push((
+                v.get_ref().clone(),
+                format!("{key}.loop"),
+                self.line(v.span()),
+            ));
+        }
+        if let Some(v) = &s.loop_csv {
+            let k = format!("{key}.loop_csv");
+            let path = self
+                .string(
+                    &s.loop_csv,
+                    &k,
+                    "a non-empty string naming a CSV file of x,y,z points",
+                )?
+                .unwrap_or_default();
+            let mut t = toml::map::Map::new();
+            t.insert("kind".into(), Value::String("csv".into()));
+            t.insert("path".into(), Value::String(path));
+            t.insert("closed".into(), Value::Boolean(true));
+            raw_loops.push((Value::Table(t), k, self.line(v.span())));
+        }
+        if let Some(v) = &s.loops {
+            let k = format!("{key}.loops");
+            let line = self.line(v.span());
+            match v.get_ref() {
+                Value::Array(items) if !items.is_empty() => {
+                    for (i, it) in items.iter().enumerate() {
+                        raw_loops.push((it.clone(), format!("{k}[{}]", i + 1), line));
+                    }
+                }
+                other => {
+                    return Err(self.invalid(
+                        line,
+                        &k,
+                        format!("must be a non-empty list of loops, got {other}"),
+                    ))
+                }
+            }
+        }
+        let mut loops = Vec::new();
+        for (v, k, line) in &raw_loops {
+            loops.push(self.boundary_loop(v, k, *line, dir, tolerance, smooth)?);
+        }
+        // Darts and rulings.
+        let mut darts = Vec::new();
+        let mut darts_line = header_line;
+        if let Some(v) = &s.darts {
+            darts_line = self.line(v.span());
+            let k = format!("{key}.darts");
+            let Value::Array(items) = v.get_ref() else {
+                return Err(self.invalid(
+                    darts_line,
+                    &k,
+                    "must be a list of tables { at = N, points = [[x, y, z], ...] }".into(),
+                ));
+            };
+            for (i, it) in items.iter().enumerate() {
+                let dk = format!("{k}[{}]", i + 1);
+                let bad = |m: &str| self.invalid(darts_line, &dk, m.to_string());
+                let Value::Table(t) = it else {
+                    return Err(bad("must be a table { at = N, points = [[x, y, z], ...] }"));
+                };
+                for name in t.keys() {
+                    if !["at", "points", "width"].contains(&name.as_str()) {
+                        return Err(self.invalid(
+                            darts_line,
+                            &format!("{dk}.{name}"),
+                            "unknown key; expected one of at, points, width".into(),
+                        ));
+                    }
+                }
+                let at =
+                    match t.get("at") {
+                        Some(Value::Integer(n)) if *n >= 1 => (*n - 1) as usize,
+                        _ => return Err(bad(
+                            "`at` must be the number (from 1) of the loop point the dart starts at",
+                        )),
+                    };
+                let points = match t.get("points") {
+                    Some(Value::Array(p)) => self.points(p, &format!("{dk}.points"), darts_line)?,
+                    _ => return Err(bad(
+                        "`points` must be the dart's points [[x, y, z], ...], ending at its tip",
+                    )),
+                };
+                let width = match t.get("width") {
+                    None => None,
+                    Some(Value::Integer(n)) if *n > 0 => Some(*n as f64),
+                    Some(Value::Float(f)) if f.is_finite() && *f > 0.0 => Some(*f),
+                    Some(_) => return Err(bad("`width` must be a positive number of millimetres")),
+                };
+                darts.push(Dart { at, points, width });
+            }
+        }
+        let mut rulings = Vec::new();
+        let mut rulings_line = header_line;
+        if let Some(v) = &s.rulings {
+            rulings_line = self.line(v.span());
+            let k = format!("{key}.rulings");
+            let msg =
+                "must be a list of point-number pairs [[i, j], ...] (points of the loop, from 1)";
+            let Value::Array(items) = v.get_ref() else {
+                return Err(self.invalid(rulings_line, &k, msg.into()));
+            };
+            for (i, it) in items.iter().enumerate() {
+                match it {
+                    Value::Array(a)
+                        if a.len() == 2
+                            && a.iter().all(|x| matches!(x, Value::Integer(n) if *n >= 1)) =>
+                    {
+                        let n = |x: &Value| match x {
+                            Value::Integer(n) => (*n - 1) as usize,
+                            _ => 0,
+                        };
+                        rulings.push([n(&a[0]), n(&a[1])]);
+                    }
+                    _ => {
+                        return Err(self.invalid(
+                            rulings_line,
+                            &format!("{k}[{}]", i + 1),
+                            msg.into(),
+                        ))
+                    }
+                }
+            }
+        }
+        if smooth && (!darts.is_empty() || !rulings.is_empty()) {
+            return Err(self.invalid(
+                header_line,
+                &format!("{key}.smooth"),
+                "darts and rulings name points of the loop, which smoothing resamples: use one or the other".into(),
+            ));
+        }
+        let input = Input {
+            loops,
+            darts,
+            rulings,
+        };
+        if let Err(e) = boundary::check(&input) {
+            let at_loop = |l: usize| {
+                raw_loops
+                    .get(l.saturating_sub(1))
+                    .map_or((header_line, key.to_string()), |r| (r.2, r.1.clone()))
+            };
+            let (line, k) = match &e {
+                BoundaryError::Ruling { .. } => (rulings_line, format!("{key}.rulings")),
+                BoundaryError::Dart { .. } => (darts_line, format!("{key}.darts")),
+                BoundaryError::TooFew { looop, .. }
+                | BoundaryError::NonFinite { looop, .. }
+                | BoundaryError::Repeated { looop, .. }
+                | BoundaryError::Open { looop } => at_loop(*looop),
+                BoundaryError::SelfIntersecting { la, .. } => at_loop(*la),
+                BoundaryError::NoLoop => (header_line, format!("{key}.loop")),
+            };
+            return Err(self.invalid(line, &k, e.to_string()));
+        }
+        let name = self
+            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .unwrap_or_else(|| format!("boundary{}", key.trim_start_matches("surface")));
+        Ok(SurfaceSpec {
+            kind: SurfaceKind::Boundary,
+            path: self.path.to_path_buf(),
+            scale: 1.0,
+            units: Units::Mm,
+            name,
+            line: raw_loops.first().map_or(header_line, |r| r.2),
+            strip: None,
+            bent: None,
+            boundary: Some(BoundarySpec { input, options }),
+        })
+    }
+
+    /// One boundary loop: an inline list of points (closed; a last point equal to the first is
+    /// dropped) or a curve table that must be closed. Point lists and CSV files are taken as
+    /// given (repeated points are errors, not dropped); other curves are sampled at `tol`;
+    /// `smooth` resamples a closed cubic B-spline on the points (§7).
+    fn boundary_loop(
+        &self,
+        v: &toml::Value,
+        key: &str,
+        line: usize,
+        dir: &Path,
+        tol: f64,
+        smooth: bool,
+    ) -> Result<Vec<glam::DVec3>, SpecError> {
+        use crate::geom::curve::Curve;
+        let c = match (v, self.curve(v, key, line, dir)?) {
+            (toml::Value::Array(_), Curve::Points { points, .. }) => Curve::Points {
+                points,
+                closed: true,
+            },
+            (_, c) => c,
+        };
+        if !c.is_closed() {
+            return Err(self.invalid(
+                line,
+                key,
+                "is an open polyline: a boundary must be a closed loop (`closed = true`, or an inline list of points, which is closed)".into(),
+            ));
+        }
+        let drop_closing = |mut p: Vec<glam::DVec3>| {
+            if p.len() > 3 && p.first() == p.last() {
+                p.pop();
+            }
+            p
+        };
+        let mut pts = match &c {
+            Curve::Points { points, .. } => drop_closing(points.clone()),
+            Curve::Csv { path, .. } => drop_closing(
+                crate::geom::curve::read_csv(path)
+                    .map_err(|e| self.invalid(line, key, e.to_string()))?,
+            ),
+            other => {
+                other
+                    .sample(tol)
+                    .map_err(|e| self.invalid(line, key, e.to_string()))?
+                    .points
+            }
+        };
+        if smooth && pts.len() >= 4 {
+            pts = Curve::BSpline {
+                control: pts,
+                degree: 3,
+                closed: true,
+            }
+            .sample(tol)
+            .map_err(|e| self.invalid(line, key, e.to_string()))?
+            .points;
+        }
+        Ok(pts)
     }
 }
 
@@ -2067,6 +2426,7 @@ fold_threshold = 1.0
                     line: 6,
                     strip: None,
                     bent: None,
+                    boundary: None,
                 }],
                 material: Material {
                     kind: MaterialKind::Paper,
@@ -2163,6 +2523,7 @@ fold_threshold = 179.5
                 line: 3,
                 strip: None,
                 bent: None,
+                boundary: None,
             }]
         );
         assert_eq!(
@@ -2440,7 +2801,7 @@ fold_threshold = 179.5
         assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
         assert_eq!(
             message,
-            "must be one of mesh, strip, bent-sheet, got \"nurbs\""
+            "must be one of mesh, strip, bent-sheet, boundary, got \"nurbs\""
         );
     }
 
@@ -2544,6 +2905,7 @@ fold_threshold = 179.5
                     line: 0,
                     strip: None,
                     bent: None,
+                    boundary: None,
                 }]
             );
             assert_eq!(
@@ -2581,5 +2943,48 @@ fold_threshold = 179.5
             assert!(shown.starts_with("patterns/lamp.toml:"), "{shown}");
             assert_single_line(&shown);
         }
+    }
+
+    #[test]
+    fn boundary_spec_parses_loops_darts_rulings_and_settings() {
+        let spec = p(r#"
+[[surface]]
+kind = "boundary"
+name = "panel"
+loop = [[0, 0, 0], [100, 0, 0], [100, 80, 10], [50, 100, 5], [0, 80, 10], [0, 0, 0]]
+darts = [{ at = 1, points = [[20, 30, 2]], width = 4 }]
+rulings = [[2, 5]]
+max_dihedral = 45
+min_chart_area = 3
+max_iterations = 200
+"#)
+        .unwrap();
+        let s = &spec.surfaces[0];
+        assert_eq!(s.kind, SurfaceKind::Boundary);
+        assert_eq!(s.name, "panel");
+        assert_eq!(s.line, 5);
+        let b = s.boundary.as_ref().unwrap();
+        assert_eq!(b.input.loops.len(), 1);
+        assert_eq!(
+            b.input.loops[0].len(),
+            5,
+            "the repeated closing point is dropped"
+        );
+        assert_eq!(b.input.darts[0].at, 0);
+        assert_eq!(b.input.darts[0].width, Some(4.0));
+        assert_eq!(b.input.rulings, vec![[1, 4]]);
+        assert_eq!(b.options.max_dihedral_deg, 45.0);
+        assert!((b.options.min_chart_area - 0.03).abs() < 1e-15);
+        assert_eq!(b.options.max_iterations, 200);
+        // A closed curve table is sampled; two loops.
+        let spec = p(r#"
+[[surface]]
+kind = "boundary"
+loops = [{ kind = "ellipse", center = [0, 0, 0], rx = 100, ry = 60 }, [[-10, -10, 0], [10, -10, 0], [0, 10, 0]]]
+"#)
+        .unwrap();
+        let b = spec.surfaces[0].boundary.as_ref().unwrap();
+        assert_eq!(b.input.loops.len(), 2);
+        assert!(b.input.loops[0].len() > 8);
     }
 }

@@ -257,6 +257,7 @@ fn strip_random_strips_flatten_to_1e_9() {
                 warnings: vec![],
                 bends: Some(s.bends(&steps, Default::default())),
                 charts: None,
+                ..Default::default()
             };
             assert_eq!(surface.mesh.faces.len(), 40 + 55 - 2);
             let flat =

@@ -40,6 +40,10 @@ pub struct CutArgs {
     pub link: super::link::LinkArgs,
     #[command(flatten)]
     pub search: super::nest::SearchArgs,
+    /// Boundary surfaces: also write the N best distinct triangulations found, as
+    /// `<surface>-alt-<k>.obj` (k = 1 is the one cut), to pick another by hand.
+    #[arg(long, value_name = "N")]
+    pub alternatives: Option<usize>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -67,6 +71,48 @@ pub fn write_surface_obj(path: &Path, flats: &[crate::flatten::Flat]) -> Result<
     let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));
     let text = crate::output::obj::write(&mesh, None, &comment).unwrap_or_default();
     write_atomic(path, text.as_bytes())
+}
+
+/// `--alternatives N`: ask every boundary surface of the spec for its N best triangulations.
+pub fn ask_alternatives(spec: &mut crate::spec::Spec, n: Option<usize>) {
+    if let Some(n) = n {
+        for s in &mut spec.surfaces {
+            if let Some(b) = s.boundary.as_mut() {
+                b.options.alternatives = n.max(1);
+            }
+        }
+    }
+}
+
+/// `--alternatives N`: write `<surface>-alt-<k>.obj`, the surface's mesh first and then the
+/// alternatives its source found; returns the file names.
+pub fn write_alternatives(
+    dir: &Path,
+    flats: &[crate::flatten::Flat],
+    n: Option<usize>,
+) -> Result<Vec<String>, Error> {
+    let mut files = Vec::new();
+    let Some(n) = n else { return Ok(files) };
+    for f in flats {
+        if f.surface.figures.is_empty() && f.surface.alternatives.is_empty() {
+            continue;
+        }
+        let meshes = std::iter::once(&f.surface.mesh).chain(&f.surface.alternatives);
+        for (k, mesh) in meshes.take(n).enumerate() {
+            let name = format!("{}-alt-{}.obj", f.surface.name, k + 1);
+            let comment = format!(
+                "{} triangulation {} of {} found for surface `{}`",
+                if k == 0 { "chosen" } else { "alternative" },
+                k + 1,
+                1 + f.surface.alternatives.len(),
+                f.surface.name
+            );
+            let text = crate::output::obj::write(mesh, None, &comment).unwrap_or_default();
+            write_atomic(&dir.join(&name), text.as_bytes())?;
+            files.push(name);
+        }
+    }
+    Ok(files)
 }
 
 /// Flags of the toolpath stage (ordering, folds, weeding, drag knife).
@@ -222,6 +268,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
 /// it from its flags): the pattern flags on top, plan, write the files, send.
 pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     a.pattern.apply(&mut spec)?;
+    ask_alternatives(&mut spec, a.alternatives);
     let device = a
         .device
         .clone()
@@ -267,6 +314,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     }
     files.extend(super::flatten::write_pictures(&dir, &spec.name, &job)?);
     files.extend(write_dxf(&dir, &spec.name, &layout)?);
+    files.extend(write_alternatives(&dir, &flats, a.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
         name: spec.name.clone(),

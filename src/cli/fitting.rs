@@ -234,6 +234,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             line: 0,
             strip: Some(strip),
             bent: None,
+            boundary: None,
         }],
         material: Material {
             kind,
@@ -265,6 +266,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),
+        alternatives: None,
         quiet: a.quiet,
         surface_obj: None,
     };

@@ -22,6 +22,10 @@ pub struct FlattenArgs {
     pub pattern: super::PatternArgs,
     #[command(flatten)]
     pub search: super::nest::SearchArgs,
+    /// Boundary surfaces: also write the N best distinct triangulations found, as
+    /// `<surface>-alt-<k>.obj` (k = 1 is the one flattened).
+    #[arg(long, value_name = "N")]
+    pub alternatives: Option<usize>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -52,6 +56,7 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         spec.material.kind = m;
     }
     a.pattern.apply(&mut spec)?;
+    super::cut::ask_alternatives(&mut spec, a.alternatives);
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
     if let Some(p) = &a.surface_obj {
         super::cut::write_surface_obj(p, &flats)?;
@@ -85,6 +90,11 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         .unwrap_or_else(|| super::cut::default_dir(&spec.name));
     create_dir(&dir)?;
     let mut files = write_pictures(&dir, &spec.name, &job)?;
+    files.extend(super::cut::write_alternatives(
+        &dir,
+        &flats,
+        a.alternatives,
+    )?);
     files.push("report.json".into());
     let info = RunInfo {
         name: spec.name.clone(),

@@ -420,6 +420,7 @@ pub(crate) mod tests {
             warnings: Vec::new(),
             bends: None,
             charts: None,
+            ..Default::default()
         }
     }
 

@@ -4,7 +4,8 @@
 //! notch positions in mm from side A's start, and `notches_b_mm` from side B's start, which is
 //! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation; on a
 //! roll the length used, on sheets the rectangle left free on the last sheet),
-//! surfaces (source, faces, pieces, repairs made on import) and the files written.
+//! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
+//! it measured some) and the files written.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
 //! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
@@ -91,13 +92,26 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     let surfaces: Vec<Value> = flats
         .iter()
         .map(|f| {
-            json!({
+            let mut v = json!({
                 "name": f.surface.name,
                 "source": f.surface.source.display().to_string(),
                 "faces": f.surface.mesh.faces.len(),
                 "pieces": f.islands.len(),
                 "warnings": f.surface.warnings,
-            })
+            });
+            // Figures the source measured (boundary surfaces: interior triangles, locally
+            // convex fraction, largest dihedral, iterations, seconds — the one entry that is
+            // not reproducible byte for byte).
+            if !f.surface.figures.is_empty() {
+                let figs: serde_json::Map<String, Value> = f
+                    .surface
+                    .figures
+                    .iter()
+                    .map(|(k, x)| (k.to_string(), json!(r6(*x))))
+                    .collect();
+                v["figures"] = Value::Object(figs);
+            }
+            v
         })
         .collect();
     // Seams: side A and side B of every seam id.

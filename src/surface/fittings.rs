@@ -443,6 +443,7 @@ mod tests {
             line: 0,
             strip: Some(f.strip_spec(opts).unwrap()),
             bent: None,
+            boundary: None,
         };
         crate::surface::build(&spec).unwrap()
     }

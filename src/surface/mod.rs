@@ -6,6 +6,7 @@
 //! ([`strip`], Wang–Tang) and the sheet-metal fittings built on strips ([`fittings`]); boundary
 //! and geodesic developables will add files here (see shared/seeds/README.md).
 
+pub mod boundary;
 pub mod fittings;
 pub mod geodesic;
 pub mod obj;
@@ -35,6 +36,12 @@ pub struct Surface {
     /// charts that the flatten stage parameterises one by one; `None`: the faces are exact flat
     /// panels, unfolded as they are.
     pub charts: Option<Vec<usize>>,
+    /// Figures the source measured, written under the surface in `report.json` (boundary
+    /// surfaces: interior triangles, locally convex fraction, …); empty for none.
+    pub figures: Vec<(&'static str, f64)>,
+    /// Other meshes the source found for the same boundary, best first (boundary surfaces,
+    /// `--alternatives`); they share the vertices of `mesh`.
+    pub alternatives: Vec<Mesh>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -86,6 +93,8 @@ pub enum SurfaceError {
         surface: String,
         source: geodesic::GeodesicError,
     },
+    #[error("surface `{surface}`: {message}")]
+    Boundary { surface: String, message: String },
     #[error("{}{}: the mesh is not orientable (a Möbius-like band): its faces cannot all be wound the same way", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     NonOrientable { path: PathBuf, line: Option<usize> },
 }
@@ -104,10 +113,12 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
                 warnings,
                 bends: None,
                 charts: None,
+                ..Default::default()
             })
         }
         SurfaceKind::Strip => build_strip(spec),
         SurfaceKind::BentSheet => build_bent(spec),
+        SurfaceKind::Boundary => build_boundary(spec),
     }
 }
 
@@ -168,6 +179,43 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         warnings,
         bends: Some(s.bends(&steps, st.bend_lines)),
         charts: None,
+        ..Default::default()
+    })
+}
+
+/// A [`boundary`] surface (Rose et al.): the boundary triangulation of the spec's loops.
+fn build_boundary(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
+    let err = |message: String| SurfaceError::Boundary {
+        surface: spec.name.clone(),
+        message,
+    };
+    let b = spec
+        .boundary
+        .as_ref()
+        .ok_or_else(|| err("a boundary surface needs `loop`".into()))?;
+    let out = boundary::triangulate(&b.input, &b.options).map_err(|e| err(e.to_string()))?;
+    let f = &out.figures;
+    Ok(Surface {
+        name: spec.name.clone(),
+        source: spec.path.clone(),
+        mesh: out.mesh,
+        warnings: out
+            .warnings
+            .into_iter()
+            .map(|w| format!("surface `{}`: {w}", spec.name))
+            .collect(),
+        figures: vec![
+            ("triangles", f.triangles as f64),
+            ("interior_triangles", f.interior_triangles as f64),
+            ("interior_edges", f.interior_edges as f64),
+            ("locally_convex_fraction", f.convex_fraction()),
+            ("largest_dihedral_deg", f.largest_dihedral_deg),
+            ("fairness_rad2", f.fairness),
+            ("iterations", f.iterations as f64),
+            ("seconds", f.seconds),
+        ],
+        alternatives: out.alternatives,
+        ..Default::default()
     })
 }
 

@@ -266,19 +266,12 @@ impl Strip {
         }
     }
 
-    /// Whether bridge `p_i q_j` lies on the convex hull of its six points (§3.2).
+    /// Whether bridge `p_i q_j` lies on the convex hull of its six points (§3.2), by
+    /// [`crate::geom::hull::segment_on_hull`].
     pub fn locally_convex(&self, i: usize, j: usize) -> bool {
-        let a = self.p[i];
-        let d = self.q[j] - a;
-        let l = d.length();
-        if l <= 0.0 {
-            return false;
-        }
-        let dh = d / l;
         let (pp, pn) = Self::neighbours(self.m(), self.closed, i);
         let (qp, qn) = Self::neighbours(self.n(), self.closed, j);
         let mut v = [DVec3::ZERO; 4];
-        let mut len = [0.0; 4];
         let mut k = 0;
         for o in [
             pp.map(|x| self.p[x]),
@@ -289,38 +282,10 @@ impl Strip {
         .into_iter()
         .flatten()
         {
-            let w = o - a;
-            let c = w.cross(dh).length();
-            if c > 1e-12 * w.length().max(l) {
-                v[k] = w;
-                len[k] = c;
-                k += 1;
-            }
+            v[k] = o;
+            k += 1;
         }
-        if k <= 1 {
-            return true;
-        }
-        'outer: for s in 0..k {
-            let (mut pos, mut neg) = (true, true);
-            for t in 0..k {
-                if t == s {
-                    continue;
-                }
-                let x = dh.dot(v[s].cross(v[t]));
-                let tol = 1e-9 * len[s] * len[t];
-                if x < -tol {
-                    pos = false;
-                }
-                if x > tol {
-                    neg = false;
-                }
-                if !pos && !neg {
-                    continue 'outer;
-                }
-            }
-            return true;
-        }
-        false
+        crate::geom::hull::segment_on_hull(self.p[i], self.q[j], &v[..k])
     }
 
     /// Validity matrix Ψ (row-major, m×n) of every bridge; start and end count as valid.
