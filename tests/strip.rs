@@ -82,6 +82,21 @@ fn strip_cone_blank_area_and_perimeter_from_hpgl() {
     assert!(ea < 0.003 && ep < 0.003);
     // --bend-lines none: nothing scored.
     assert!(hpgl::parse(&plt).unwrap().iter().all(|s| s.pen != 2));
+    // report.json has the strip's figures: every ruling of a cone is locally convex.
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let figs = &report["surfaces"][0]["figures"];
+    let interior = figs["interior_bridges"].as_f64().expect("interior_bridges");
+    assert!(interior > 100.0, "{figs}");
+    assert_eq!(
+        figs["locally_convex_bridges"].as_f64(),
+        Some(interior),
+        "{figs}"
+    );
+    assert_eq!(
+        interior,
+        figs["points_p"].as_f64().unwrap() + figs["points_q"].as_f64().unwrap() - 3.0
+    );
 }
 
 #[test]

@@ -36,8 +36,9 @@ pub struct Surface {
     /// charts that the flatten stage parameterises one by one; `None`: the faces are exact flat
     /// panels, unfolded as they are.
     pub charts: Option<Vec<usize>>,
-    /// Figures the source measured, written under the surface in `report.json` (boundary
-    /// surfaces: interior triangles, locally convex fraction, …); empty for none.
+    /// Figures the source measured, written under the surface in `report.json` (strips: points
+    /// on each curve, interior and locally convex bridges, bending energy; boundary surfaces:
+    /// interior triangles, locally convex fraction, …); empty for none.
     pub figures: Vec<(&'static str, f64)>,
     /// Other meshes the source found for the same boundary, best first (boundary surfaces,
     /// `--alternatives`); they share the vertices of `mesh`.
@@ -172,6 +173,13 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         }
         s = s.offset(&steps, st.neutral_offset);
     }
+    let figures = vec![
+        ("points_p", s.m() as f64),
+        ("points_q", s.n() as f64),
+        ("interior_bridges", mt.interior as f64),
+        ("locally_convex_bridges", mt.convex as f64),
+        ("bending_energy", mt.energy),
+    ];
     Ok(Surface {
         name: spec.name.clone(),
         source: spec.path.clone(),
@@ -179,6 +187,7 @@ fn build_strip(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         warnings,
         bends: Some(s.bends(&steps, st.bend_lines)),
         charts: None,
+        figures,
         ..Default::default()
     })
 }
