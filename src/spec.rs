@@ -951,6 +951,9 @@ impl Ctx<'_> {
                         ),
                     )
                 })?;
+            if kind != SurfaceKind::Boundary {
+                self.no_boundary_keys(s, &key)?;
+            }
             match kind {
                 SurfaceKind::Strip => out.push(self.strip_surface(s, &key, header_line, dir)?),
                 SurfaceKind::Boundary => {
@@ -1717,6 +1720,37 @@ impl Ctx<'_> {
             strip: None,
             boundary: Some(BoundarySpec { input, options }),
         })
+    }
+
+    /// Boundary keys on another kind of surface are mistakes, not silently ignored.
+    fn no_boundary_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        let spans = [
+            ("loop", s.loop_.as_ref().map(|v| v.span())),
+            ("loop_csv", s.loop_csv.as_ref().map(|v| v.span())),
+            ("loops", s.loops.as_ref().map(|v| v.span())),
+            ("darts", s.darts.as_ref().map(|v| v.span())),
+            ("rulings", s.rulings.as_ref().map(|v| v.span())),
+            ("max_dihedral", s.max_dihedral.as_ref().map(|v| v.span())),
+            (
+                "min_chart_area",
+                s.min_chart_area.as_ref().map(|v| v.span()),
+            ),
+            (
+                "max_iterations",
+                s.max_iterations.as_ref().map(|v| v.span()),
+            ),
+            ("smooth", s.smooth.as_ref().map(|v| v.span())),
+        ];
+        for (k, span) in spans {
+            if let Some(span) = span {
+                return Err(self.invalid(
+                    self.line(span),
+                    &format!("{key}.{k}"),
+                    "is for boundary surfaces (kind = \"boundary\")".to_string(),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// One boundary loop: an inline list of points (closed; a last point equal to the first is

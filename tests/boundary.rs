@@ -556,6 +556,11 @@ fn bad_boundaries_exit_1_naming_the_problem_and_where() {
         &["bad.toml:3", "surface[1].path"],
     );
     expect_user_error(head, &["surface[1].loop", "exactly one of"]);
+    // Boundary keys on another kind.
+    expect_user_error(
+        "[[surface]]\nkind = \"mesh\"\npath = \"cube.obj\"\nrulings = [[1, 3]]\n",
+        &["bad.toml:4", "surface[1].rulings", "boundary surfaces"],
+    );
 }
 
 #[test]
