@@ -99,7 +99,9 @@
 //! counted from 1, to the tip, the last point; `width` the opening at the mouth in mm),
 //! `rulings = [[i, j], ...]` (edges between loop points, counted from 1, that the surface
 //! must contain), `max_dihedral` (degrees, default 60), `min_chart_area` (percent of the hull,
-//! default 2), `max_iterations` (default 1000), `smooth` (resample a B-spline through the
+//! default 2), `max_iterations` (default 1000), `good_interior` and `good_fairness` (stop as
+//! soon as a triangulation has at most that many interior triangles and that sum of squared
+//! dihedral angles in radians²; default 0 and 0), `smooth` (resample a B-spline through the
 //! points, default false) and `tolerance` (chordal, for curves and smoothing, default 0.5 mm).
 //! Open polylines, fewer than three points, repeated consecutive points and loops that cross
 //! themselves are errors naming the loop and point.
@@ -536,6 +538,8 @@ struct RawSurface {
     min_chart_area: Option<Spanned<Val>>,
     max_iterations: Option<Spanned<Val>>,
     smooth: Option<Spanned<Val>>,
+    good_interior: Option<Spanned<Val>>,
+    good_fairness: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -1541,6 +1545,22 @@ impl Ctx<'_> {
         )? {
             options.max_iterations = v as usize;
         }
+        if let Some((v, _)) = self.number(
+            &s.good_interior,
+            &format!("{key}.good_interior"),
+            "a whole number of interior triangles, 0 or more",
+            |v| v >= 0.0 && v.fract() == 0.0 && v <= 1e9,
+        )? {
+            options.good_interior = v as usize;
+        }
+        if let Some((v, _)) = self.number(
+            &s.good_fairness,
+            &format!("{key}.good_fairness"),
+            "a sum of squared angles in radians², 0 or more",
+            |v| v >= 0.0,
+        )? {
+            options.good_fairness = v;
+        }
         // Loops: exactly one of `loop`, `loop_csv`, `loops`.
         let mut raw_loops: Vec<(Value, String, usize)> = Vec::new();
         let given = [s.loop_.is_some(), s.loop_csv.is_some(), s.loops.is_some()];
@@ -1740,6 +1760,8 @@ impl Ctx<'_> {
                 s.max_iterations.as_ref().map(|v| v.span()),
             ),
             ("smooth", s.smooth.as_ref().map(|v| v.span())),
+            ("good_interior", s.good_interior.as_ref().map(|v| v.span())),
+            ("good_fairness", s.good_fairness.as_ref().map(|v| v.span())),
         ];
         for (k, span) in spans {
             if let Some(span) = span {
@@ -2450,6 +2472,8 @@ rulings = [[2, 5]]
 max_dihedral = 45
 min_chart_area = 3
 max_iterations = 200
+good_interior = 2
+good_fairness = 0.5
 "#)
         .unwrap();
         let s = &spec.surfaces[0];
@@ -2469,6 +2493,8 @@ max_iterations = 200
         assert_eq!(b.options.max_dihedral_deg, 45.0);
         assert!((b.options.min_chart_area - 0.03).abs() < 1e-15);
         assert_eq!(b.options.max_iterations, 200);
+        assert_eq!(b.options.good_interior, 2);
+        assert_eq!(b.options.good_fairness, 0.5);
         // A closed curve table is sampled; two loops.
         let spec = p(r#"
 [[surface]]

@@ -609,3 +609,36 @@ fn same_boundary_gives_the_same_triangulation() {
     assert_eq!(a.alternatives, b.alternatives);
     assert_eq!(a.figures.iterations, b.figures.iterations);
 }
+
+#[test]
+fn good_enough_stops_the_search_early() {
+    let input = Input {
+        loops: vec![csv("gazebo-roof")],
+        ..Default::default()
+    };
+    let full = triangulate(&input, &Options::default()).unwrap();
+    let quick = triangulate(
+        &input,
+        &Options {
+            good_interior: 100,
+            good_fairness: 1e9,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(
+        quick.figures.iterations < full.figures.iterations,
+        "{} vs {}",
+        quick.figures.iterations,
+        full.figures.iterations
+    );
+    assert!(full.figures.iterations <= 1000);
+    check_boundary_triangulation(&quick.mesh, &one_loop(input.loops[0].len()));
+    // The full search is at least as good.
+    assert!(
+        full.figures.interior_triangles <= quick.figures.interior_triangles,
+        "{} vs {}",
+        full.figures.interior_triangles,
+        quick.figures.interior_triangles
+    );
+}
