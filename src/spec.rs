@@ -117,7 +117,9 @@
 //! counted from 1, to the tip, the last point; `width` the opening at the mouth in mm),
 //! `rulings = [[i, j], ...]` (edges between loop points, counted from 1, that the surface
 //! must contain), `max_dihedral` (degrees, default 60), `min_chart_area` (percent of the hull,
-//! default 2), `max_iterations` (default 1000), `smooth` (resample a B-spline through the
+//! default 2), `max_iterations` (default 1000), `good_interior` and `good_fairness` (stop as
+//! soon as a triangulation has at most that many interior triangles and that sum of squared
+//! dihedral angles in radians²; default 0 and 0), `smooth` (resample a B-spline through the
 //! points, default false) and `tolerance` (chordal, for curves and smoothing, default 0.5 mm).
 //! Open polylines, fewer than three points, repeated consecutive points and loops that cross
 //! themselves are errors naming the loop and point.
@@ -627,6 +629,8 @@ struct RawSurface {
     min_chart_area: Option<Spanned<Val>>,
     max_iterations: Option<Spanned<Val>>,
     smooth: Option<Spanned<Val>>,
+    good_interior: Option<Spanned<Val>>,
+    good_fairness: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -1044,6 +1048,9 @@ impl Ctx<'_> {
                 })?;
             if kind != SurfaceKind::BentSheet {
                 self.no_bent_keys(s, &key)?;
+            }
+            if kind != SurfaceKind::Boundary {
+                self.no_boundary_keys(s, &key)?;
             }
             match kind {
                 SurfaceKind::BentSheet => out.push(self.bent_surface(s, &key, header_line, dir)?),
@@ -2075,6 +2082,22 @@ impl Ctx<'_> {
         )? {
             options.max_iterations = v as usize;
         }
+        if let Some((v, _)) = self.number(
+            &s.good_interior,
+            &format!("{key}.good_interior"),
+            "a whole number of interior triangles, 0 or more",
+            |v| v >= 0.0 && v.fract() == 0.0 && v <= 1e9,
+        )? {
+            options.good_interior = v as usize;
+        }
+        if let Some((v, _)) = self.number(
+            &s.good_fairness,
+            &format!("{key}.good_fairness"),
+            "a sum of squared angles in radians², 0 or more",
+            |v| v >= 0.0,
+        )? {
+            options.good_fairness = v;
+        }
         // Loops: exactly one of `loop`, `loop_csv`, `loops`.
         let mut raw_loops: Vec<(Value, String, usize)> = Vec::new();
         let given = [s.loop_.is_some(), s.loop_csv.is_some(), s.loops.is_some()];
@@ -2255,6 +2278,39 @@ impl Ctx<'_> {
             bent: None,
             boundary: Some(BoundarySpec { input, options }),
         })
+    }
+
+    /// Boundary keys on another kind of surface are mistakes, not silently ignored.
+    fn no_boundary_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        let spans = [
+            ("loop", s.loop_.as_ref().map(|v| v.span())),
+            ("loop_csv", s.loop_csv.as_ref().map(|v| v.span())),
+            ("loops", s.loops.as_ref().map(|v| v.span())),
+            ("darts", s.darts.as_ref().map(|v| v.span())),
+            ("rulings", s.rulings.as_ref().map(|v| v.span())),
+            ("max_dihedral", s.max_dihedral.as_ref().map(|v| v.span())),
+            (
+                "min_chart_area",
+                s.min_chart_area.as_ref().map(|v| v.span()),
+            ),
+            (
+                "max_iterations",
+                s.max_iterations.as_ref().map(|v| v.span()),
+            ),
+            ("smooth", s.smooth.as_ref().map(|v| v.span())),
+            ("good_interior", s.good_interior.as_ref().map(|v| v.span())),
+            ("good_fairness", s.good_fairness.as_ref().map(|v| v.span())),
+        ];
+        for (k, span) in spans {
+            if let Some(span) = span {
+                return Err(self.invalid(
+                    self.line(span),
+                    &format!("{key}.{k}"),
+                    "is for boundary surfaces (kind = \"boundary\")".to_string(),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// One boundary loop: an inline list of points (closed; a last point equal to the first is
@@ -2957,6 +3013,8 @@ rulings = [[2, 5]]
 max_dihedral = 45
 min_chart_area = 3
 max_iterations = 200
+good_interior = 2
+good_fairness = 0.5
 "#)
         .unwrap();
         let s = &spec.surfaces[0];
@@ -2976,6 +3034,8 @@ max_iterations = 200
         assert_eq!(b.options.max_dihedral_deg, 45.0);
         assert!((b.options.min_chart_area - 0.03).abs() < 1e-15);
         assert_eq!(b.options.max_iterations, 200);
+        assert_eq!(b.options.good_interior, 2);
+        assert_eq!(b.options.good_fairness, 0.5);
         // A closed curve table is sampled; two loops.
         let spec = p(r#"
 [[surface]]

@@ -556,6 +556,11 @@ fn bad_boundaries_exit_1_naming_the_problem_and_where() {
         &["bad.toml:3", "surface[1].path"],
     );
     expect_user_error(head, &["surface[1].loop", "exactly one of"]);
+    // Boundary keys on another kind.
+    expect_user_error(
+        "[[surface]]\nkind = \"mesh\"\npath = \"cube.obj\"\nrulings = [[1, 3]]\n",
+        &["bad.toml:4", "surface[1].rulings", "boundary surfaces"],
+    );
 }
 
 #[test]
@@ -603,4 +608,37 @@ fn same_boundary_gives_the_same_triangulation() {
     assert_eq!(a.mesh, b.mesh);
     assert_eq!(a.alternatives, b.alternatives);
     assert_eq!(a.figures.iterations, b.figures.iterations);
+}
+
+#[test]
+fn good_enough_stops_the_search_early() {
+    let input = Input {
+        loops: vec![csv("gazebo-roof")],
+        ..Default::default()
+    };
+    let full = triangulate(&input, &Options::default()).unwrap();
+    let quick = triangulate(
+        &input,
+        &Options {
+            good_interior: 100,
+            good_fairness: 1e9,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(
+        quick.figures.iterations < full.figures.iterations,
+        "{} vs {}",
+        quick.figures.iterations,
+        full.figures.iterations
+    );
+    assert!(full.figures.iterations <= 1000);
+    check_boundary_triangulation(&quick.mesh, &one_loop(input.loops[0].len()));
+    // The full search is at least as good.
+    assert!(
+        full.figures.interior_triangles <= quick.figures.interior_triangles,
+        "{} vs {}",
+        full.figures.interior_triangles,
+        quick.figures.interior_triangles
+    );
 }
