@@ -1617,7 +1617,8 @@ pub fn bend_with(
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             let (l2, l3) = (pos[a].distance(pos[b]), vert3[a].distance(vert3[b]));
-            if !((l3 - l2).abs() <= 1e-7 * l2.max(1.0)) {
+            let err = (l3 - l2).abs();
+            if err.is_nan() || err > 1e-7 * l2.max(1.0) {
                 return Err(GeodesicError::Mesh(format!(
                     "the rulings cross on the sheet near ({:.2}, {:.2}): the sheet cannot bend this way without creasing; bend less there",
                     pos[a].x, pos[a].y
