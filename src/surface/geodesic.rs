@@ -439,7 +439,8 @@ impl<'a> ArcLength<'a> {
             }
             let du = f / sp;
             u = (u - du).clamp(u0, u1);
-            if du.abs() < 1e-15 * (1.0 + u.abs()) {
+            // Converged to a few ulps of the panel (1e-14 of its length in mm at most).
+            if du.abs() <= 1e-13 * (u1 - u0) {
                 break;
             }
         }
@@ -774,8 +775,10 @@ fn piece_folds(
     // Step: sagitta h²|ω|/8 within the tolerance.
     let probes = 256;
     let mut wmax: f64 = 0.0;
+    let (f0, f1) = fitted.domain();
     for j in 0..=probes {
-        let u = arc.param(length * j as f64 / probes as f64);
+        // |ω| does not depend on the parameterisation: probe evenly in the parameter.
+        let u = f0 + (f1 - f0) * j as f64 / probes as f64;
         if let Some(l) = local(&fitted, u) {
             wmax = wmax.max(l.omega.length());
         }
@@ -1614,7 +1617,8 @@ pub fn bend_with(
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             let (l2, l3) = (pos[a].distance(pos[b]), vert3[a].distance(vert3[b]));
-            if !((l3 - l2).abs() <= 1e-7 * l2.max(1.0)) {
+            let err = (l3 - l2).abs();
+            if err.is_nan() || err > 1e-7 * l2.max(1.0) {
                 return Err(GeodesicError::Mesh(format!(
                     "the rulings cross on the sheet near ({:.2}, {:.2}): the sheet cannot bend this way without creasing; bend less there",
                     pos[a].x, pos[a].y
