@@ -321,3 +321,45 @@ fn fabric_gets_allowance_and_notch_slits_metal_bend_notes() {
     assert!(lost > 5.0 && lost < 30.0, "{lost}");
     assert!(polygon::is_simple_ring(&p.outline[0]));
 }
+
+#[test]
+fn metal_bend_notes_stay_on_the_blank_of_a_boundary_panel() {
+    // The gazebo roof panel (a boundary developable): many bends close to the outline, some in
+    // thin triangles. Each bend note lies on its piece (beside the bend on either side, smaller
+    // if need be, or left out), so the layout passes the nest's own check.
+    let spec = load(
+        &manifest("patterns/gazebo-roof.toml"),
+        MaterialKind::Metal,
+        None,
+    );
+    let (_, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    let p = &pieces[0];
+    assert!(p.folds.len() > 10, "{} bends", p.folds.len());
+    assert!(
+        p.notes.len() * 10 >= p.folds.len() * 8,
+        "{} of {} bends have their note",
+        p.notes.len(),
+        p.folds.len()
+    );
+    for t in &p.notes {
+        for q in t.points() {
+            assert!(
+                polygon::contains_rings(&p.border, q),
+                "note point {q} off the blank"
+            );
+        }
+    }
+    let dir = scratch("pattern-gazebo-metal");
+    let o = flatcut(&[
+        "cut",
+        manifest("patterns/gazebo-roof.toml").to_str().unwrap(),
+        "--material",
+        "metal",
+        "--device",
+        "hpgl-pens",
+        "--dry-run",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

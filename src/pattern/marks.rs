@@ -279,8 +279,20 @@ pub(super) fn finish(flat: &Flat, p: &mut Piece, opts: &PatternOptions) {
                 FoldKind::Valley => "UP",
             };
             let text = format!("{:.0}° {way}", f.angle_deg);
-            let t = edge_text(&text, f.a, f.b, depth, opts.max_mark_height);
-            if !t.is_empty() {
+            // Beside the bend on either side, smaller if need be, but always on the piece: a
+            // note that sticks out of the outline would be drawn off the blank (and off the
+            // sheet, where the nest leaves no room for it). None fits: no note; the bend line
+            // and the DXF still carry the angle.
+            let fits = |t: &Text| {
+                !t.is_empty() && t.points().all(|q| polygon::contains_rings(&p.border, q))
+            };
+            let found = [1.0, 0.6, 0.36].into_iter().find_map(|k| {
+                [(f.a, f.b), (f.b, f.a)].into_iter().find_map(|(a, b)| {
+                    let t = edge_text(&text, a, b, depth, k * opts.max_mark_height);
+                    fits(&t).then_some(t)
+                })
+            });
+            if let Some(t) = found {
                 p.notes.push(t);
             }
         }
