@@ -37,6 +37,12 @@
 //!   [`ABF_MAX_ITER`] Newton steps or leaving (0, π)) the other is kept; if both fail, the LSCM
 //!   error is returned. If both results have flipped triangles the one with fewer is returned
 //!   and `stretch.flipped` says how many: the caller must split such a chart (D-Charts does).
+//!   A flip-free winner is then relaxed by free-boundary L2 stretch minimisation (Sander et
+//!   al. 2001 §4, the parameterisation the thesis evaluates its charts with, §5.4), which never
+//!   raises L2 and never flips a triangle (a developable chart, already at 1.0, stays as it
+//!   is); `method` still names the conformal method it started from. It lowers L2 at the cost
+//!   of conformality (shear) and, on strongly curved charts, of L∞: `Lscm` and `Abf` give the
+//!   pure conformal layouts.
 //! - **Polygon faces** (more than 3 corners) are ear-clipped in their best-fit plane
 //!   ([`distortion::face_triangles`]); their `uv` is still one point per original corner.
 //! - **Refused** (a [`ParamError`] naming the face and its OBJ line): no faces, a face index out
@@ -52,7 +58,7 @@ use crate::geom::mesh::Mesh;
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
-use glam::{DVec2, DVec3};
+use glam::{DMat2, DVec2, DVec3};
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -70,7 +76,8 @@ pub const ABF_TOLERANCE: f64 = 1e-10;
 pub enum ParamMethod {
     Lscm,
     Abf,
-    /// Both; keep the one with fewer flipped triangles, then the lower L2 stretch.
+    /// Both; keep the one with fewer flipped triangles, then the lower L2 stretch, then
+    /// minimise its L2 stretch (see the module doc).
     #[default]
     Best,
 }
@@ -83,7 +90,8 @@ pub struct ChartParam {
     /// Per chart face (same order), per corner: flat position in mm, scaled so the flat area
     /// equals the 3D area.
     pub uv: Vec<Vec<DVec2>>,
-    /// The method whose result this is (`Lscm` or `Abf`).
+    /// The method whose result this is (`Lscm` or `Abf`; for `Best`, the one the stretch
+    /// minimisation started from).
     pub method: ParamMethod,
     /// Distortion of `uv`.
     pub stretch: Stretch,
@@ -614,9 +622,9 @@ fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
     // Interior vertex -> row pair (V = 2i, L = 2i + 1).
     let mut row: Vec<Option<usize>> = vec![None; nv];
     let mut ni = 0;
-    for v in 0..nv {
-        if !chart.boundary[v] {
-            row[v] = Some(ni);
+    for (slot, &on_boundary) in row.iter_mut().zip(&chart.boundary) {
+        if !on_boundary {
+            *slot = Some(ni);
             ni += 1;
         }
     }
@@ -865,19 +873,163 @@ pub fn parameterize(
         ParamMethod::Best => {
             let l = run_lscm(mesh, faces, &chart, pin);
             let a = run_abf(mesh, faces, &chart, pin);
-            match (l, a) {
+            let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
+            let kept = match (l, a) {
                 (Ok(l), Ok(a)) => {
-                    let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
                     if key(&a) < key(&l) {
-                        Ok(a)
+                        a
                     } else {
-                        Ok(l)
+                        l
                     }
                 }
-                (Ok(l), Err(_)) => Ok(l),
-                (Err(_), Ok(a)) => Ok(a),
-                (Err(e), Err(_)) => Err(e),
-            }
+                (Ok(l), Err(_)) => l,
+                (Err(_), Ok(a)) => a,
+                (Err(e), Err(_)) => return Err(e),
+            };
+            let refined = refine(mesh, faces, &chart, &kept);
+            Ok(if key(&refined) < key(&kept) {
+                refined
+            } else {
+                kept
+            })
         }
     }
+}
+
+/// Sweeps of the stretch minimisation that `Best` runs on the kept layout.
+pub const STRETCH_SWEEPS: usize = 60;
+
+/// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4) from a flip-free layout: a
+/// nonlinear Gauss–Seidel over the vertices, each moved by a backtracking line search down the
+/// gradient of the whole chart's scale-free L2 stretch, E = (Σ A₃·(a + c)) · (Σ A₂) (the L2²
+/// of [`distortion::stretch`] up to a constant). A move that would flip or collapse a triangle
+/// is refused, so the result stays flip-free, and E never increases.
+fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> ChartParam {
+    if start.stretch.flipped > 0 {
+        return start.clone();
+    }
+    let nv = chart.pos.len();
+    let mut uv = vec![DVec2::ZERO; nv];
+    for (cs, pts) in chart.corners.iter().zip(&start.uv) {
+        for (&v, &p) in cs.iter().zip(pts) {
+            uv[v] = p;
+        }
+    }
+    let shapes = shapes_from_3d(chart);
+    // Per triangle: 3D edge matrix in its own plane, 3D area.
+    let q: Vec<DMat2> = shapes
+        .iter()
+        .map(|s| DMat2::from_cols(s[1] - s[0], s[2] - s[0]))
+        .collect();
+    let a3: Vec<f64> = q.iter().map(|m| 0.5 * m.determinant()).collect();
+    let mut vt: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nv];
+    for (t, tri) in chart.tris.iter().enumerate() {
+        for (c, &v) in tri.iter().enumerate() {
+            vt[v].push((t, c));
+        }
+    }
+    // (A₃·f, A₂) of a triangle with the given flat corners; None if not positive.
+    let term = |t: usize, p: [DVec2; 3]| -> Option<(f64, f64)> {
+        let pm = DMat2::from_cols(p[1] - p[0], p[2] - p[0]);
+        let det = pm.determinant();
+        if !(det > 0.0 && det.is_finite()) {
+            return None;
+        }
+        let g = q[t] * pm.inverse();
+        let f = g.x_axis.length_squared() + g.y_axis.length_squared();
+        Some((a3[t] * f, 0.5 * det))
+    };
+    let corners = |t: usize, uv: &[DVec2]| chart.tris[t].map(|v| uv[v]);
+    let totals = |uv: &[DVec2]| -> Option<(f64, f64)> {
+        let (mut s, mut a) = (0.0, 0.0);
+        for t in 0..chart.tris.len() {
+            let (x, y) = term(t, corners(t, uv))?;
+            s += x;
+            a += y;
+        }
+        Some((s, a))
+    };
+    let Some((mut s_tot, mut a_tot)) = totals(&uv) else {
+        return start.clone();
+    };
+    let e0 = s_tot * a_tot;
+    let mut e_prev = e0;
+    for _sweep in 0..STRETCH_SWEEPS {
+        for v in 0..nv {
+            // Local sums and gradient.
+            let (mut s_loc, mut a_loc) = (0.0, 0.0);
+            let (mut gs, mut ga) = (DVec2::ZERO, DVec2::ZERO);
+            let mut reach = f64::INFINITY;
+            for &(t, c) in &vt[v] {
+                let p = corners(t, &uv);
+                let pm = DMat2::from_cols(p[1] - p[0], p[2] - p[0]);
+                let m = pm.inverse();
+                let det = pm.determinant();
+                let g = q[t] * m;
+                s_loc += a3[t] * (g.x_axis.length_squared() + g.y_axis.length_squared());
+                a_loc += 0.5 * det;
+                let h = m * g.transpose() * g;
+                let dfdp = h.transpose() * (-2.0 * a3[t]);
+                let dadp = m.transpose() * (0.5 * det);
+                let pick = |d: DMat2| match c {
+                    1 => d.x_axis,
+                    2 => d.y_axis,
+                    _ => -(d.x_axis + d.y_axis),
+                };
+                gs += pick(dfdp);
+                ga += pick(dadp);
+                reach = reach.min(
+                    p[(c + 1) % 3]
+                        .distance(p[c])
+                        .min(p[(c + 2) % 3].distance(p[c])),
+                );
+            }
+            let (s_rest, a_rest) = (s_tot - s_loc, a_tot - a_loc);
+            let e_here = s_tot * a_tot;
+            let grad = gs * a_tot + ga * s_tot;
+            let gl = grad.length();
+            if !(gl > 0.0 && gl.is_finite()) {
+                continue;
+            }
+            let dir = -grad / gl;
+            let mut step = 0.5 * reach;
+            let old = uv[v];
+            for _ in 0..12 {
+                uv[v] = old + dir * step;
+                let mut ok = true;
+                let (mut s_new, mut a_new) = (0.0, 0.0);
+                for &(t, _) in &vt[v] {
+                    match term(t, corners(t, &uv)) {
+                        Some((x, y)) => {
+                            s_new += x;
+                            a_new += y;
+                        }
+                        None => {
+                            ok = false;
+                            break;
+                        }
+                    }
+                }
+                if ok && (s_rest + s_new) * (a_rest + a_new) < e_here {
+                    s_tot = s_rest + s_new;
+                    a_tot = a_rest + a_new;
+                    break;
+                }
+                uv[v] = old;
+                step *= 0.5;
+            }
+        }
+        // Fresh sums (no drift), and stop when a sweep gains little.
+        let Some((s, a)) = totals(&uv) else {
+            return start.clone();
+        };
+        s_tot = s;
+        a_tot = a;
+        let e = s * a;
+        if e > e_prev * (1.0 - 1e-5) {
+            break;
+        }
+        e_prev = e;
+    }
+    finish(mesh, faces, chart, start.method, uv)
 }
