@@ -34,8 +34,9 @@
 //!   point to, like [`super::Flat`].
 //! - **Best**: both methods run; the result with fewer flipped triangles wins, then the lower L2
 //!   stretch; a tie keeps LSCM. If one method fails (singular system, ABF++ not converging in
-//!   [`ABF_MAX_ITER`] Newton steps or leaving (0, π)) the other is kept; if both fail, the LSCM
-//!   error is returned. If both results have flipped triangles the one with fewer is returned
+//!   [`ABF_MAX_ITER`] Newton steps) the other is kept; if both fail, the LSCM
+//!   error is returned. ABF++ steps are damped when a full Newton step would take an angle
+//!   out of (0, π) (the paper takes full steps). If both results have flipped triangles the one with fewer is returned
 //!   and `stretch.flipped` says how many: the caller must split such a chart (D-Charts does).
 //!   An LSCM layout already isometric (L2 within [`ISOMETRIC`] of 1, no flip) is returned at
 //!   once. A flip-free winner is otherwise relaxed by free-boundary L2 stretch minimisation (Sander et
@@ -769,24 +770,43 @@ fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
             local_d[t] = d;
         }
         let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic)?;
+        let mut d_alpha = vec![[0.0f64; 3]; nt];
+        let mut d_lam_t = vec![0.0f64; nt];
+        // Largest step fraction keeping every angle inside (0, π) with a margin (a damped
+        // Newton step; ABF++ takes full steps, which can leave the domain on hard charts).
+        let mut step = 1.0f64;
         for (t, tri) in chart.tris.iter().enumerate() {
             let xl: [f64; 6] =
                 std::array::from_fn(|s| row[tri[s / 2]].map(|r| x[2 * r + s % 2]).unwrap_or(0.0));
             let bx: f64 = (0..6).map(|s| local_b[t][s] * xl[s]).sum();
             let dl1 = (local_r1[t] - bx) / local_d[t];
-            lam_t[t] += dl1;
+            d_lam_t[t] = dl1;
             for c in 0..3 {
                 let j = jac(t, c);
                 let jx: f64 = (0..6).map(|s| j[s] * xl[s]).sum();
                 let da = -(b1[t][c] + dl1 + jx) / lam_diag[t][c];
-                alpha[t][c] += da;
-                if !(alpha[t][c] > 0.0 && alpha[t][c] < PI) {
-                    return Err(chart.solver_error(M, "an angle left (0, π)"));
+                let a = alpha[t][c];
+                if da < 0.0 {
+                    step = step.min(0.9 * a / -da);
+                } else if da > 0.0 {
+                    step = step.min(0.9 * (PI - a) / da);
                 }
+                d_alpha[t][c] = da;
+            }
+        }
+        if step.is_nan() || step <= 1e-6 {
+            return Err(chart.solver_error(M, "the Newton step cannot keep the angles in (0, π)"));
+        }
+        for (l, dl) in lam_t.iter_mut().zip(&d_lam_t) {
+            *l += step * dl;
+        }
+        for (a, da) in alpha.iter_mut().zip(&d_alpha) {
+            for c in 0..3 {
+                a[c] += step * da[c];
             }
         }
         for (l, dx) in lam2.iter_mut().zip(&x) {
-            *l += dx;
+            *l += step * dx;
         }
     }
     if !converged {
@@ -1132,17 +1152,13 @@ mod tests {
         // Angles that satisfy the constraints rebuild a layout whose triangles have exactly
         // those angles (up to round-off): the reconstruction is consistent.
         let p = run_abf(&m, &faces, &chart, pins(&chart)).expect("layout");
-        for t in 0..chart.tris.len() {
-            // One triangle per face, faces in order: triangle t is face t.
-            let uv = &p.uv[t];
+        // One triangle per face, faces in order: triangle t is face t.
+        assert_eq!(p.uv.len(), alpha.len());
+        for (t, (uv, al)) in p.uv.iter().zip(&alpha).enumerate() {
             for c in 0..3 {
                 let (a, b, d) = (uv[c], uv[(c + 1) % 3], uv[(c + 2) % 3]);
                 let ang = (b - a).angle_to(d - a);
-                assert!(
-                    (ang - alpha[t][c]).abs() < 1e-7,
-                    "{t} {c}: {ang} vs {}",
-                    alpha[t][c]
-                );
+                assert!((ang - al[c]).abs() < 1e-7, "{t} {c}: {ang} vs {}", al[c]);
             }
         }
     }
