@@ -40,6 +40,8 @@ pub struct CutArgs {
     pub link: super::link::LinkArgs,
     #[command(flatten)]
     pub search: super::nest::SearchArgs,
+    #[command(flatten)]
+    pub smooth: super::flatten::SmoothArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -198,6 +200,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
 /// it from its flags): the pattern flags on top, plan, write the files, send.
 pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     a.pattern.apply(&mut spec)?;
+    a.smooth.apply(&mut spec);
     let device = a
         .device
         .clone()
@@ -224,6 +227,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         }
     })?;
     let machine = machine_job(&job, &profile, &spec);
+    a.smooth.write_uv(&flats)?;
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;

@@ -233,6 +233,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             name,
             line: 0,
             strip: Some(strip),
+            segment: Default::default(),
         }],
         material: Material {
             kind,
@@ -261,6 +262,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         material: None,
         pattern: Default::default(),
         search: Default::default(),
+        smooth: Default::default(),
         toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),

@@ -441,6 +441,7 @@ mod tests {
             name: f.kind().into(),
             line: 0,
             strip: Some(f.strip_spec(opts).unwrap()),
+            segment: Default::default(),
         };
         crate::surface::build(&spec).unwrap()
     }

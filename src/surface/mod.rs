@@ -6,6 +6,8 @@
 //! ([`strip`], Wang–Tang) and the sheet-metal fittings built on strips ([`fittings`]); boundary
 //! and geodesic developables will add files here (see shared/seeds/README.md).
 
+pub mod dcharts;
+pub mod dcs;
 pub mod fittings;
 pub mod obj;
 pub mod solids;
@@ -91,14 +93,17 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             let scale = spec.scale * spec.units.mm();
             let raw = obj::read(&spec.path)?;
             let (mesh, warnings) = obj::validate(raw, scale)?;
-            Ok(Surface {
+            let mut surface = Surface {
                 name: spec.name.clone(),
                 source: spec.path.clone(),
                 mesh,
                 warnings,
                 bends: None,
                 charts: None,
-            })
+            };
+            // Smooth meshes (issue 7): DCS approximation and D-Charts segmentation.
+            dcharts::apply(&mut surface, &spec.segment)?;
+            Ok(surface)
         }
         SurfaceKind::Strip => build_strip(spec),
     }
