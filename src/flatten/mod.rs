@@ -2,10 +2,16 @@
 //! 3D↔2D correspondence (every face keeps its mesh index; every edge knows whether its two
 //! faces stay joined in the plane and by how much the surface bends there).
 //!
-//! [`unfold`] is the exact unfolding of polyhedral (developable) meshes. Parameterisation of
-//! nearly developable charts (LSCM / ABF++) and distortion metrics will join it here.
+//! [`unfold`] is the exact unfolding of polyhedral (developable) meshes. [`param`] flattens
+//! nearly developable disk-topology charts (LSCM / ABF++) and [`distortion`] measures any flat
+//! layout against its mesh (L2 / L∞ stretch, shear, angle defect).
 
+pub mod distortion;
+pub mod param;
 pub mod unfold;
+
+pub use distortion::Stretch;
+pub use param::{parameterize, ChartParam, ParamError, ParamMethod};
 
 pub use unfold::{unfold, UnfoldOptions};
 

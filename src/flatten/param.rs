@@ -1,0 +1,883 @@
+//! Parameterisation of nearly developable disk-topology charts: LSCM (Lévy, Petitjean, Ray,
+//! Maillot 2002) and ABF++ (Sheffer, Lévy, Mogilnitsky, Bogomyakov 2005), the unfolding the
+//! thesis (seed 001, §6.2 / §6.4) uses for its panels. [`parameterize`] flattens one chart (a
+//! set of mesh faces) and measures it with [`distortion::stretch`].
+//!
+//! **LSCM.** Each triangle, laid in its own plane with corners z₁ z₂ z₃ (complex), asks the
+//! flat map U to be conformal: |Σⱼ Wⱼ Uⱼ|² / (2A) = 0 with Wⱼ = z_{j+2} − z_{j+1} (Lévy et al.
+//! eq. 8–10, written so that direct similarities cost nothing and mirror images do). Two vertices
+//! are pinned and the rest solved by sparse least squares: the normal equations AᵀA x = −Aᵀb
+//! (symmetric positive definite once two vertices are pinned) are factored by faer's sparse
+//! Cholesky with its fill-reducing ordering.
+//!
+//! **ABF++.** Unknowns: the 3 angles α of every triangle. Targets β: the 3D angles, scaled at
+//! each interior vertex so they sum to 2π (ABF, Sheffer & de Sturler 2001). Energy Σ (α − β)²/β²
+//! under the constraints: triangle sums π, interior vertex sums 2π, and the wheel (law of sines)
+//! condition Σ log sin α_next − Σ log sin α_prev = 0 around each interior vertex (the log form of
+//! the paper's product, same zero set, better scaled). Newton steps on the Lagrangian with the
+//! Hessian approximated by its diagonal Λ = 2/β² (ABF++ §4.1); each step is solved through the
+//! ABF++ reduction: the triangle constraints (J₁, whose J₁Λ⁻¹J₁ᵀ is diagonal) are eliminated, and
+//! only the Schur complement J₂Λ⁻¹J₂ᵀ − BᵀD⁻¹B over the 2 × (interior vertices) vertex and
+//! wheel multipliers is factored (sparse Cholesky) (ABF++ §4.2, eq. 12–16). Angles → coordinates
+//! as ABF++ §5 does: the LSCM energy with each triangle's shape built from its angles (law of
+//! sines), same two pins.
+//!
+//! Choices where the papers are silent:
+//! - **Pins**: the two boundary vertices farthest apart in 3D (ties: the lowest local indices,
+//!   local indices being first appearance in `faces` order), placed at (0, 0) and (d, 0), d their
+//!   3D distance. Exact over all pairs up to [`EXACT_PIN_LIMIT`] boundary vertices; beyond it a
+//!   double sweep (the vertex farthest from the first boundary vertex, then the one farthest
+//!   from that), which is within a factor √2 of the diameter and O(n).
+//! - **Output frame**: the layout is scaled so its area equals the chart's 3D area, mirrored if
+//!   it came out clockwise (it never should: both energies penalise mirror images), and moved so
+//!   its bounding box starts at (0, 0). Counter-clockwise = seen from the side the face normals
+//!   point to, like [`super::Flat`].
+//! - **Best**: both methods run; the result with fewer flipped triangles wins, then the lower L2
+//!   stretch; a tie keeps LSCM. If one method fails (singular system, ABF++ not converging in
+//!   [`ABF_MAX_ITER`] Newton steps or leaving (0, π)) the other is kept; if both fail, the LSCM
+//!   error is returned. If both results have flipped triangles the one with fewer is returned
+//!   and `stretch.flipped` says how many: the caller must split such a chart (D-Charts does).
+//! - **Polygon faces** (more than 3 corners) are ear-clipped in their best-fit plane
+//!   ([`distortion::face_triangles`]); their `uv` is still one point per original corner.
+//! - **Refused** (a [`ParamError`] naming the face and its OBJ line): no faces, a face index out
+//!   of range or repeated, a vertex index out of range or not finite, a triangle with an angle
+//!   below [`MIN_ANGLE`] (1e-3 rad), an edge used by more than two triangles, two faces wound
+//!   against each other, a vertex where two boundary fans meet, several connected components,
+//!   no boundary (closed), several boundary loops (holes), handles. Nothing is repaired here:
+//!   charts come from a segmentation that can cut differently.
+//! - Determinism: no hash-map iteration order reaches the result; the solves are sequential.
+
+use super::distortion::{self, corner_angle, face_triangles, Stretch};
+use crate::geom::mesh::Mesh;
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+use glam::{DVec2, DVec3};
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+/// Smallest triangle angle accepted (radians).
+pub const MIN_ANGLE: f64 = 1e-3;
+/// Boundary size up to which the pins are the exact farthest pair.
+pub const EXACT_PIN_LIMIT: usize = 4000;
+/// Newton steps ABF++ may take.
+pub const ABF_MAX_ITER: usize = 50;
+/// ABF++ stops when the gradient of the Lagrangian is below this (radians).
+pub const ABF_TOLERANCE: f64 = 1e-10;
+
+/// Which parameterisation to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ParamMethod {
+    Lscm,
+    Abf,
+    /// Both; keep the one with fewer flipped triangles, then the lower L2 stretch.
+    #[default]
+    Best,
+}
+
+/// One chart laid flat.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChartParam {
+    /// The chart's faces (mesh face indices), as given.
+    pub faces: Vec<usize>,
+    /// Per chart face (same order), per corner: flat position in mm, scaled so the flat area
+    /// equals the 3D area.
+    pub uv: Vec<Vec<DVec2>>,
+    /// The method whose result this is (`Lscm` or `Abf`).
+    pub method: ParamMethod,
+    /// Distortion of `uv`.
+    pub stretch: Stretch,
+}
+
+fn at(face: usize, line: &Option<usize>) -> String {
+    match line {
+        Some(l) => format!("face {face} (line {l})"),
+        None => format!("face {face}"),
+    }
+}
+
+/// Why a chart cannot be parameterised. Each message names the face (and its OBJ line).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    #[error("chart has no faces")]
+    Empty,
+    #[error("chart lists face {face}, but the mesh has {count} faces")]
+    FaceOutOfRange { face: usize, count: usize },
+    #[error("chart lists {} twice", at(*face, line))]
+    DuplicateFace { face: usize, line: Option<usize> },
+    #[error("{}: vertex {vertex} is missing or not a finite point", at(*face, line))]
+    BadVertex {
+        face: usize,
+        line: Option<usize>,
+        vertex: usize,
+    },
+    #[error("{}: degenerate triangle (angle {angle:.2e} rad, below 1e-3); remove or remesh it", at(*face, line))]
+    Degenerate {
+        face: usize,
+        line: Option<usize>,
+        angle: f64,
+    },
+    #[error("{}: non-manifold edge {a}-{b}, used by {count} triangles; a chart must be a disk", at(*face, line))]
+    NonManifoldEdge {
+        face: usize,
+        line: Option<usize>,
+        a: usize,
+        b: usize,
+        count: usize,
+    },
+    #[error("{}: non-manifold vertex {vertex} (two boundary fans meet there); a chart must be a disk", at(*face, line))]
+    NonManifoldVertex {
+        face: usize,
+        line: Option<usize>,
+        vertex: usize,
+    },
+    #[error("{}: wound against its neighbour across edge {a}-{b}; orient the mesh consistently", at(*face, line))]
+    Inconsistent {
+        face: usize,
+        line: Option<usize>,
+        a: usize,
+        b: usize,
+    },
+    #[error("chart is not a disk: {count} separate components ({} is not connected to the first face)", at(*face, line))]
+    SeveralComponents {
+        count: usize,
+        face: usize,
+        line: Option<usize>,
+    },
+    #[error("chart is not a disk: it is closed (no boundary, e.g. {}); cut it open", at(*face, line))]
+    Closed { face: usize, line: Option<usize> },
+    #[error("chart is not a disk: {loops} boundary loops (holes; one runs along {}); cut from each hole to the outer boundary", at(*face, line))]
+    Holes {
+        loops: usize,
+        face: usize,
+        line: Option<usize>,
+    },
+    #[error("chart is not a disk: Euler characteristic {euler} with one boundary loop (handles; e.g. {}); cut the handles", at(*face, line))]
+    Handles {
+        euler: i64,
+        face: usize,
+        line: Option<usize>,
+    },
+    #[error("{method}: {message} (chart of {faces} faces starting at {})", at(*face, line))]
+    Solver {
+        method: &'static str,
+        message: String,
+        faces: usize,
+        face: usize,
+        line: Option<usize>,
+    },
+}
+
+/// A chart ready to solve: local vertices, triangles over them.
+struct Chart {
+    /// Local vertex → 3D position.
+    pos: Vec<DVec3>,
+    /// Triangles over local vertices (face winding).
+    tris: Vec<[usize; 3]>,
+    /// Per chart face: local vertex of each corner.
+    corners: Vec<Vec<usize>>,
+    /// Per local vertex: on the boundary.
+    boundary: Vec<bool>,
+    /// Boundary vertices (local), in loop order.
+    boundary_loop: Vec<usize>,
+    /// For messages: the first face and its line.
+    first: (usize, Option<usize>),
+    nfaces: usize,
+}
+
+impl Chart {
+    fn solver_error(&self, method: &'static str, message: impl Into<String>) -> ParamError {
+        ParamError::Solver {
+            method,
+            message: message.into(),
+            faces: self.nfaces,
+            face: self.first.0,
+            line: self.first.1,
+        }
+    }
+}
+
+fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
+    if faces.is_empty() {
+        return Err(ParamError::Empty);
+    }
+    let line = |f: usize| mesh.faces[f].line;
+    let mut seen: HashMap<usize, usize> = HashMap::with_capacity(faces.len());
+    let mut local: HashMap<usize, usize> = HashMap::new();
+    let mut pos: Vec<DVec3> = Vec::new();
+    let mut tris: Vec<[usize; 3]> = Vec::new();
+    let mut tri_face: Vec<usize> = Vec::new();
+    let mut corners: Vec<Vec<usize>> = Vec::with_capacity(faces.len());
+    for (k, &f) in faces.iter().enumerate() {
+        if f >= mesh.faces.len() {
+            return Err(ParamError::FaceOutOfRange {
+                face: f,
+                count: mesh.faces.len(),
+            });
+        }
+        if seen.insert(f, k).is_some() {
+            return Err(ParamError::DuplicateFace {
+                face: f,
+                line: line(f),
+            });
+        }
+        let face = &mesh.faces[f];
+        let mut cs = Vec::with_capacity(face.verts.len());
+        for &v in &face.verts {
+            let p = mesh.vertices.get(v).copied().unwrap_or(DVec3::NAN);
+            if !p.is_finite() {
+                return Err(ParamError::BadVertex {
+                    face: f,
+                    line: line(f),
+                    vertex: v,
+                });
+            }
+            let id = *local.entry(v).or_insert_with(|| {
+                pos.push(p);
+                pos.len() - 1
+            });
+            cs.push(id);
+        }
+        let tri_list = face_triangles(mesh, f);
+        if tri_list.is_empty() {
+            return Err(ParamError::Degenerate {
+                face: f,
+                line: line(f),
+                angle: 0.0,
+            });
+        }
+        for t in tri_list {
+            let lt = t.map(|i| cs[i]);
+            let p = lt.map(|i| pos[i]);
+            let mut min = f64::INFINITY;
+            for c in 0..3 {
+                min = min.min(corner_angle(p[c], p[(c + 1) % 3], p[(c + 2) % 3]));
+            }
+            if lt[0] == lt[1] || lt[1] == lt[2] || lt[0] == lt[2] || min.is_nan() || min < MIN_ANGLE
+            {
+                return Err(ParamError::Degenerate {
+                    face: f,
+                    line: line(f),
+                    angle: if min.is_nan() { 0.0 } else { min },
+                });
+            }
+            tris.push(lt);
+            tri_face.push(f);
+        }
+        corners.push(cs);
+    }
+    let global: Vec<usize> = {
+        let mut g = vec![0; pos.len()];
+        for (&v, &l) in &local {
+            g[l] = v;
+        }
+        g
+    };
+
+    // Edges over triangles: uses as (triangle, directed a -> b).
+    let mut edge_index: HashMap<(usize, usize), usize> = HashMap::with_capacity(tris.len() * 2);
+    let mut edge_uses: Vec<Vec<(usize, usize, usize)>> = Vec::new();
+    for (t, tri) in tris.iter().enumerate() {
+        for c in 0..3 {
+            let (a, b) = (tri[c], tri[(c + 1) % 3]);
+            let id = *edge_index.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                edge_uses.push(Vec::new());
+                edge_uses.len() - 1
+            });
+            let uses = &mut edge_uses[id];
+            uses.push((t, a, b));
+            if uses.len() > 2 {
+                let f = tri_face[t];
+                return Err(ParamError::NonManifoldEdge {
+                    face: f,
+                    line: line(f),
+                    a: global[a],
+                    b: global[b],
+                    count: uses.len(),
+                });
+            }
+        }
+    }
+    // Components (union-find over triangles sharing an edge), orientation.
+    let mut parent: Vec<usize> = (0..tris.len()).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for uses in &edge_uses {
+        if let [(t, a, b), (u, a2, _)] = uses[..] {
+            if a == a2 {
+                let f = tri_face[u];
+                return Err(ParamError::Inconsistent {
+                    face: f,
+                    line: line(f),
+                    a: global[a],
+                    b: global[b],
+                });
+            }
+            let (rt, ru) = (find(&mut parent, t), find(&mut parent, u));
+            if rt != ru {
+                parent[rt.max(ru)] = rt.min(ru);
+            }
+        }
+    }
+    let root0 = find(&mut parent, 0);
+    let mut roots = Vec::new();
+    let mut other = None;
+    for t in 0..tris.len() {
+        let r = find(&mut parent, t);
+        if r == t {
+            roots.push(r);
+        }
+        if r != root0 && other.is_none() {
+            other = Some(t);
+        }
+    }
+    if let Some(t) = other {
+        let f = tri_face[t];
+        return Err(ParamError::SeveralComponents {
+            count: roots.len(),
+            face: f,
+            line: line(f),
+        });
+    }
+    // Boundary: directed edges used once; one out- and one in-edge per boundary vertex.
+    let nv = pos.len();
+    let mut next: Vec<Option<usize>> = vec![None; nv];
+    let mut has_in = vec![false; nv];
+    let mut boundary_face: Vec<usize> = vec![0; nv];
+    let mut nb = 0usize;
+    for uses in &edge_uses {
+        if let [(t, a, b)] = uses[..] {
+            let f = tri_face[t];
+            if next[a].is_some() || has_in[b] {
+                let v = if next[a].is_some() { a } else { b };
+                return Err(ParamError::NonManifoldVertex {
+                    face: f,
+                    line: line(f),
+                    vertex: global[v],
+                });
+            }
+            next[a] = Some(b);
+            has_in[b] = true;
+            boundary_face[a] = f;
+            nb += 1;
+        }
+    }
+    if nb == 0 {
+        let f = faces[0];
+        return Err(ParamError::Closed {
+            face: f,
+            line: line(f),
+        });
+    }
+    let mut visited = vec![false; nv];
+    let mut loops: Vec<Vec<usize>> = Vec::new();
+    for s in 0..nv {
+        if next[s].is_none() || visited[s] {
+            continue;
+        }
+        let mut lp = Vec::new();
+        let mut cur = s;
+        while !visited[cur] {
+            visited[cur] = true;
+            lp.push(cur);
+            match next[cur] {
+                Some(n) => cur = n,
+                None => break,
+            }
+        }
+        loops.push(lp);
+    }
+    if loops.len() > 1 {
+        // Name a face on the second loop (the first is usually the outer one).
+        let f = boundary_face[loops[1][0]];
+        return Err(ParamError::Holes {
+            loops: loops.len(),
+            face: f,
+            line: line(f),
+        });
+    }
+    let euler = nv as i64 - edge_uses.len() as i64 + tris.len() as i64;
+    if euler != 1 {
+        let f = faces[0];
+        return Err(ParamError::Handles {
+            euler,
+            face: f,
+            line: line(f),
+        });
+    }
+    let mut boundary = vec![false; nv];
+    for &v in &loops[0] {
+        boundary[v] = true;
+    }
+    Ok(Chart {
+        pos,
+        tris,
+        corners,
+        boundary,
+        boundary_loop: loops.swap_remove(0),
+        first: (faces[0], line(faces[0])),
+        nfaces: faces.len(),
+    })
+}
+
+/// The two pinned vertices (local ids): the farthest pair of boundary vertices (see the module
+/// doc for the rule).
+fn pins(chart: &Chart) -> [usize; 2] {
+    let b = &chart.boundary_loop;
+    let p = &chart.pos;
+    let farthest = |from: usize| -> usize {
+        let mut best = (f64::NEG_INFINITY, from);
+        for &v in b {
+            let d = p[v].distance_squared(p[from]);
+            if d > best.0 || (d == best.0 && v < best.1) {
+                best = (d, v);
+            }
+        }
+        best.1
+    };
+    if b.len() <= EXACT_PIN_LIMIT {
+        let mut sorted = b.clone();
+        sorted.sort_unstable();
+        let mut best = (f64::NEG_INFINITY, sorted[0], sorted[0]);
+        for (i, &u) in sorted.iter().enumerate() {
+            for &v in &sorted[i + 1..] {
+                let d = p[u].distance_squared(p[v]);
+                if d > best.0 {
+                    best = (d, u, v);
+                }
+            }
+        }
+        [best.1, best.2]
+    } else {
+        let start = *b.iter().min().unwrap_or(&0);
+        let a = farthest(start);
+        let c = farthest(a);
+        [a.min(c), a.max(c)]
+    }
+}
+
+/// Shape of each triangle in its own plane: corner 0 at the origin, corner 1 on +x.
+fn shapes_from_3d(chart: &Chart) -> Vec<[DVec2; 3]> {
+    chart
+        .tris
+        .iter()
+        .map(|t| {
+            let (a, b, c) = (chart.pos[t[0]], chart.pos[t[1]], chart.pos[t[2]]);
+            let e1 = b - a;
+            let e2 = c - a;
+            let l1 = e1.length();
+            let x = e1 / l1;
+            let cx = e2.dot(x);
+            let cy = x.cross(e2).length();
+            [DVec2::ZERO, DVec2::new(l1, 0.0), DVec2::new(cx, cy)]
+        })
+        .collect()
+}
+
+/// Shape of a triangle from its angles (law of sines), unit-free.
+fn shape_from_angles(a: [f64; 3]) -> [DVec2; 3] {
+    [
+        DVec2::ZERO,
+        DVec2::new(a[2].sin(), 0.0),
+        DVec2::new(a[0].cos(), a[0].sin()) * a[1].sin(),
+    ]
+}
+
+/// Solve a symmetric positive definite system given by its lower-triangle triplets.
+fn spd_solve(
+    chart: &Chart,
+    method: &'static str,
+    n: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+    rhs: &[f64],
+) -> Result<Vec<f64>, ParamError> {
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, triplets).map_err(|e| {
+        chart.solver_error(method, format!("cannot build the sparse system: {e:?}"))
+    })?;
+    let llt = a
+        .sp_cholesky(Side::Lower)
+        .map_err(|e| chart.solver_error(method, format!("the system is singular ({e:?})")))?;
+    let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
+    let x = llt.solve(&b);
+    let out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err(chart.solver_error(method, "the solve gave non-finite values"));
+    }
+    Ok(out)
+}
+
+/// LSCM with the given triangle shapes and two pins; returns a position per local vertex.
+fn lscm_solve(
+    chart: &Chart,
+    method: &'static str,
+    shapes: &[[DVec2; 3]],
+    pin: [usize; 2],
+    pin_pos: [DVec2; 2],
+) -> Result<Vec<DVec2>, ParamError> {
+    let nv = chart.pos.len();
+    // Free vertex k has unknowns u = 2k, v = 2k + 1.
+    let mut var: Vec<Option<usize>> = vec![None; nv];
+    let mut k = 0;
+    for (v, slot) in var.iter_mut().enumerate() {
+        if v != pin[0] && v != pin[1] {
+            *slot = Some(k);
+            k += 1;
+        }
+    }
+    let n = 2 * k;
+    let fixed = |v: usize| -> DVec2 {
+        if v == pin[0] {
+            pin_pos[0]
+        } else {
+            pin_pos[1]
+        }
+    };
+    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(chart.tris.len() * 21);
+    let mut rhs = vec![0.0; n];
+    for (t, tri) in chart.tris.iter().enumerate() {
+        let s = shapes[t];
+        let d = (s[1] - s[0]).perp_dot(s[2] - s[0]);
+        if !(d > 0.0 && d.is_finite()) {
+            return Err(chart.solver_error(method, "a triangle shape has no area"));
+        }
+        let w = 1.0 / d.sqrt();
+        // Rows (real, imaginary) over the 6 unknowns (u_j, v_j): entries (var or pinned value).
+        let mut rows = [[0.0f64; 6]; 2];
+        for j in 0..3 {
+            let wj = (s[(j + 2) % 3] - s[(j + 1) % 3]) * w;
+            rows[0][2 * j] = wj.x;
+            rows[0][2 * j + 1] = -wj.y;
+            rows[1][2 * j] = wj.y;
+            rows[1][2 * j + 1] = wj.x;
+        }
+        // Local 6x6 block of AᵀA over free unknowns and the pinned part of each row.
+        let idx: [Option<usize>; 6] =
+            std::array::from_fn(|i| var[tri[i / 2]].map(|kk| 2 * kk + i % 2));
+        for row in &rows {
+            let mut pinned = 0.0;
+            for j in 0..3 {
+                if var[tri[j]].is_none() {
+                    let p = fixed(tri[j]);
+                    pinned += row[2 * j] * p.x + row[2 * j + 1] * p.y;
+                }
+            }
+            for i in 0..6 {
+                let Some(ri) = idx[i] else { continue };
+                rhs[ri] -= row[i] * pinned;
+            }
+        }
+        for i in 0..6 {
+            let Some(ri) = idx[i] else { continue };
+            for j in 0..6 {
+                let Some(cj) = idx[j] else { continue };
+                if ri >= cj {
+                    let v = rows[0][i] * rows[0][j] + rows[1][i] * rows[1][j];
+                    if v != 0.0 {
+                        triplets.push(Triplet::new(ri, cj, v));
+                    }
+                }
+            }
+        }
+    }
+    let x = spd_solve(chart, method, n, &triplets, &rhs)?;
+    Ok((0..nv)
+        .map(|v| match var[v] {
+            Some(kk) => DVec2::new(x[2 * kk], x[2 * kk + 1]),
+            None => fixed(v),
+        })
+        .collect())
+}
+
+/// ABF++: optimal angles per triangle.
+fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
+    const M: &str = "ABF++";
+    let nt = chart.tris.len();
+    let nv = chart.pos.len();
+    // 3D angles and targets.
+    let mut phi = vec![[0.0f64; 3]; nt];
+    let mut sum = vec![0.0f64; nv];
+    for (t, tri) in chart.tris.iter().enumerate() {
+        let p = tri.map(|v| chart.pos[v]);
+        for c in 0..3 {
+            phi[t][c] = corner_angle(p[c], p[(c + 1) % 3], p[(c + 2) % 3]);
+            sum[tri[c]] += phi[t][c];
+        }
+    }
+    // Interior vertex -> row pair (V = 2i, L = 2i + 1).
+    let mut row: Vec<Option<usize>> = vec![None; nv];
+    let mut ni = 0;
+    for v in 0..nv {
+        if !chart.boundary[v] {
+            row[v] = Some(ni);
+            ni += 1;
+        }
+    }
+    let mut beta = phi.clone();
+    for (t, tri) in chart.tris.iter().enumerate() {
+        for c in 0..3 {
+            if row[tri[c]].is_some() {
+                beta[t][c] *= 2.0 * PI / sum[tri[c]];
+            }
+        }
+    }
+    let lam_diag: Vec<[f64; 3]> = beta.iter().map(|b| b.map(|x| 2.0 / (x * x))).collect();
+    let mut alpha = beta.clone();
+    let mut lam_t = vec![0.0f64; nt];
+    let mut lam2 = vec![0.0f64; 2 * ni];
+    let m2 = 2 * ni;
+    let mut converged = false;
+    for _iter in 0..ABF_MAX_ITER {
+        // Gradient of the Lagrangian and constraint values.
+        let mut c2 = vec![0.0f64; m2];
+        for i in 0..ni {
+            c2[2 * i] = -2.0 * PI;
+        }
+        let mut b1 = vec![[0.0f64; 3]; nt];
+        let mut c1 = vec![0.0f64; nt];
+        let mut cot = vec![[0.0f64; 3]; nt];
+        for (t, tri) in chart.tris.iter().enumerate() {
+            c1[t] = alpha[t][0] + alpha[t][1] + alpha[t][2] - PI;
+            for c in 0..3 {
+                let a = alpha[t][c];
+                cot[t][c] = a.cos() / a.sin();
+                let mut g = lam_diag[t][c] * (a - beta[t][c]) + lam_t[t];
+                if let Some(r) = row[tri[c]] {
+                    g += lam2[2 * r];
+                    c2[2 * r] += a;
+                }
+                // This corner is "next" for the vertex at corner c+2, "prev" for c+1.
+                if let Some(r) = row[tri[(c + 2) % 3]] {
+                    g += lam2[2 * r + 1] * cot[t][c];
+                    c2[2 * r + 1] += a.sin().ln();
+                }
+                if let Some(r) = row[tri[(c + 1) % 3]] {
+                    g -= lam2[2 * r + 1] * cot[t][c];
+                    c2[2 * r + 1] -= a.sin().ln();
+                }
+                b1[t][c] = g;
+            }
+        }
+        let norm = b1
+            .iter()
+            .flat_map(|b| b.iter())
+            .chain(c1.iter())
+            .chain(c2.iter())
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt();
+        if !norm.is_finite() {
+            return Err(chart.solver_error(M, "the Newton iteration diverged"));
+        }
+        if norm < ABF_TOLERANCE * (nt as f64).sqrt().max(1.0) {
+            converged = true;
+            break;
+        }
+        // Reduced system over the vertex and wheel multipliers.
+        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(nt * 21);
+        let mut rhs = c2.clone();
+        let mut local_b = vec![[0.0f64; 6]; nt];
+        let mut local_r1 = vec![0.0f64; nt];
+        let mut local_d = vec![0.0f64; nt];
+        // Local slots: 2k = V row of corner k's vertex, 2k + 1 = its L row.
+        let jac = |t: usize, c: usize| -> [f64; 6] {
+            let tri = chart.tris[t];
+            let mut j = [0.0; 6];
+            if row[tri[c]].is_some() {
+                j[2 * c] = 1.0;
+            }
+            let cn = (c + 2) % 3;
+            if row[tri[cn]].is_some() {
+                j[2 * cn + 1] += cot[t][c];
+            }
+            let cp = (c + 1) % 3;
+            if row[tri[cp]].is_some() {
+                j[2 * cp + 1] -= cot[t][c];
+            }
+            j
+        };
+        for (t, tri) in chart.tris.iter().enumerate() {
+            let js = [jac(t, 0), jac(t, 1), jac(t, 2)];
+            let inv = lam_diag[t].map(|x| 1.0 / x);
+            let d = inv[0] + inv[1] + inv[2];
+            let mut bt = [0.0f64; 6];
+            let mut jb = [0.0f64; 6];
+            let mut r1 = c1[t];
+            for c in 0..3 {
+                r1 -= b1[t][c] * inv[c];
+                for s in 0..6 {
+                    bt[s] += js[c][s] * inv[c];
+                    jb[s] += js[c][s] * b1[t][c] * inv[c];
+                }
+            }
+            let slot_row = |s: usize| row[tri[s / 2]].map(|r| 2 * r + s % 2);
+            for s in 0..6 {
+                let Some(rs) = slot_row(s) else { continue };
+                rhs[rs] -= jb[s] + bt[s] * r1 / d;
+                for q in 0..6 {
+                    let Some(rq) = slot_row(q) else { continue };
+                    if rs < rq {
+                        continue;
+                    }
+                    let mut v = -bt[s] * bt[q] / d;
+                    for c in 0..3 {
+                        v += js[c][s] * js[c][q] * inv[c];
+                    }
+                    if v != 0.0 {
+                        triplets.push(Triplet::new(rs, rq, v));
+                    }
+                }
+            }
+            local_b[t] = bt;
+            local_r1[t] = r1;
+            local_d[t] = d;
+        }
+        let x = spd_solve(chart, M, m2, &triplets, &rhs)?;
+        for (t, tri) in chart.tris.iter().enumerate() {
+            let xl: [f64; 6] =
+                std::array::from_fn(|s| row[tri[s / 2]].map(|r| x[2 * r + s % 2]).unwrap_or(0.0));
+            let bx: f64 = (0..6).map(|s| local_b[t][s] * xl[s]).sum();
+            let dl1 = (local_r1[t] - bx) / local_d[t];
+            lam_t[t] += dl1;
+            for c in 0..3 {
+                let j = jac(t, c);
+                let jx: f64 = (0..6).map(|s| j[s] * xl[s]).sum();
+                let da = -(b1[t][c] + dl1 + jx) / lam_diag[t][c];
+                alpha[t][c] += da;
+                if !(alpha[t][c] > 0.0 && alpha[t][c] < PI) {
+                    return Err(chart.solver_error(M, "an angle left (0, π)"));
+                }
+            }
+        }
+        for (l, dx) in lam2.iter_mut().zip(&x) {
+            *l += dx;
+        }
+    }
+    if !converged {
+        return Err(chart.solver_error(M, format!("no convergence in {ABF_MAX_ITER} Newton steps")));
+    }
+    Ok(alpha)
+}
+
+/// Scale to the 3D area, make counter-clockwise, move to the origin; per chart face corners.
+fn finish(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    method: ParamMethod,
+    mut uv: Vec<DVec2>,
+) -> ChartParam {
+    let mut a2 = 0.0;
+    let mut a3 = 0.0;
+    for t in &chart.tris {
+        let p = t.map(|v| uv[v]);
+        a2 += 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        let q = t.map(|v| chart.pos[v]);
+        a3 += 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).length();
+    }
+    if a2 < 0.0 {
+        for p in &mut uv {
+            p.x = -p.x;
+        }
+    }
+    let k = if a2 != 0.0 && a2.is_finite() {
+        (a3 / a2.abs()).sqrt()
+    } else {
+        1.0
+    };
+    let mut lo = DVec2::splat(f64::INFINITY);
+    for p in &mut uv {
+        *p *= k;
+        lo = lo.min(*p);
+    }
+    for p in &mut uv {
+        *p -= lo;
+    }
+    let face_uv: Vec<Vec<DVec2>> = chart
+        .corners
+        .iter()
+        .map(|cs| cs.iter().map(|&v| uv[v]).collect())
+        .collect();
+    let stretch = distortion::stretch(mesh, faces, &face_uv);
+    ChartParam {
+        faces: faces.to_vec(),
+        uv: face_uv,
+        method,
+        stretch,
+    }
+}
+
+fn run_lscm(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    pin: [usize; 2],
+) -> Result<ChartParam, ParamError> {
+    let d = chart.pos[pin[0]].distance(chart.pos[pin[1]]);
+    let uv = lscm_solve(
+        chart,
+        "LSCM",
+        &shapes_from_3d(chart),
+        pin,
+        [DVec2::ZERO, DVec2::new(d, 0.0)],
+    )?;
+    Ok(finish(mesh, faces, chart, ParamMethod::Lscm, uv))
+}
+
+fn run_abf(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    pin: [usize; 2],
+) -> Result<ChartParam, ParamError> {
+    let angles = abf_angles(chart)?;
+    let shapes: Vec<[DVec2; 3]> = angles.iter().map(|a| shape_from_angles(*a)).collect();
+    let d = chart.pos[pin[0]].distance(chart.pos[pin[1]]);
+    let uv = lscm_solve(
+        chart,
+        "ABF++ (angles to coordinates)",
+        &shapes,
+        pin,
+        [DVec2::ZERO, DVec2::new(d, 0.0)],
+    )?;
+    Ok(finish(mesh, faces, chart, ParamMethod::Abf, uv))
+}
+
+/// Flatten one disk-topology chart (mesh face indices) with the given method. See the module
+/// doc for what is refused and how `Best` chooses.
+pub fn parameterize(
+    mesh: &Mesh,
+    faces: &[usize],
+    method: ParamMethod,
+) -> Result<ChartParam, ParamError> {
+    let chart = build_chart(mesh, faces)?;
+    let pin = pins(&chart);
+    match method {
+        ParamMethod::Lscm => run_lscm(mesh, faces, &chart, pin),
+        ParamMethod::Abf => run_abf(mesh, faces, &chart, pin),
+        ParamMethod::Best => {
+            let l = run_lscm(mesh, faces, &chart, pin);
+            let a = run_abf(mesh, faces, &chart, pin);
+            match (l, a) {
+                (Ok(l), Ok(a)) => {
+                    let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
+                    if key(&a) < key(&l) {
+                        Ok(a)
+                    } else {
+                        Ok(l)
+                    }
+                }
+                (Ok(l), Err(_)) => Ok(l),
+                (Err(_), Ok(a)) => Ok(a),
+                (Err(e), Err(_)) => Err(e),
+            }
+        }
+    }
+}
