@@ -11,6 +11,8 @@
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
 //! name = "box"             # optional; default: the mesh file stem
+//! segment = "dcharts"      # optional: "faces" | "dcharts" (smooth meshes, issue 7); see
+//!                          # `SegmentSpec` for this and `charts`, `f_max`, `approximate`
 //!
 //! [material]               # optional table
 //! kind = "paper"           # "paper" | "fabric" | "metal"; default paper

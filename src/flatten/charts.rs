@@ -137,6 +137,10 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         };
         let p = match laid {
             Ok(p) => p,
+            // A sliver triangle cannot be laid flat in any chart: say which.
+            Err(param::ParamError::Degenerate { face, .. }) => {
+                return Err(degenerate(face.min(nf - 1)))
+            }
             Err(_) => {
                 if faces.len() == 1 || !split_it(&mut todo, &faces, splits) {
                     return Err(degenerate(faces[0]));
@@ -153,14 +157,16 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         }
         // Counter-clockwise, as the pattern stage expects.
         let total: f64 = uv.iter().map(|c| polygon::signed_area(c)).sum();
-        if total < 0.0 {
+        let stretch = if total < 0.0 {
             for c in uv.iter_mut() {
                 for q in c.iter_mut() {
                     q.x = -q.x;
                 }
             }
-        }
-        let stretch = distortion::stretch(mesh, &faces, &uv);
+            distortion::stretch(mesh, &faces, &uv)
+        } else {
+            p.stretch
+        };
         let flipped = uv.iter().any(|c| polygon::signed_area(c) <= 0.0);
         let bad_shape = faces.len() > 1 && (flipped || self_overlap(&faces, &uv));
         if bad_shape && split_it(&mut todo, &faces, splits) {
