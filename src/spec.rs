@@ -1195,7 +1195,11 @@ impl Ctx<'_> {
         })
     }
 
-    fn approximate(&self, v: &Spanned<toml::Value>, key: &str) -> Result<ApproximateSpec, SpecError> {
+    fn approximate(
+        &self,
+        v: &Spanned<toml::Value>,
+        key: &str,
+    ) -> Result<ApproximateSpec, SpecError> {
         let line = self.line(v.span());
         let bad = |k: &str, m: &str| self.invalid(line, k, m.to_string());
         let toml::Value::Table(t) = v.get_ref() else {

@@ -161,7 +161,12 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
         };
         let flat = crate::flatten::charts::flatten(surface, &opts)?;
         if !quiet && flat.surface.charts.is_some() {
-            for w in flat.surface.warnings.iter().filter(|w| w.contains("stretches by")) {
+            for w in flat
+                .surface
+                .warnings
+                .iter()
+                .filter(|w| w.contains("stretches by"))
+            {
                 eprintln!("flatcut: warning: {w}");
             }
         }

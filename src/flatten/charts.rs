@@ -9,9 +9,14 @@
 //! `dihedral` the signed bend of every interior edge, as [`super::unfold`] computes it.
 //!
 //! After the thesis' §5.3 ("overlaps cut away", "a piece over the material's tolerance"), a
-//! chart is split in two ([`crate::surface::dcharts::bisect`], along the bisector of its two
-//! most distant faces) and both halves laid flat again when
-//! - its layout overlaps itself (a global overlap, or a gusset folding over),
+//! chart is split in two and both halves laid flat again when
+//! - its layout overlaps itself deeper than the unfolder's tolerance (a global overlap, or a
+//!   gusset folding over): split between the two overlapping faces
+//!   ([`crate::surface::dcharts::split_between`]: each face goes with the nearer of the two,
+//!   through the chart), so the overlapping parts end up in different pieces;
+//!
+//! and along the bisector of its two most distant faces ([`crate::surface::dcharts::bisect`])
+//! when
 //! - it has a flipped triangle,
 //! - the parameteriser refuses it (not a disk),
 //! - or its L2 stretch is over [`FlattenOptions::tolerance`] — at most
@@ -31,7 +36,7 @@ use super::{unfold, Flat, FlattenError, UnfoldOptions};
 use crate::geom::mesh::Topology;
 use crate::geom::polygon;
 use crate::spec::MaterialKind;
-use crate::surface::dcharts::{bisect, Graph};
+use crate::surface::dcharts::{bisect, split_between, Graph};
 use crate::surface::Surface;
 use glam::DVec2;
 
@@ -118,6 +123,14 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         .collect();
     todo.reverse();
     let mut done: Vec<Laid> = Vec::new();
+    // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
+    let mean_edge = topology
+        .edges
+        .iter()
+        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
+        .sum::<f64>()
+        / topology.edges.len().max(1) as f64;
+    let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge);
     let mut over: Vec<(usize, f64)> = Vec::new();
     let degenerate = |f: usize| FlattenError::Degenerate {
         surface: surface.name.clone(),
@@ -167,10 +180,19 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         } else {
             p.stretch
         };
-        let flipped = uv.iter().any(|c| polygon::signed_area(c) <= 0.0);
-        let bad_shape = faces.len() > 1 && (flipped || self_overlap(&faces, &uv));
-        if bad_shape && split_it(&mut todo, &faces, splits) {
-            continue;
+        if faces.len() > 1 {
+            // Overlapping parts go to different pieces: split between the two faces.
+            if let Some((x, y)) = self_overlap(&uv, overlap_eps) {
+                let (a, b) = split_between(&graph, &faces, faces[x], faces[y]);
+                if !a.is_empty() && !b.is_empty() {
+                    todo.push((b, splits));
+                    todo.push((a, splits));
+                    continue;
+                }
+            }
+            if stretch.flipped > 0 && split_it(&mut todo, &faces, splits) {
+                continue;
+            }
         }
         if stretch.l2 > opts.tolerance
             && splits < opts.max_splits
@@ -277,21 +299,15 @@ fn bend(mesh: &crate::geom::mesh::Mesh, f: usize, i: usize, g: usize) -> f64 {
     }
 }
 
-/// Whether two faces of one chart's layout overlap (interiors, beyond rounding): a sweep over
-/// x of the triangles' boxes.
-fn self_overlap(faces: &[usize], uv: &[Vec<DVec2>]) -> bool {
+/// Two faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`, if
+/// any: a sweep over x of the triangles' boxes.
+fn self_overlap(uv: &[Vec<DVec2>], eps: f64) -> Option<(usize, usize)> {
     let mut tris: Vec<([DVec2; 3], usize)> = Vec::new();
-    let mut scale: f64 = 0.0;
     for (k, c) in uv.iter().enumerate() {
         for t in polygon::triangulate(c) {
             tris.push(([c[t[0]], c[t[1]], c[t[2]]], k));
         }
-        for q in c {
-            scale = scale.max(q.abs().max_element());
-        }
     }
-    let _ = faces;
-    let eps = 1e-9 * scale.max(1e-300);
     let mut boxes: Vec<(f64, f64, usize)> = tris
         .iter()
         .enumerate()
@@ -309,9 +325,9 @@ fn self_overlap(faces: &[usize], uv: &[Vec<DVec2>]) -> bool {
                 continue;
             }
             if polygon::triangles_overlap(&tris[i].0, &tris[j].0, eps) {
-                return true;
+                return Some((tris[i].1, tris[j].1));
             }
         }
     }
-    false
+    None
 }

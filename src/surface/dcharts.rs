@@ -273,7 +273,13 @@ impl Segmenter<'_> {
     }
 
     /// Grow `charts` over unassigned faces where `allowed` holds, bounded by `bound` on F.
-    fn grow(&self, st: &mut State, charts: &[usize], allowed: &dyn Fn(usize) -> bool, bound: Option<f64>) {
+    fn grow(
+        &self,
+        st: &mut State,
+        charts: &[usize],
+        allowed: &dyn Fn(usize) -> bool,
+        bound: Option<f64>,
+    ) {
         let nc = st.proxies.len();
         let mut slot = vec![NONE; nc];
         for (k, &c) in charts.iter().enumerate() {
@@ -304,10 +310,7 @@ impl Segmenter<'_> {
         loop {
             let mut best: Option<(f64, usize)> = None;
             for (k, &c) in charts.iter().enumerate() {
-                while heaps[k]
-                    .peek()
-                    .is_some_and(|e| st.assign[e.face] != NONE)
-                {
+                while heaps[k].peek().is_some_and(|e| st.assign[e.face] != NONE) {
                     heaps[k].pop();
                 }
                 if let Some(e) = heaps[k].peek() {
@@ -474,9 +477,9 @@ pub fn is_disk(mesh: &Mesh, topo: &Topology, g: &Graph, faces: &[usize]) -> bool
     edges.dedup();
     // A non-manifold edge inside the chart, or a vertex whose faces in the chart do not form
     // one fan, also keeps it from being a disk.
-    let nonmanifold = edges.iter().any(|&e| {
-        topo.edges[e].uses.iter().filter(|u| inside[u.0]).count() > 2
-    });
+    let nonmanifold = edges
+        .iter()
+        .any(|&e| topo.edges[e].uses.iter().filter(|u| inside[u.0]).count() > 2);
     if nonmanifold {
         return false;
     }
@@ -529,8 +532,31 @@ pub fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
     faces.iter().partition(|&&f| da[f] <= db[f])
 }
 
+/// Split faces in two by which of faces `a` and `b` is nearer through the face graph restricted
+/// to `faces` (used to separate two faces whose layouts overlap). Each part is connected when
+/// `faces` is.
+pub fn split_between(g: &Graph, faces: &[usize], a: usize, b: usize) -> (Vec<usize>, Vec<usize>) {
+    let nf = g.area.len();
+    let mut inside = vec![false; nf];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let within = |f: usize| inside[f];
+    let da = g.distances(&[a], &within);
+    let db = g.distances(&[b], &within);
+    faces
+        .iter()
+        .partition(|&&f| da[f] < db[f] || (da[f] == db[f] && da[f].is_finite() && f < b))
+}
+
 /// Split every chart that is not a disk until all are; returns the number of splits.
-fn make_disks(mesh: &Mesh, topo: &Topology, g: &Graph, chart: &mut [usize], count: &mut usize) -> usize {
+fn make_disks(
+    mesh: &Mesh,
+    topo: &Topology,
+    g: &Graph,
+    chart: &mut [usize],
+    count: &mut usize,
+) -> usize {
     let mut splits = 0;
     let mut queue: Vec<usize> = (0..*count).collect();
     // Each split makes a smaller chart; single faces are disks, so this ends.
@@ -742,8 +768,7 @@ fn merge(
     let mut rejected: std::collections::HashSet<(usize, usize)> = Default::default();
     loop {
         // Boundary faces of each adjacent pair.
-        let mut pairs: std::collections::BTreeMap<(usize, usize), Vec<usize>> =
-            Default::default();
+        let mut pairs: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
         for f in 0..nf {
             for &(u, _) in &g.adj[f] {
                 let (a, b) = (chart[f], chart[u]);
@@ -790,7 +815,9 @@ fn merge(
             }
         }
         let Some((_, (a, b))) = best else { break };
-        let faces: Vec<usize> = (0..nf).filter(|&f| chart[f] == a || chart[f] == b).collect();
+        let faces: Vec<usize> = (0..nf)
+            .filter(|&f| chart[f] == a || chart[f] == b)
+            .collect();
         if !is_disk(mesh, topo, g, &faces) {
             rejected.insert((a, b));
             continue;

@@ -26,7 +26,8 @@
 //! For every triangle: the faces within [`ApproximateOptions::rings`] vertex rings are fitted
 //! (planar test first: if the plane fits with mean error below
 //! [`ApproximateOptions::planar_error`], the plane is used; else eq. 6.1 under `|cos θ| ≤ 0.5`,
-//! so no cone apex lands on the surface); the face normal is turned onto the proxy's cone
+//! so no cone apex lands on the surface, unless the plane still fits better than that bounded
+//! DCS — as on a sphere, whose small patches no cone of half-angle ≥ 60° follows); the face normal is turned onto the proxy's cone
 //! (the nearest direction with `n·N = c`), and the triangle is moved onto the plane with that
 //! normal closest to its vertices (eq. 6.2: each vertex projected onto the plane through their
 //! mean; with fixed vertices, through the mean of the fixed ones, which stay where they are).
@@ -187,15 +188,25 @@ pub fn fit_with_cos(mo: &Moments, c: f64) -> Option<Proxy> {
             })
             .sum()
     };
-    let axis = if coef[0].abs() <= 1e-12 * mo.w.max(1e-300) {
-        // Hard case (or c = 0): the smallest eigenvector minimises Nᵀ M N.
-        let mut a = e[0];
-        if a.dot(mo.b) * c < 0.0 {
+    // |N(λ)| grows as λ rises to μ₀; in the "hard case" (b has no part along the smallest
+    // eigenvector e₀, e.g. c = 0, or a symmetric patch) it stays finite, and when it stays
+    // below 1 the minimiser is N(μ₀) completed by e₀ to unit length.
+    let small = coef[0].abs() <= 1e-12 * (mo.w + rhs.length()).max(1e-300);
+    let rest = (1..3).fold(DVec3::ZERO, |acc, i| {
+        let d = mu[i] - mu[0];
+        if d > 1e-12 * mu[2].abs().max(1e-300) {
+            acc + e[i] * (coef[i] / d)
+        } else {
+            acc
+        }
+    });
+    let axis = if small && rest.length_squared() < 1.0 {
+        let mut a = rest + e[0] * (1.0 - rest.length_squared()).max(0.0).sqrt();
+        if c == 0.0 && a.dot(mo.b) < 0.0 {
             a = -a;
         }
-        a
+        a.try_normalize()?
     } else {
-        // |N(λ)| grows from 0 to ∞ as λ rises to μ₀; bisect for 1.
         let mut hi = mu[0];
         let mut lo = mu[0] - rhs.length() - 1.0;
         while norm2(lo) > 1.0 {
@@ -213,7 +224,14 @@ pub fn fit_with_cos(mo: &Moments, c: f64) -> Option<Proxy> {
             }
         }
         let lam = lo;
-        let v = (0..3).fold(DVec3::ZERO, |acc, i| acc + e[i] * (coef[i] / (mu[i] - lam)));
+        let v = (0..3).fold(DVec3::ZERO, |acc, i| {
+            let d = mu[i] - lam;
+            if d.abs() < 1e-300 {
+                acc
+            } else {
+                acc + e[i] * (coef[i] / d)
+            }
+        });
         v.try_normalize()?
     };
     Some(Proxy { axis, cos: c })
@@ -233,14 +251,22 @@ pub fn mean_error(p: &Proxy, mo: &Moments) -> f64 {
 /// The DCS fit of eq. 6.1 with `|cos θ| ≤ 0.5`, after the planar test.
 pub fn fit_local(mo: &Moments, planar_error: f64) -> Option<Proxy> {
     let plane = fit_with_cos(mo, 1.0)?;
-    if mean_error(&plane, mo) <= planar_error {
+    let plane_err = mean_error(&plane, mo);
+    if plane_err <= planar_error {
         return Some(plane);
     }
     let free = fit(mo)?;
-    if free.cos <= 0.5 {
-        return Some(free);
+    let dcs = if free.cos <= 0.5 {
+        free
+    } else {
+        fit_with_cos(mo, 0.5)?
+    };
+    // The plane is a developable too: keep whichever fits better.
+    if plane_err <= mean_error(&dcs, mo) {
+        Some(plane)
+    } else {
+        Some(dcs)
     }
-    fit_with_cos(mo, 0.5)
 }
 
 /// Settings of the DCS approximation.
@@ -448,7 +474,9 @@ fn glue(
     };
     for (f, t, m, a) in targets {
         let v = &mesh.faces[*f].verts;
-        let s = ((t[1] - t[0]).cross(t[2] - t[0]).length()).sqrt().max(1e-300);
+        let s = ((t[1] - t[0]).cross(t[2] - t[0]).length())
+            .sqrt()
+            .max(1e-300);
         let t4 = t[0] + *m * s;
         let frame = DMat3::from_cols(t4 - t[0], t4 - t[1], t4 - t[2]);
         if frame.determinant().abs() < 1e-300 || !frame.determinant().is_finite() {
@@ -619,6 +647,34 @@ mod tests {
             };
             assert!(mean_error(&r, &mo) >= e - 1e-12);
         }
+    }
+
+    #[test]
+    fn symmetric_patch_plane_fit_is_its_mean_normal() {
+        // Normals spread evenly around z: b lies along z, the smallest eigenvectors across.
+        let mut mo = Moments::default();
+        mo.add(DVec3::Z, 1.0);
+        for k in 0..6 {
+            let t = k as f64 * std::f64::consts::PI / 3.0;
+            mo.add(
+                DVec3::new(0.1 * t.cos(), 0.1 * t.sin(), 1.0).normalize(),
+                1.0,
+            );
+        }
+        let p = fit_with_cos(&mo, 1.0).unwrap();
+        assert!((p.axis - DVec3::Z).length() < 1e-9, "{p:?}");
+        let q = fit_with_cos(&mo, 0.5).unwrap();
+        assert!((q.axis.length() - 1.0).abs() < 1e-12);
+        assert!(
+            mean_error(&q, &mo)
+                < mean_error(
+                    &Proxy {
+                        axis: DVec3::X,
+                        cos: 0.5
+                    },
+                    &mo
+                )
+        );
     }
 
     #[test]
