@@ -26,11 +26,11 @@
 //! For every triangle: the faces within [`ApproximateOptions::rings`] vertex rings are fitted
 //! (planar test first: if the plane fits with mean error below
 //! [`ApproximateOptions::planar_error`], the plane is used; else eq. 6.1 under `|cos θ| ≤ 0.5`,
-//! so no cone apex lands on the surface, unless the plane still fits better than that bounded
-//! DCS — as on a sphere, whose small patches no cone of half-angle ≥ 60° follows); the face normal is turned onto the proxy's cone
+//! so no cone apex lands on the surface); the face normal is turned onto the proxy's cone
 //! (the nearest direction with `n·N = c`), and the triangle is moved onto the plane with that
 //! normal closest to its vertices (eq. 6.2: each vertex projected onto the plane through their
-//! mean; with fixed vertices, through the mean of the fixed ones, which stay where they are).
+//! mean; fixed vertices leave the sum and stay where they are, the plane goes through the mean
+//! of the free ones).
 //! Gluing (eq. 6.3) minimises `Σ_j A_j ‖Ṽ_j V_j⁻¹ − I‖²_F` over the new vertex positions, one
 //! sparse least-squares problem per coordinate solved by conjugate gradients on the normal
 //! equations. Choices where the thesis is silent: the fourth frame point `ṽ4 = ṽ1 + s·m_j`
@@ -261,12 +261,8 @@ pub fn fit_local(mo: &Moments, planar_error: f64) -> Option<Proxy> {
     } else {
         fit_with_cos(mo, 0.5)?
     };
-    // The plane is a developable too: keep whichever fits better.
-    if plane_err <= mean_error(&dcs, mo) {
-        Some(plane)
-    } else {
-        Some(dcs)
-    }
+    let _ = plane_err;
+    Some(dcs)
 }
 
 /// Settings of the DCS approximation.
@@ -406,12 +402,13 @@ pub fn approximate(
                 axis * proxy.cos + side * (1.0 - proxy.cos * proxy.cos).max(0.0).sqrt()
             };
             // Eq. 6.2: the plane with normal m closest to the free vertices.
-            let fixed_here: Vec<usize> = (0..3).filter(|&i| fixed[v[i]]).collect();
-            let d = if fixed_here.is_empty() {
-                p0.iter().map(|p| p.dot(m)).sum::<f64>() / 3.0
-            } else {
-                fixed_here.iter().map(|&i| p0[i].dot(m)).sum::<f64>() / fixed_here.len() as f64
-            };
+            // Fixed vertices leave the minimisation (thesis §6.2.2): the plane goes through
+            // the free ones' mean.
+            let free_here: Vec<usize> = (0..3).filter(|&i| !fixed[v[i]]).collect();
+            if free_here.is_empty() {
+                continue;
+            }
+            let d = free_here.iter().map(|&i| p0[i].dot(m)).sum::<f64>() / free_here.len() as f64;
             let mut t = p0;
             for i in 0..3 {
                 if !fixed[v[i]] {
