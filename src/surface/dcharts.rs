@@ -354,8 +354,8 @@ impl Segmenter<'_> {
                 faces[c].push(f);
             }
         }
-        for c in 0..nc {
-            if let Some(s) = self.best_seed(&st.proxies[c], &faces[c]) {
+        for (c, fs) in faces.iter().enumerate() {
+            if let Some(s) = self.best_seed(&st.proxies[c], fs) {
                 st.seeds[c] = s;
             }
         }

@@ -65,6 +65,7 @@ impl Proxy {
 }
 
 /// Eigenvalues (ascending) and unit eigenvectors of a symmetric 3×3 matrix (Jacobi).
+#[allow(clippy::needless_range_loop)] // rows and columns of the same small matrix
 pub fn eigen_sym(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
     let mut a = m.to_cols_array_2d();
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -529,7 +530,7 @@ fn glue(
             }
         }
     }
-    trip.sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    trip.sort_unstable_by_key(|t| (t.0, t.1));
     let mut start = vec![0usize; nfree + 1];
     let mut cols: Vec<usize> = Vec::new();
     let mut vals: Vec<f64> = Vec::new();
