@@ -11,6 +11,8 @@
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
 //! name = "box"             # optional; default: the mesh file stem
+//! segment = "dcharts"      # optional: "faces" | "dcharts" (smooth meshes, issue 7); see
+//!                          # `SegmentSpec` for this and `charts`, `f_max`, `approximate`
 //!
 //! [material]               # optional table
 //! kind = "paper"           # "paper" | "fabric" | "metal"; default paper
@@ -172,6 +174,8 @@ pub struct SurfaceSpec {
     pub bent: Option<BentSpec>,
     /// The loops and settings of a [`SurfaceKind::Boundary`]; `None` for other kinds.
     pub boundary: Option<BoundarySpec>,
+    /// How a mesh is cut into pieces (issue 7); default: decided from the mesh.
+    pub segment: SegmentSpec,
 }
 
 /// A developable from a closed 3D boundary (`kind = "boundary"`, Rose et al.): the loops as
@@ -545,6 +549,7 @@ impl Spec {
                 strip: None,
                 bent: None,
                 boundary: None,
+                segment: SegmentSpec::default(),
             }],
             material: Material::default(),
             sheet: SheetSpec::default(),
@@ -631,6 +636,10 @@ struct RawSurface {
     smooth: Option<Spanned<Val>>,
     good_interior: Option<Spanned<Val>>,
     good_fairness: Option<Spanned<Val>>,
+    segment: Option<Spanned<Val>>,
+    charts: Option<Spanned<Val>>,
+    f_max: Option<Spanned<Val>>,
+    approximate: Option<Spanned<toml::Value>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -1102,6 +1111,7 @@ impl Ctx<'_> {
                         strip: None,
                         bent: None,
                         boundary: None,
+                        segment: self.segment(s, &key)?,
                     });
                 }
             }
@@ -1240,6 +1250,169 @@ impl Ctx<'_> {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Smooth meshes (issue 7): `segment`, `charts`, `f_max`, `approximate` on `kind = "mesh"`
+// ---------------------------------------------------------------------------------------------
+
+/// How a mesh surface is cut into pieces (`kind = "mesh"` keys, issue 7):
+///
+/// ```toml
+/// segment = "dcharts"      # "faces": exact polyhedral unfolding; "dcharts": nearly developable
+///                          # charts (default: dcharts when the mesh is smooth, see
+///                          # `surface::dcharts::is_smooth`)
+/// charts = 8               # initial estimate of the number of charts, integer >= 1
+/// f_max = 0.2              # D-Charts fitting threshold, > 0 and <= 1
+/// approximate = { iterations = 1, fixed = ["boundary", 12] }   # DCS approximation first;
+///                          # fixed: "boundary" and/or 1-based vertex numbers of the mesh
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SegmentSpec {
+    /// `None`: decided from the mesh.
+    pub mode: Option<Segment>,
+    pub charts: Option<usize>,
+    pub f_max: Option<f64>,
+    pub approximate: Option<ApproximateSpec>,
+}
+
+/// `segment = "faces" | "dcharts"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Segment {
+    /// Every face a rigid panel, unfolded exactly.
+    Faces,
+    /// D-Charts: nearly developable charts, parameterised.
+    Dcharts,
+}
+
+impl Segment {
+    const NAMES: [(&'static str, Segment); 2] =
+        [("faces", Segment::Faces), ("dcharts", Segment::Dcharts)];
+}
+
+impl FromStr for Segment {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        pick(s, &Self::NAMES)
+    }
+}
+
+/// `approximate = { iterations, fixed }`: DCS approximation before segmenting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ApproximateSpec {
+    /// Rounds (>= 1; default 1).
+    pub iterations: usize,
+    /// Vertices that stay in place.
+    pub fixed: Vec<Fixed>,
+}
+
+/// A fixed vertex (or set) of the DCS approximation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fixed {
+    /// Every vertex on the mesh boundary.
+    Boundary,
+    /// A vertex by its 1-based number in the (welded) mesh.
+    Vertex(usize),
+}
+
+impl Ctx<'_> {
+    /// The issue-7 keys of a mesh surface.
+    fn segment(&self, s: &RawSurface, key: &str) -> Result<SegmentSpec, SpecError> {
+        let mode = self.choice(&s.segment, &format!("{key}.segment"), &Segment::NAMES)?;
+        let charts = self
+            .number(
+                &s.charts,
+                &format!("{key}.charts"),
+                "a whole number of charts, at least 1",
+                |v| v >= 1.0 && v.fract() == 0.0 && v <= 1e6,
+            )?
+            .map(|(v, _)| v as usize);
+        let f_max = self
+            .number(
+                &s.f_max,
+                &format!("{key}.f_max"),
+                "a fitting threshold, more than 0 and at most 1",
+                |v| v > 0.0 && v <= 1.0,
+            )?
+            .map(|(v, _)| v);
+        let approximate = match &s.approximate {
+            None => None,
+            Some(v) => Some(self.approximate(v, &format!("{key}.approximate"))?),
+        };
+        Ok(SegmentSpec {
+            mode,
+            charts,
+            f_max,
+            approximate,
+        })
+    }
+
+    fn approximate(
+        &self,
+        v: &Spanned<toml::Value>,
+        key: &str,
+    ) -> Result<ApproximateSpec, SpecError> {
+        let line = self.line(v.span());
+        let bad = |k: &str, m: &str| self.invalid(line, k, m.to_string());
+        let toml::Value::Table(t) = v.get_ref() else {
+            return Err(bad(
+                key,
+                "must be a table { iterations = N, fixed = [...] }",
+            ));
+        };
+        let mut out = ApproximateSpec {
+            iterations: 1,
+            fixed: Vec::new(),
+        };
+        for (k, val) in t {
+            match k.as_str() {
+                "iterations" => {
+                    let n = match val {
+                        toml::Value::Integer(n) if (1..=100).contains(n) => *n as usize,
+                        _ => {
+                            return Err(bad(
+                                &format!("{key}.iterations"),
+                                &format!("must be a whole number from 1 to 100, got {val}"),
+                            ))
+                        }
+                    };
+                    out.iterations = n;
+                }
+                "fixed" => {
+                    let toml::Value::Array(items) = val else {
+                        return Err(bad(
+                            &format!("{key}.fixed"),
+                            "must be an array of \"boundary\" and 1-based vertex numbers",
+                        ));
+                    };
+                    for it in items {
+                        let f = match it {
+                            toml::Value::String(s) if s.trim().eq_ignore_ascii_case("boundary") => {
+                                Fixed::Boundary
+                            }
+                            toml::Value::Integer(n) if *n >= 1 => Fixed::Vertex(*n as usize),
+                            _ => {
+                                return Err(bad(
+                                    &format!("{key}.fixed"),
+                                    &format!(
+                                        "entries must be \"boundary\" or a vertex number from 1, got {it}"
+                                    ),
+                                ))
+                            }
+                        };
+                        out.fixed.push(f);
+                    }
+                }
+                other => {
+                    return Err(bad(
+                        &format!("{key}.{other}"),
+                        "unknown key; expected `iterations` or `fixed`",
+                    ))
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Strips (issue 4): `kind = "strip"` with curves `p` and `q`
 // ---------------------------------------------------------------------------------------------
 
@@ -1253,7 +1426,14 @@ impl Ctx<'_> {
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
         use crate::surface::strip::{BendLines, Method};
-        for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
+        for (k, v) in [
+            ("path", &s.path),
+            ("scale", &s.scale),
+            ("units", &s.units),
+            ("segment", &s.segment),
+            ("charts", &s.charts),
+            ("f_max", &s.f_max),
+        ] {
             if let Some(v) = v {
                 return Err(self.invalid(
                     self.line(v.span()),
@@ -1261,6 +1441,13 @@ impl Ctx<'_> {
                     "is for mesh surfaces; a strip takes the curves `p` and `q`".to_string(),
                 ));
             }
+        }
+        if let Some(v) = &s.approximate {
+            return Err(self.invalid(
+                self.line(v.span()),
+                &format!("{key}.approximate"),
+                "is for mesh surfaces; a strip takes the curves `p` and `q`".to_string(),
+            ));
         }
         let tolerance = self
             .number(
@@ -1352,6 +1539,7 @@ impl Ctx<'_> {
             }),
             bent: None,
             boundary: None,
+            segment: SegmentSpec::default(),
         })
     }
 
@@ -2001,6 +2189,7 @@ impl Ctx<'_> {
             line: line_no,
             strip: None,
             boundary: None,
+            segment: SegmentSpec::default(),
             bent: Some(BentSpec {
                 outline,
                 holes,
@@ -2277,6 +2466,7 @@ impl Ctx<'_> {
             strip: None,
             bent: None,
             boundary: Some(BoundarySpec { input, options }),
+            segment: SegmentSpec::default(),
         })
     }
 
@@ -2483,6 +2673,7 @@ fold_threshold = 1.0
                     strip: None,
                     bent: None,
                     boundary: None,
+                    segment: SegmentSpec::default(),
                 }],
                 material: Material {
                     kind: MaterialKind::Paper,
@@ -2580,6 +2771,7 @@ fold_threshold = 179.5
                 strip: None,
                 bent: None,
                 boundary: None,
+                segment: SegmentSpec::default(),
             }]
         );
         assert_eq!(
@@ -2962,6 +3154,7 @@ fold_threshold = 179.5
                     strip: None,
                     bent: None,
                     boundary: None,
+                    segment: SegmentSpec::default(),
                 }]
             );
             assert_eq!(

@@ -44,6 +44,8 @@ pub struct CutArgs {
     /// `<surface>-alt-<k>.obj` (k = 1 is the one cut), to pick another by hand.
     #[arg(long, value_name = "N")]
     pub alternatives: Option<usize>,
+    #[command(flatten)]
+    pub smooth: super::flatten::SmoothArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -269,6 +271,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
 pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     a.pattern.apply(&mut spec)?;
     ask_alternatives(&mut spec, a.alternatives);
+    a.smooth.apply(&mut spec);
     let device = a
         .device
         .clone()
@@ -298,6 +301,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
     if let Some(p) = &a.surface_obj {
         write_surface_obj(p, &flats)?;
     }
+    a.smooth.write_uv(&flats)?;
 
     let dir = a.output.clone().unwrap_or_else(|| default_dir(&spec.name));
     create_dir(&dir)?;

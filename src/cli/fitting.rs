@@ -235,6 +235,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             strip: Some(strip),
             bent: None,
             boundary: None,
+            segment: Default::default(),
         }],
         material: Material {
             kind,
@@ -263,6 +264,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         material: None,
         pattern: Default::default(),
         search: Default::default(),
+        smooth: Default::default(),
         toolpath: Default::default(),
         dry_run: a.dry_run,
         link: a.link.clone(),

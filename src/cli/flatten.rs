@@ -26,6 +26,8 @@ pub struct FlattenArgs {
     /// `<surface>-alt-<k>.obj` (k = 1 is the one flattened).
     #[arg(long, value_name = "N")]
     pub alternatives: Option<usize>,
+    #[command(flatten)]
+    pub smooth: SmoothArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -57,10 +59,12 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
     }
     a.pattern.apply(&mut spec)?;
     super::cut::ask_alternatives(&mut spec, a.alternatives);
+    a.smooth.apply(&mut spec);
     let (flats, pieces) = super::pieces(&spec, a.quiet)?;
     if let Some(p) = &a.surface_obj {
         super::cut::write_surface_obj(p, &flats)?;
     }
+    a.smooth.write_uv(&flats)?;
     // One strip wide enough for the widest piece: the pieces, not the sheets, are the result.
     let widest = pieces
         .iter()
@@ -118,4 +122,72 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// Smooth-mesh flags (issue 7), shared by `flatten` and `cut`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct SmoothArgs {
+    /// How mesh surfaces are cut into pieces: `faces` (exact unfolding of flat panels) or
+    /// `dcharts` (nearly developable charts of a smooth mesh); default: the spec's `segment`,
+    /// else dcharts for smooth meshes.
+    #[arg(long, value_name = "faces|dcharts")]
+    pub segment: Option<crate::spec::Segment>,
+    /// Also write the mesh with its flat layout (mm) as texture coordinates `vt` (Wavefront
+    /// OBJ); with several surfaces, FILE gets `-<k>` before its extension from the second on.
+    #[arg(long, value_name = "FILE")]
+    pub uv_obj: Option<PathBuf>,
+}
+
+impl SmoothArgs {
+    /// Puts `--segment` into every mesh surface of the spec (flags win).
+    pub fn apply(&self, spec: &mut crate::spec::Spec) {
+        if let Some(mode) = self.segment {
+            for s in spec
+                .surfaces
+                .iter_mut()
+                .filter(|s| s.kind == crate::spec::SurfaceKind::Mesh)
+            {
+                s.segment.mode = Some(mode);
+            }
+        }
+    }
+
+    /// Writes `--uv-obj` (atomically), if asked.
+    pub fn write_uv(&self, flats: &[crate::flatten::Flat]) -> Result<(), Error> {
+        let Some(path) = &self.uv_obj else {
+            return Ok(());
+        };
+        for (k, flat) in flats.iter().enumerate() {
+            let file = if k == 0 {
+                path.clone()
+            } else {
+                let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+                let ext = path.extension().map(|s| s.to_string_lossy().into_owned());
+                path.with_file_name(format!(
+                    "{}-{}{}",
+                    stem.unwrap_or_default(),
+                    k + 1,
+                    ext.map(|e| format!(".{e}")).unwrap_or_default()
+                ))
+            };
+            let comment = format!(
+                "{}: {} pieces, flat coordinates in mm as vt (one per face corner)\nwritten by flatcut {}",
+                flat.surface.name,
+                flat.islands.len(),
+                env!("CARGO_PKG_VERSION")
+            );
+            let text = crate::output::obj::write(&flat.surface.mesh, Some(&flat.face_2d), &comment)
+                .ok_or_else(|| {
+                    Error::Usage(format!(
+                        "{}: the flat layout does not cover every face corner",
+                        file.display()
+                    ))
+                })?;
+            if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+                create_dir(dir)?;
+            }
+            write_atomic(&file, text.as_bytes())?;
+        }
+        Ok(())
+    }
 }

@@ -154,7 +154,23 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
                 eprintln!("flatcut: warning: {w}");
             }
         }
-        flats.push(crate::flatten::unfold(surface, &UnfoldOptions::default())?);
+        // Charted (smooth) surfaces are parameterised, the rest unfolded exactly (issue 7).
+        let opts = crate::flatten::charts::FlattenOptions {
+            unfold: UnfoldOptions::default(),
+            ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
+        };
+        let flat = crate::flatten::charts::flatten(surface, &opts)?;
+        if !quiet && flat.surface.charts.is_some() {
+            for w in flat
+                .surface
+                .warnings
+                .iter()
+                .filter(|w| w.contains("stretches by"))
+            {
+                eprintln!("flatcut: warning: {w}");
+            }
+        }
+        flats.push(flat);
     }
     let opts = PatternOptions::from_spec(spec);
     let pieces = crate::pattern::build(&flats, &opts)?;

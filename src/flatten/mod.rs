@@ -6,6 +6,7 @@
 //! nearly developable disk-topology charts (LSCM / ABF++) and [`distortion`] measures any flat
 //! layout against its mesh (L2 / L∞ stretch, shear, angle defect).
 
+pub mod charts;
 pub mod distortion;
 pub mod param;
 pub mod unfold;

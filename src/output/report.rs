@@ -5,7 +5,9 @@
 //! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation; on a
 //! roll the length used, on sheets the rectangle left free on the last sheet),
 //! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
-//! it measured some) and the files written.
+//! it measured some) and the files written. Pieces and surfaces laid out from charts of a
+//! smooth mesh (issue 7) carry `stretch`: `{l2, linf, flipped}` (1 = isometric); it is `null`
+//! for exact unfoldings.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
 //! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
@@ -72,6 +74,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "mirrored": at.mirror,
                 "offset_mm": [r6(at.offset.x), r6(at.offset.y)],
                 "bbox_mm": [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)],
+                "stretch": piece_stretch(flats, p),
             })
         })
         .collect();
@@ -98,6 +101,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "faces": f.surface.mesh.faces.len(),
                 "pieces": f.islands.len(),
                 "warnings": f.surface.warnings,
+                "stretch": f.surface.charts.as_ref().map(|_| stretch_json(&crate::flatten::charts::stretch(f).1)),
             });
             // Figures the source measured (boundary surfaces: interior triangles, locally
             // convex fraction, largest dihedral, iterations, seconds — the one entry that is
@@ -168,4 +172,25 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         },
         "files": info.files,
     })
+}
+
+/// Stretch figures (issue 7): L2 and L∞ (1 = isometric), triangles flipped.
+fn stretch_json(s: &crate::flatten::Stretch) -> Value {
+    json!({ "l2": r6(s.l2), "linf": r6(s.linf), "flipped": s.flipped })
+}
+
+/// Stretch of a piece laid out from a charted (smooth) surface; `null` for exact unfoldings.
+fn piece_stretch(flats: &[Flat], p: &crate::pattern::Piece) -> Value {
+    let Some(flat) = flats
+        .iter()
+        .find(|f| f.surface.name == p.surface && f.surface.charts.is_some())
+    else {
+        return Value::Null;
+    };
+    let uv: Vec<_> = p.faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
+    stretch_json(&crate::flatten::distortion::stretch(
+        &flat.surface.mesh,
+        &p.faces,
+        &uv,
+    ))
 }

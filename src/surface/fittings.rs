@@ -444,6 +444,7 @@ mod tests {
             strip: Some(f.strip_spec(opts).unwrap()),
             bent: None,
             boundary: None,
+            segment: Default::default(),
         };
         crate::surface::build(&spec).unwrap()
     }

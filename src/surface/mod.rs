@@ -7,6 +7,8 @@
 //! and geodesic developables will add files here (see shared/seeds/README.md).
 
 pub mod boundary;
+pub mod dcharts;
+pub mod dcs;
 pub mod fittings;
 pub mod geodesic;
 pub mod obj;
@@ -107,7 +109,7 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             let scale = spec.scale * spec.units.mm();
             let raw = obj::read(&spec.path)?;
             let (mesh, warnings) = obj::validate(raw, scale)?;
-            Ok(Surface {
+            let mut surface = Surface {
                 name: spec.name.clone(),
                 source: spec.path.clone(),
                 mesh,
@@ -115,7 +117,10 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
                 bends: None,
                 charts: None,
                 ..Default::default()
-            })
+            };
+            // Smooth meshes (issue 7): DCS approximation and D-Charts segmentation.
+            dcharts::apply(&mut surface, &spec.segment)?;
+            Ok(surface)
         }
         SurfaceKind::Strip => build_strip(spec),
         SurfaceKind::BentSheet => build_bent(spec),

@@ -1,0 +1,534 @@
+//! D-Charts segmentation, DCS approximation and chart flattening (issue 7): the acceptance
+//! meshes (fandisk, cylinder, mushroom), generated developables, a 30° spherical cap, broken
+//! inputs, and the command line (`--segment dcharts --uv-obj`).
+//!
+//! Figures are printed (`cargo test --release --test dcharts -- --nocapture`) for the issue
+//! note.
+
+mod common;
+use common::*;
+use flatcut::flatten::charts::{self as fcharts, FlattenOptions};
+use flatcut::flatten::{distortion, param, Flat};
+use flatcut::geom::mesh::{Face, Mesh};
+use flatcut::surface::dcharts::{self, DChartsOptions};
+use flatcut::surface::dcs::{self, ApproximateOptions};
+use flatcut::surface::Surface;
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+fn load(name: &str) -> Mesh {
+    let raw = flatcut::surface::obj::read(&shared_data(&format!("meshes/{name}"))).unwrap();
+    flatcut::surface::obj::validate(raw, 1.0).unwrap().0
+}
+
+fn surface(mesh: Mesh, charts: Option<Vec<usize>>) -> Surface {
+    Surface {
+        name: "t".into(),
+        source: PathBuf::from("t.obj"),
+        mesh,
+        charts,
+        ..Default::default()
+    }
+}
+
+/// Segment with the defaults and lay flat for paper.
+fn run(mesh: Mesh) -> (dcharts::Segmentation, Flat, distortion::Stretch, f64) {
+    let t = std::time::Instant::now();
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    let flat = fcharts::charts(
+        surface(mesh, Some(seg.chart.clone())),
+        &FlattenOptions::default(),
+    )
+    .unwrap();
+    let secs = t.elapsed().as_secs_f64();
+    let (_, whole) = fcharts::stretch(&flat);
+    (seg, flat, whole, secs)
+}
+
+/// Every face corner finite, edges shared inside an island coincide, faces counter-clockwise.
+fn check_flat(flat: &Flat) {
+    let mesh = &flat.surface.mesh;
+    assert_eq!(flat.face_2d.len(), mesh.faces.len());
+    for (f, c) in flat.face_2d.iter().enumerate() {
+        assert_eq!(c.len(), mesh.faces[f].verts.len());
+        assert!(c.iter().all(|q| q.is_finite()), "face {f}: {c:?}");
+    }
+    for (e, edge) in flat.topology.edges.iter().enumerate() {
+        if flat.joined[e] {
+            let [(f, i), (g, j)] = [edge.uses[0], edge.uses[1]];
+            assert_eq!(flat.face_island[f], flat.face_island[g]);
+            let (p, q) = flat.corner_edge(f, i);
+            let (q2, p2) = flat.corner_edge(g, j);
+            assert!(p.distance(p2) < 1e-9 * (1.0 + p.length()));
+            assert!(q.distance(q2) < 1e-9 * (1.0 + q.length()));
+        }
+        assert!(flat.dihedral[e].is_finite());
+    }
+    // Each island is one chart of the surface.
+    let charts = flat.surface.charts.as_ref().unwrap();
+    for (k, isl) in flat.islands.iter().enumerate() {
+        for &f in isl {
+            assert_eq!(flat.face_island[f], k);
+            assert_eq!(charts[f], k);
+        }
+    }
+}
+
+#[test]
+fn fandisk_few_charts_near_isometric() {
+    let mesh = load("fandisk.obj");
+    let nf = mesh.faces.len();
+    let (seg, flat, s, secs) = run(mesh);
+    println!(
+        "fandisk: {nf} faces, {} D-Charts ({} Lloyd iterations, {} added, {} merged, {} split), {} pieces, L2 {:.6}, Linf {:.4}, shear {:.2e}, flipped {}, {secs:.2} s",
+        seg.count, seg.iterations, seg.added, seg.merged, seg.split, flat.islands.len(), s.l2, s.linf, s.shear_l2, s.flipped
+    );
+    check_flat(&flat);
+    assert!(flat.islands.len() <= 10, "{} pieces", flat.islands.len());
+    assert!(s.l2 <= 1.001, "L2 {}", s.l2);
+    assert_eq!(s.flipped, 0);
+}
+
+#[test]
+fn cylinder_is_one_or_few_charts() {
+    let mesh = load("cylinder.obj");
+    let (seg, flat, s, secs) = run(mesh);
+    println!(
+        "cylinder: {} D-Charts, {} pieces, L2 {:.7}, Linf {:.5}, flipped {}, {secs:.2} s",
+        seg.count,
+        flat.islands.len(),
+        s.l2,
+        s.linf,
+        s.flipped
+    );
+    check_flat(&flat);
+    assert!(flat.islands.len() <= 3, "{} pieces", flat.islands.len());
+    assert!(s.l2 <= 1.0005, "L2 {}", s.l2);
+    assert_eq!(s.flipped, 0);
+}
+
+#[test]
+fn mushroom_charts_and_stretch() {
+    let mesh = load("mushroom.obj");
+    // The whole disk in one piece, for comparison with libigl's LSCM (L2 2.585).
+    let all: Vec<usize> = (0..mesh.faces.len()).collect();
+    let whole = param::parameterize(&mesh, &all, param::ParamMethod::Best).unwrap();
+    let (seg, flat, s, secs) = run(mesh);
+    let (per, _) = fcharts::stretch(&flat);
+    let worst = per.iter().map(|p| p.l2).fold(1.0, f64::max);
+    println!(
+        "mushroom: whole disk {:?} L2 {:.4} Linf {:.3}; {} D-Charts, {} pieces, L2 {:.5}, Linf {:.4}, worst piece L2 {:.5}, flipped {}, {secs:.2} s",
+        whole.method, whole.stretch.l2, whole.stretch.linf,
+        seg.count, flat.islands.len(), s.l2, s.linf, worst, s.flipped
+    );
+    check_flat(&flat);
+    // The whole disk against libigl's LSCM (L2 2.585) is `param`'s acceptance (tests/param.rs).
+    assert!(s.l2.is_finite() && s.l2 >= 1.0 && s.l2 < whole.stretch.l2);
+    assert_eq!(s.flipped, 0);
+}
+
+/// A truncated cone of `rings` × `n` planar trapezoids, each split in two triangles.
+fn frustum(r0: f64, r1: f64, h: f64, n: usize, rings: usize) -> Mesh {
+    let mut vertices = Vec::new();
+    for k in 0..=rings {
+        let t = k as f64 / rings as f64;
+        let r = r0 + (r1 - r0) * t;
+        for i in 0..n {
+            let a = i as f64 / n as f64 * 2.0 * PI;
+            vertices.push(DVec3::new(r * a.cos(), r * a.sin(), h * t));
+        }
+    }
+    let mut faces = Vec::new();
+    for k in 0..rings {
+        for i in 0..n {
+            let a = k * n + i;
+            let b = k * n + (i + 1) % n;
+            let (c, d) = (b + n, a + n);
+            faces.push(Face {
+                verts: vec![a, b, c],
+                line: None,
+            });
+            faces.push(Face {
+                verts: vec![a, c, d],
+                line: None,
+            });
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+#[test]
+fn generated_cone_flattens_isometrically() {
+    let mesh = frustum(100.0, 60.0, 80.0, 48, 6);
+    let (seg, flat, s, _) = run(mesh.clone());
+    println!(
+        "frustum: {} charts, {} pieces, L2 {:.9}, Linf {:.9}",
+        seg.count,
+        flat.islands.len(),
+        s.l2,
+        s.linf
+    );
+    check_flat(&flat);
+    assert!((s.l2 - 1.0).abs() < 1e-6, "L2 {}", s.l2);
+    // Every edge keeps its length.
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for i in 0..3 {
+            let d3 = mesh.vertices[face.verts[i]].distance(mesh.vertices[face.verts[(i + 1) % 3]]);
+            let d2 = flat.face_2d[f][i].distance(flat.face_2d[f][(i + 1) % 3]);
+            assert!((d3 - d2).abs() <= 1e-6 * d3, "face {f}: {d3} vs {d2}");
+        }
+    }
+    // A tube is not a disk: it is cut into charts that are.
+    assert!(flat.islands.len() >= 2);
+}
+
+/// A spherical cap of half-angle `deg` on a sphere of radius `r`: `rings` rings of `n`.
+fn cap(r: f64, deg: f64, n: usize, rings: usize) -> Mesh {
+    let mut vertices = vec![DVec3::new(0.0, 0.0, r)];
+    for k in 1..=rings {
+        let phi = deg.to_radians() * k as f64 / rings as f64;
+        for i in 0..n {
+            let a = (i as f64 + 0.5 * (k % 2) as f64) / n as f64 * 2.0 * PI;
+            vertices.push(DVec3::new(
+                r * phi.sin() * a.cos(),
+                r * phi.sin() * a.sin(),
+                r * phi.cos(),
+            ));
+        }
+    }
+    let mut faces = Vec::new();
+    for i in 0..n {
+        faces.push(Face {
+            verts: vec![0, 1 + i, 1 + (i + 1) % n],
+            line: None,
+        });
+    }
+    for k in 1..rings {
+        let o = 1 + (k - 1) * n;
+        let p = 1 + k * n;
+        for i in 0..n {
+            let (a, b) = (o + i, o + (i + 1) % n);
+            let (c, d) = (p + i, p + (i + 1) % n);
+            if k % 2 == 1 {
+                faces.push(Face {
+                    verts: vec![a, c, d],
+                    line: None,
+                });
+                faces.push(Face {
+                    verts: vec![a, d, b],
+                    line: None,
+                });
+            } else {
+                let cm = p + (i + n - 1) % n;
+                let _ = cm;
+                faces.push(Face {
+                    verts: vec![a, c, b],
+                    line: None,
+                });
+                faces.push(Face {
+                    verts: vec![b, c, d],
+                    line: None,
+                });
+            }
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+fn whole_stretch(mesh: &Mesh) -> distortion::Stretch {
+    let all: Vec<usize> = (0..mesh.faces.len()).collect();
+    param::parameterize(mesh, &all, param::ParamMethod::Best)
+        .unwrap()
+        .stretch
+}
+
+#[test]
+fn dcs_approximation_lowers_stretch_of_a_spherical_cap() {
+    let mut mesh = cap(100.0, 30.0, 32, 8);
+    let before = whole_stretch(&mesh);
+    let boundary: Vec<usize> = {
+        let t = mesh.topology();
+        let mut v: Vec<usize> = t
+            .edges
+            .iter()
+            .filter(|e| e.uses.len() == 1)
+            .flat_map(|e| e.verts)
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let fixed_pos: Vec<DVec3> = boundary.iter().map(|&v| mesh.vertices[v]).collect();
+    let mut rows = vec![(0, before)];
+    for it in 1..=3 {
+        let stats = dcs::approximate(
+            &mut mesh,
+            &ApproximateOptions {
+                iterations: 1,
+                fixed: boundary.clone(),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let s = whole_stretch(&mesh);
+        println!(
+            "cap 30°, after {it} round(s): L2 {:.6} Linf {:.5} shear {:.2e} (moved at most {:.3} mm, mean {:.3} mm)",
+            s.l2, s.linf, s.shear_l2, stats.max_move, stats.mean_move
+        );
+        rows.push((it, s));
+    }
+    println!(
+        "cap 30°, input: L2 {:.6} Linf {:.5} shear {:.2e}",
+        before.l2, before.linf, before.shear_l2
+    );
+    for (&v, p) in boundary.iter().zip(&fixed_pos) {
+        assert_eq!(mesh.vertices[v], *p, "fixed vertex {v} moved");
+    }
+    assert!(mesh.vertices.iter().all(|p| p.is_finite()));
+    let after = rows[1].1;
+    assert!(
+        after.linf < before.linf,
+        "{} !< {}",
+        after.linf,
+        before.linf
+    );
+    assert!(after.l2 < before.l2, "{} !< {}", after.l2, before.l2);
+}
+
+#[test]
+fn approximation_refuses_a_missing_fixed_vertex() {
+    let mut mesh = cap(100.0, 30.0, 8, 2);
+    let nv = mesh.vertices.len();
+    let e = dcs::approximate(
+        &mut mesh,
+        &ApproximateOptions {
+            fixed: vec![nv + 3],
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("does not exist"), "{e}");
+}
+
+#[test]
+fn several_components_get_their_own_charts() {
+    let mut a = frustum(50.0, 50.0, 40.0, 24, 3);
+    let b = frustum(30.0, 20.0, 30.0, 16, 2);
+    let off = a.vertices.len();
+    a.vertices
+        .extend(b.vertices.iter().map(|p| *p + DVec3::new(300.0, 0.0, 0.0)));
+    a.faces.extend(b.faces.iter().map(|f| Face {
+        verts: f.verts.iter().map(|v| v + off).collect(),
+        line: None,
+    }));
+    let na = 2 * 24 * 3;
+    let (seg, flat, s, _) = run(a);
+    check_flat(&flat);
+    for isl in &flat.islands {
+        let first = isl[0] < na;
+        assert!(isl.iter().all(|&f| (f < na) == first), "a piece spans both");
+    }
+    assert!(seg.count >= 2);
+    assert!((s.l2 - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn non_manifold_edges_split_charts() {
+    // Three fins on one edge (0-1), each a square of two triangles.
+    let mut vertices = vec![DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 50.0)];
+    let mut faces = Vec::new();
+    for k in 0..3 {
+        let a = k as f64 * 2.0 * PI / 3.0;
+        let d = DVec3::new(a.cos(), a.sin(), 0.0) * 40.0;
+        let i = vertices.len();
+        vertices.push(d);
+        vertices.push(d + DVec3::new(0.0, 0.0, 50.0));
+        faces.push(Face {
+            verts: vec![0, i, i + 1],
+            line: None,
+        });
+        faces.push(Face {
+            verts: vec![0, i + 1, 1],
+            line: None,
+        });
+    }
+    let mesh = Mesh { vertices, faces };
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    let flat = fcharts::charts(
+        surface(mesh, Some(seg.chart.clone())),
+        &FlattenOptions::default(),
+    )
+    .unwrap();
+    check_flat(&flat);
+    // No piece holds two fins: each pair of faces across the non-manifold edge is cut.
+    assert!(flat.islands.len() >= 3, "{}", flat.islands.len());
+    let (_, s) = fcharts::stretch(&flat);
+    assert!((s.l2 - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn sliver_triangle_is_refused_with_its_face() {
+    let mut mesh = frustum(50.0, 50.0, 40.0, 12, 1);
+    // A needle: tip angle far below 1e-3 rad, hanging off a boundary edge.
+    let (a, b) = (0, 1);
+    let mid = (mesh.vertices[a] + mesh.vertices[b]) * 0.5;
+    let out = (mid - DVec3::new(0.0, 0.0, mid.z)).normalize() * 1e6 + mid;
+    mesh.vertices.push(out);
+    let v = mesh.vertices.len() - 1;
+    mesh.faces.push(Face {
+        verts: vec![b, a, v],
+        line: Some(99),
+    });
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    let e =
+        fcharts::charts(surface(mesh, Some(seg.chart)), &FlattenOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("line 99") && msg.contains("degenerate"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn bad_options_and_empty_meshes_are_refused() {
+    let mesh = frustum(50.0, 50.0, 40.0, 12, 1);
+    for (o, what) in [
+        (
+            DChartsOptions {
+                f_max: 0.0,
+                ..Default::default()
+            },
+            "f_max",
+        ),
+        (
+            DChartsOptions {
+                charts: 0,
+                ..Default::default()
+            },
+            "charts",
+        ),
+    ] {
+        let e = dcharts::segment(&mesh, &o).unwrap_err();
+        assert!(e.to_string().contains(what), "{e}");
+    }
+    assert!(dcharts::segment(&Mesh::default(), &DChartsOptions::default()).is_err());
+    let mut nan = mesh.clone();
+    nan.vertices[0].x = f64::NAN;
+    assert!(dcharts::segment(&nan, &DChartsOptions::default()).is_err());
+}
+
+#[test]
+fn smooth_detection() {
+    assert!(dcharts::is_smooth(&load("mushroom.obj")));
+    assert!(dcharts::is_smooth(&cap(100.0, 30.0, 32, 8)));
+    let raw = flatcut::surface::obj::read(&manifest("patterns/cube.obj")).unwrap();
+    let cube = flatcut::surface::obj::validate(raw, 1.0).unwrap().0;
+    assert!(!dcharts::is_smooth(&cube));
+    let raw = flatcut::surface::obj::read(&manifest("patterns/lampshade.obj")).unwrap();
+    let lamp = flatcut::surface::obj::validate(raw, 1.0).unwrap().0;
+    assert!(!dcharts::is_smooth(&lamp));
+}
+
+/// `vt` lines of an OBJ, in order.
+fn vts(text: &str) -> Vec<DVec2> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            DVec2::new(v[0], v[1])
+        })
+        .collect()
+}
+
+#[test]
+fn cli_flatten_writes_uv_obj_and_stretch() {
+    let dir = scratch("dcharts-cli");
+    let uv = dir.join("fandisk-uv.obj");
+    let o = flatcut(&[
+        "flatten",
+        &shared_data("meshes/cylinder.obj").to_string_lossy(),
+        "--segment",
+        "dcharts",
+        "--uv-obj",
+        &uv.to_string_lossy(),
+        "-o",
+        &dir.join("out").to_string_lossy(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&uv).unwrap();
+    assert!(!text.to_lowercase().contains("nan"));
+    let faces = text.lines().filter(|l| l.starts_with("f ")).count();
+    let t = vts(&text);
+    assert_eq!(t.len(), 3 * faces);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/report.json")).unwrap())
+            .unwrap();
+    let pieces = report["pieces"].as_array().unwrap();
+    assert!(!pieces.is_empty() && pieces.len() <= 3);
+    for p in pieces {
+        let l2 = p["stretch"]["l2"].as_f64().unwrap();
+        assert!((0.999_999..1.0005).contains(&l2), "{l2}");
+    }
+}
+
+#[test]
+fn cli_refuses_bad_segment_settings() {
+    let dir = scratch("dcharts-bad");
+    let mesh = shared_data("meshes/cylinder.obj");
+    let cases = [
+        ("segment = \"spline\"", "segment"),
+        ("f_max = 2", "f_max"),
+        ("charts = 0", "charts"),
+        ("charts = 2.5", "charts"),
+        ("approximate = { iterations = 0 }", "iterations"),
+        ("approximate = { fixed = [0] }", "fixed"),
+        ("approximate = { fixed = [\"edge\"] }", "fixed"),
+        ("approximate = { rounds = 2 }", "rounds"),
+        ("approximate = 3", "approximate"),
+        ("approximate = { fixed = [99999] }", "99999"),
+    ];
+    for (k, (line, what)) in cases.iter().enumerate() {
+        let spec = dir.join(format!("bad{k}.toml"));
+        std::fs::write(
+            &spec,
+            format!(
+                "[[surface]]\nkind = \"mesh\"\npath = \"{}\"\n{line}\n",
+                mesh.to_string_lossy()
+            ),
+        )
+        .unwrap();
+        let o = flatcut(&[
+            "flatten",
+            &spec.to_string_lossy(),
+            "-o",
+            &dir.join("out").to_string_lossy(),
+        ]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{line}: {err}");
+        assert!(
+            err.contains(what) && err.contains(&format!("bad{k}.toml")),
+            "{line}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+    // A strip takes no segmentation keys.
+    let spec = dir.join("strip.toml");
+    std::fs::write(
+        &spec,
+        "[[surface]]\nkind = \"strip\"\np = [[0, 0, 0], [100, 0, 0]]\nq = [[0, 50, 10], [100, 50, 10]]\nsegment = \"dcharts\"\n",
+    )
+    .unwrap();
+    let o = flatcut(&[
+        "flatten",
+        &spec.to_string_lossy(),
+        "-o",
+        &dir.join("o2").to_string_lossy(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("strip.toml:5"), "{}", stderr(&o));
+    // --segment takes faces or dcharts.
+    let o = flatcut(&["flatten", &mesh.to_string_lossy(), "--segment", "quads"]);
+    assert_ne!(o.status.code(), Some(0));
+}
