@@ -25,9 +25,11 @@
 //!   GODT+GMBT (the paper's combination: fewest invalid bridges, then least energy, as a
 //!   lexicographic cost on Ω). The graphs are monotone DAGs on the m×n grid, so instead of
 //!   Dijkstra one O(mn) dynamic program in row order finds the same optimum (§8 asks for
-//!   exactly this); tests compare it with a plain Dijkstra and with brute force. Memory: two
-//!   rows of costs and one byte of back pointers per grid node (the surface stage refuses more
-//!   than 64 million nodes and asks for a coarser tolerance).
+//!   exactly this); tests compare it with a plain Dijkstra and with brute force. The nodes'
+//!   costs are computed in bands of rows on every core, the recurrence runs on one thread
+//!   (see [`Strip::global`]). Memory: three rows of states, a few bands of costs and one byte
+//!   of back pointers per grid node (the surface stage refuses more than 64 million nodes and
+//!   asks for a coarser tolerance).
 //! - LODT + LMBT (§4), kept for comparison: the greedy walk; when neither successor is valid it
 //!   finds the nearest valid bridge `E_{i',j'}` with i' > i and j' > j (fewest steps, then the
 //!   one most balanced between P and Q, then smaller i'), or the ending bridge if there is
