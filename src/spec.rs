@@ -1417,6 +1417,28 @@ impl Ctx<'_> {
 // ---------------------------------------------------------------------------------------------
 
 impl Ctx<'_> {
+    /// `bend_lines` of a strip or a bent sheet: "all" (default), "none" or a spacing in mm.
+    fn bend_lines(
+        &self,
+        v: &Option<Spanned<Val>>,
+        key: &str,
+    ) -> Result<crate::surface::strip::BendLines, SpecError> {
+        use crate::surface::strip::BendLines;
+        let Some(v) = v else {
+            return Ok(BendLines::All);
+        };
+        match v.get_ref() {
+            Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => Ok(BendLines::All),
+            Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => Ok(BendLines::None),
+            Val::Num(x) if x.is_finite() && *x > 0.0 => Ok(BendLines::Spacing(*x)),
+            _ => Err(self.expected(
+                v,
+                &format!("{key}.bend_lines"),
+                "\"all\", \"none\" or a positive spacing in millimetres",
+            )),
+        }
+    }
+
     /// One `kind = "strip"` entry.
     fn strip_surface(
         &self,
@@ -1425,7 +1447,7 @@ impl Ctx<'_> {
         header_line: usize,
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
-        use crate::surface::strip::{BendLines, Method};
+        use crate::surface::strip::Method;
         for (k, v) in [
             ("path", &s.path),
             ("scale", &s.scale),
@@ -1471,21 +1493,7 @@ impl Ctx<'_> {
                 |v| (0.0..=1.0).contains(&v),
             )?
             .map_or(0.4, |(v, _)| v);
-        let bend_lines = match &s.bend_lines {
-            None => BendLines::All,
-            Some(v) => match v.get_ref() {
-                Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => BendLines::All,
-                Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => BendLines::None,
-                Val::Num(x) if x.is_finite() && *x > 0.0 => BendLines::Spacing(*x),
-                _ => {
-                    return Err(self.expected(
-                        v,
-                        &format!("{key}.bend_lines"),
-                        "\"all\", \"none\" or a positive spacing in millimetres",
-                    ))
-                }
-            },
-        };
+        let bend_lines = self.bend_lines(&s.bend_lines, key)?;
         let mut curves = Vec::new();
         for (name, v) in [("p", &s.p), ("q", &s.q)] {
             let ck = format!("{key}.{name}");
@@ -1878,7 +1886,6 @@ impl Ctx<'_> {
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
         use crate::surface::geodesic::{Control, LengthFit, PieceSpec};
-        use crate::surface::strip::BendLines;
         for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
             if let Some(v) = v {
                 return Err(self.invalid(
@@ -1913,21 +1920,7 @@ impl Ctx<'_> {
                 |v| v > 0.0,
             )?
             .map_or(crate::geom::curve::DEFAULT_TOLERANCE, |(v, _)| v);
-        let bend_lines = match &s.bend_lines {
-            None => BendLines::All,
-            Some(v) => match v.get_ref() {
-                Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => BendLines::All,
-                Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => BendLines::None,
-                Val::Num(x) if x.is_finite() && *x > 0.0 => BendLines::Spacing(*x),
-                _ => {
-                    return Err(self.expected(
-                        v,
-                        &format!("{key}.bend_lines"),
-                        "\"all\", \"none\" or a positive spacing in millimetres",
-                    ))
-                }
-            },
-        };
+        let bend_lines = self.bend_lines(&s.bend_lines, key)?;
         // Outline: [width, height] or a list of points.
         let ok = format!("{key}.outline");
         let ov = s.outline.as_ref().ok_or_else(|| {

@@ -366,32 +366,7 @@ mod tests {
     fn angle_defect_of_a_cube_corner_and_a_flat_fan() {
         // Closed cube (quads): every vertex has defect π/2.
         let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let cube = Mesh {
-            vertices: vec![
-                v(0., 0., 0.),
-                v(1., 0., 0.),
-                v(1., 1., 0.),
-                v(0., 1., 0.),
-                v(0., 0., 1.),
-                v(1., 0., 1.),
-                v(1., 1., 1.),
-                v(0., 1., 1.),
-            ],
-            faces: [
-                [0, 3, 2, 1],
-                [4, 5, 6, 7],
-                [0, 1, 5, 4],
-                [1, 2, 6, 5],
-                [2, 3, 7, 6],
-                [3, 0, 4, 7],
-            ]
-            .iter()
-            .map(|f| Face {
-                verts: f.to_vec(),
-                line: None,
-            })
-            .collect(),
-        };
+        let cube = crate::surface::solids::cuboid(1.0, 1.0, 1.0);
         let d = angle_defect(&cube);
         assert_eq!(d.len(), 8);
         for x in d {
