@@ -107,8 +107,12 @@ pub struct Segmentation {
     pub added: usize,
     /// Merges made.
     pub merged: usize,
-    /// Splits made so that every chart is a disk.
+    /// Splits made so that every chart is a disk (charts with handles; tubes and closed
+    /// shells are cut open instead).
     pub split: usize,
+    /// Edges cut open inside charts so that every chart is a disk ([`disk_cuts`]), as mesh
+    /// vertex pairs (smaller first), sorted: what [`super::Surface::cuts`] takes.
+    pub cuts: Vec<[usize; 2]>,
 }
 
 impl Segmentation {
@@ -549,7 +553,8 @@ pub fn split_between(g: &Graph, faces: &[usize], a: usize, b: usize) -> (Vec<usi
         .partition(|&&f| da[f] < db[f] || (da[f] == db[f] && da[f].is_finite() && f < b))
 }
 
-/// Split every chart that is not a disk until all are; returns the number of splits.
+/// Split every chart that cutting cannot make a disk ([`disk_cuts`]: handles, pinched or
+/// non-manifold charts) until all can be; returns the number of splits.
 fn make_disks(
     mesh: &Mesh,
     topo: &Topology,
@@ -562,7 +567,7 @@ fn make_disks(
     // Each split makes a smaller chart; single faces are disks, so this ends.
     while let Some(c) = queue.pop() {
         let faces: Vec<usize> = (0..chart.len()).filter(|&f| chart[f] == c).collect();
-        if faces.len() <= 1 || is_disk(mesh, topo, g, &faces) {
+        if faces.len() <= 1 || disk_cuts(mesh, topo, g, &faces, &|_| false).is_some() {
             continue;
         }
         let (_, b) = bisect(g, &faces);
@@ -702,6 +707,18 @@ pub fn segment(mesh: &Mesh, o: &DChartsOptions) -> Result<Segmentation, DChartsE
     let merged = merge(mesh, &topo, &g, o, &mut chart, &mut count);
     split += make_disks(mesh, &topo, &g, &mut chart, &mut count);
     compact_ids(&mut chart, &mut count);
+    let mut cuts = Vec::new();
+    let mut faces_of: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (f, &c) in chart.iter().enumerate() {
+        faces_of[c].push(f);
+    }
+    for faces in &faces_of {
+        for e in disk_cuts(mesh, &topo, &g, faces, &|_| false).unwrap_or_default() {
+            let [a, b] = topo.edges[e].verts;
+            cuts.push([a.min(b), a.max(b)]);
+        }
+    }
+    cuts.sort_unstable();
     Ok(Segmentation {
         chart,
         count,
@@ -709,6 +726,7 @@ pub fn segment(mesh: &Mesh, o: &DChartsOptions) -> Result<Segmentation, DChartsE
         added,
         merged,
         split,
+        cuts,
     })
 }
 
@@ -818,7 +836,7 @@ fn merge(
         let faces: Vec<usize> = (0..nf)
             .filter(|&f| chart[f] == a || chart[f] == b)
             .collect();
-        if !is_disk(mesh, topo, g, &faces) {
+        if disk_cuts(mesh, topo, g, &faces, &|_| false).is_none() {
             rejected.insert((a, b));
             continue;
         }
@@ -957,6 +975,7 @@ pub fn apply(
     let s = segment(&surface.mesh, &opts).map_err(|e| invalid(format!("D-Charts: {e}")))?;
     surface.bends = Some(creases(&surface.mesh, &s.chart, CREASE_DEG));
     surface.charts = Some(s.chart);
+    surface.cuts = s.cuts;
     Ok(())
 }
 
@@ -993,4 +1012,377 @@ pub fn triangulate(mesh: &mut Mesh) {
         }
     }
     mesh.faces = faces;
+}
+
+/// A chart opened along its cut edges: one local vertex per wedge of chart faces around a mesh
+/// vertex (faces joined through chart edges that are not cut), so a cut path splits the
+/// vertices along it and a pinched vertex (two fans meeting at a point) becomes two.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Opened {
+    /// Per chart face (in the order given): local vertex of each corner.
+    pub corners: Vec<Vec<usize>>,
+    /// Local vertex → mesh vertex.
+    pub vertex: Vec<usize>,
+    /// Faces connected through uncut chart edges.
+    pub connected: bool,
+    /// Euler characteristic of the opened chart (V − E + F).
+    pub euler: i64,
+    /// Boundary loops of the opened chart (each cut edge gives two boundary edges).
+    pub loops: usize,
+    /// Some edge is used by more than two chart faces.
+    pub nonmanifold: bool,
+}
+
+impl Opened {
+    /// Whether the opened chart is a topological disk.
+    pub fn is_disk(&self) -> bool {
+        self.connected && !self.nonmanifold && self.euler == 1 && self.loops == 1
+    }
+}
+
+fn uf_find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+fn uf_union(parent: &mut [usize], a: usize, b: usize) {
+    let (ra, rb) = (uf_find(parent, a), uf_find(parent, b));
+    if ra != rb {
+        parent[ra.max(rb)] = ra.min(rb);
+    }
+}
+
+/// Local position of each chart face (`NONE` outside).
+fn positions(nf: usize, faces: &[usize]) -> Vec<usize> {
+    let mut at = vec![NONE; nf];
+    for (k, &f) in faces.iter().enumerate() {
+        if f < nf {
+            at[f] = k;
+        }
+    }
+    at
+}
+
+/// Whether edge `e` joins two faces of the chart (`at` from [`positions`]) and is not cut.
+fn inner(topo: &Topology, at: &[usize], e: usize, cut: &dyn Fn(usize) -> bool) -> bool {
+    let u = &topo.edges[e].uses;
+    u.len() == 2 && at[u[0].0] != NONE && at[u[1].0] != NONE && u[0].0 != u[1].0 && !cut(e)
+}
+
+/// Open the chart `faces` along the edges where `cut` holds (see [`Opened`]).
+pub fn open(mesh: &Mesh, topo: &Topology, faces: &[usize], cut: &dyn Fn(usize) -> bool) -> Opened {
+    let nf = mesh.faces.len();
+    let at = positions(nf, faces);
+    let mut offset = Vec::with_capacity(faces.len() + 1);
+    let mut n = 0;
+    for &f in faces {
+        offset.push(n);
+        n += mesh.faces[f].verts.len();
+    }
+    offset.push(n);
+    let mut corner_parent: Vec<usize> = (0..n).collect();
+    let mut face_parent: Vec<usize> = (0..faces.len()).collect();
+    let mut nonmanifold = false;
+    // Twice the number of local edges: inner edges are met from both faces.
+    let mut twice_edges: i64 = 0;
+    for (k, &f) in faces.iter().enumerate() {
+        let vs = &mesh.faces[f].verts;
+        for (i, &e) in topo.face_edges[f].iter().enumerate() {
+            if topo.edges[e].uses.iter().filter(|u| at[u.0] != NONE).count() > 2 {
+                nonmanifold = true;
+            }
+            if !inner(topo, &at, e, cut) {
+                twice_edges += 2;
+                continue;
+            }
+            twice_edges += 1;
+            let &(g, _) = topo.edges[e]
+                .uses
+                .iter()
+                .find(|u| u.0 != f)
+                .unwrap_or(&(f, i));
+            let kg = at[g];
+            uf_union(&mut face_parent, k, kg);
+            let gv = &mesh.faces[g].verts;
+            for c in [i, (i + 1) % vs.len()] {
+                if let Some(cg) = gv.iter().position(|&v| v == vs[c]) {
+                    uf_union(&mut corner_parent, offset[k] + c, offset[kg] + cg);
+                }
+            }
+        }
+    }
+    let mut local = vec![NONE; n];
+    let mut vertex = Vec::new();
+    let mut corners = Vec::with_capacity(faces.len());
+    for (k, &f) in faces.iter().enumerate() {
+        let vs = &mesh.faces[f].verts;
+        let mut cs = Vec::with_capacity(vs.len());
+        for (c, &v) in vs.iter().enumerate() {
+            let r = uf_find(&mut corner_parent, offset[k] + c);
+            if local[r] == NONE {
+                local[r] = vertex.len();
+                vertex.push(v);
+            }
+            cs.push(local[r]);
+        }
+        corners.push(cs);
+    }
+    // Boundary loops: components of the boundary edges over local vertices.
+    let nv = vertex.len();
+    let mut vparent: Vec<usize> = (0..nv).collect();
+    let mut on_boundary = vec![false; nv];
+    for (k, &f) in faces.iter().enumerate() {
+        let m = mesh.faces[f].verts.len();
+        for (i, &e) in topo.face_edges[f].iter().enumerate() {
+            if !inner(topo, &at, e, cut) {
+                let (a, b) = (corners[k][i], corners[k][(i + 1) % m]);
+                on_boundary[a] = true;
+                on_boundary[b] = true;
+                uf_union(&mut vparent, a, b);
+            }
+        }
+    }
+    let loops = (0..nv)
+        .filter(|&v| on_boundary[v] && uf_find(&mut vparent, v) == v)
+        .count();
+    let connected = faces.is_empty()
+        || (0..faces.len()).all(|k| uf_find(&mut face_parent, k) == uf_find(&mut face_parent, 0));
+    Opened {
+        corners,
+        vertex,
+        connected,
+        euler: nv as i64 - twice_edges / 2 + faces.len() as i64,
+        loops,
+        nonmanifold,
+    }
+}
+
+/// Bends above this many degrees count fully as "sharp" when choosing where to cut.
+const SHARP_DEG: f64 = 30.0;
+
+/// Length of edge `e` as a cut costs it: edges that bend are cheaper (down to a quarter at
+/// [`SHARP_DEG`] and beyond), so seams follow creases where there are some.
+pub fn cut_weight(mesh: &Mesh, topo: &Topology, g: &Graph, e: usize) -> f64 {
+    let ed = &topo.edges[e];
+    let len = mesh.vertices[ed.verts[0]].distance(mesh.vertices[ed.verts[1]]);
+    let bend = match ed.uses[..] {
+        [(f, _), (h, _)] => {
+            let a = g.normal[f].angle_between(g.normal[h]);
+            if a.is_finite() {
+                a
+            } else {
+                0.0
+            }
+        }
+        _ => 0.0,
+    };
+    len * (1.0 - 0.75 * (bend / SHARP_DEG.to_radians()).min(1.0))
+}
+
+/// Vertex graph of the chart's inner (uncut) edges: per mesh vertex, (neighbour, edge).
+fn inner_graph(
+    mesh: &Mesh,
+    topo: &Topology,
+    faces: &[usize],
+    cut: &dyn Fn(usize) -> bool,
+) -> Vec<Vec<(usize, usize)>> {
+    let at = positions(mesh.faces.len(), faces);
+    let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); mesh.vertices.len()];
+    let mut edges: Vec<usize> = faces
+        .iter()
+        .flat_map(|&f| topo.face_edges[f].iter().copied())
+        .filter(|&e| inner(topo, &at, e, cut))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    for e in edges {
+        let [a, b] = topo.edges[e].verts;
+        adj[a].push((b, e));
+        adj[b].push((a, e));
+    }
+    adj
+}
+
+/// Dijkstra over `adj` from `sources` with edge weights `w`, stopping at the first vertex where
+/// `stop` holds; returns the distances, the edge each vertex was reached through, and the
+/// vertex it stopped at.
+fn vertex_paths(
+    adj: &[Vec<(usize, usize)>],
+    topo: &Topology,
+    w: &dyn Fn(usize) -> f64,
+    sources: &[usize],
+    stop: &dyn Fn(usize) -> bool,
+) -> (Vec<f64>, Vec<usize>, Option<usize>) {
+    let nv = adj.len();
+    let mut d = vec![f64::INFINITY; nv];
+    let mut via = vec![NONE; nv];
+    let mut heap = BinaryHeap::new();
+    for &s in sources {
+        if d[s] > 0.0 {
+            d[s] = 0.0;
+            heap.push(Entry {
+                key: 0.0,
+                face: s,
+                d: 0.0,
+            });
+        }
+    }
+    while let Some(Entry { key, face: v, .. }) = heap.pop() {
+        if key > d[v] {
+            continue;
+        }
+        if key > 0.0 && stop(v) {
+            return (d, via, Some(v));
+        }
+        for &(u, e) in &adj[v] {
+            let nd = key + w(e);
+            if nd < d[u] {
+                d[u] = nd;
+                via[u] = e;
+                heap.push(Entry {
+                    key: nd,
+                    face: u,
+                    d: nd,
+                });
+            }
+        }
+    }
+    let _ = topo;
+    (d, via, None)
+}
+
+/// The edges of the shortest path (weights `w`) over `adj` (per vertex: neighbour, edge) from
+/// any of `sources` to `target`, from `target` back to the source; `None` when it cannot be
+/// reached.
+pub fn path_to(
+    adj: &[Vec<(usize, usize)>],
+    w: &dyn Fn(usize) -> f64,
+    sources: &[usize],
+    target: usize,
+    topo: &Topology,
+) -> Option<Vec<usize>> {
+    let stop = |v: usize| v == target;
+    let (_, via, hit) = vertex_paths(adj, topo, w, sources, &stop);
+    hit.map(|v| trace(topo, &via, v))
+}
+
+/// The edges of the path that reached `v` (through `via`), from `v` back to a source.
+fn trace(topo: &Topology, via: &[usize], mut v: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    while via[v] != NONE && out.len() <= via.len() {
+        let e = via[v];
+        out.push(e);
+        let [a, b] = topo.edges[e].verts;
+        v = if a == v { b } else { a };
+    }
+    out
+}
+
+/// Edges to cut so that the chart `faces` (already cut where `cut` holds) becomes a disk
+/// (thesis §5.2.3, "cuts connecting the chart boundary loops"): a tube or a sphere with holes
+/// gets shortest paths joining its boundary loops one by one (each path from everything
+/// already joined to the nearest loop not yet joined), a closed shell one path between two
+/// vertices far apart (the second farthest from the first, the first farthest from the
+/// chart's lowest vertex). Paths run along chart edges, bent edges counting shorter
+/// ([`cut_weight`]). Empty when the chart already is a disk; `None` when cutting cannot make
+/// it one (disconnected, non-manifold, or with handles): the caller splits it.
+pub fn disk_cuts(
+    mesh: &Mesh,
+    topo: &Topology,
+    g: &Graph,
+    faces: &[usize],
+    cut: &dyn Fn(usize) -> bool,
+) -> Option<Vec<usize>> {
+    let op = open(mesh, topo, faces, cut);
+    if op.is_disk() {
+        return Some(Vec::new());
+    }
+    if !op.connected || op.nonmanifold || op.euler != 2 - op.loops as i64 {
+        return None;
+    }
+    let adj = inner_graph(mesh, topo, faces, cut);
+    let w = |e: usize| cut_weight(mesh, topo, g, e);
+    let nv = mesh.vertices.len();
+    let mut added: Vec<usize> = Vec::new();
+    // Boundary loops as sets of mesh vertices (through the opened chart's local vertices).
+    let nl = op.vertex.len();
+    let at = positions(mesh.faces.len(), faces);
+    let mut parent: Vec<usize> = (0..nl).collect();
+    let mut on_b = vec![false; nl];
+    for (k, &f) in faces.iter().enumerate() {
+        let m = mesh.faces[f].verts.len();
+        for (i, &e) in topo.face_edges[f].iter().enumerate() {
+            if !inner(topo, &at, e, cut) {
+                let (a, b) = (op.corners[k][i], op.corners[k][(i + 1) % m]);
+                on_b[a] = true;
+                on_b[b] = true;
+                uf_union(&mut parent, a, b);
+            }
+        }
+    }
+    let mut loop_of = vec![NONE; nv];
+    for l in 0..nl {
+        if on_b[l] {
+            let r = uf_find(&mut parent, l);
+            let v = op.vertex[l];
+            loop_of[v] = loop_of[v].min(r);
+        }
+    }
+    if op.loops == 0 {
+        let Some(&low) = faces.iter().flat_map(|&f| mesh.faces[f].verts.iter()).min() else {
+            return None;
+        };
+        let never = |_: usize| false;
+        let far = |d: &[f64]| -> usize {
+            (0..nv)
+                .filter(|&v| d[v].is_finite())
+                .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
+                .unwrap_or(low)
+        };
+        let (d0, _, _) = vertex_paths(&adj, topo, &w, &[low], &never);
+        let a = far(&d0);
+        let (da, via, _) = vertex_paths(&adj, topo, &w, &[a], &never);
+        let b = far(&da);
+        added = trace(topo, &via, b);
+    } else {
+        // Root: the loop through the lowest boundary vertex; the others joined one by one.
+        let mut reached = vec![false; nv];
+        let mut loop_reached: std::collections::BTreeSet<usize> = Default::default();
+        let root = (0..nv).find(|&v| loop_of[v] != NONE).map(|v| loop_of[v])?;
+        loop_reached.insert(root);
+        let mut sources: Vec<usize> = (0..nv).filter(|&v| loop_of[v] == root).collect();
+        for &s in &sources {
+            reached[s] = true;
+        }
+        for _ in 1..op.loops {
+            let stop = |v: usize| loop_of[v] != NONE && !loop_reached.contains(&loop_of[v]);
+            let (_, via, hit) = vertex_paths(&adj, topo, &w, &sources, &stop);
+            let hit = hit?;
+            let path = trace(topo, &via, hit);
+            for &e in &path {
+                for v in topo.edges[e].verts {
+                    if !reached[v] {
+                        reached[v] = true;
+                        sources.push(v);
+                    }
+                }
+            }
+            added.extend(path);
+            let l = loop_of[hit];
+            loop_reached.insert(l);
+            for v in 0..nv {
+                if loop_of[v] == l && !reached[v] {
+                    reached[v] = true;
+                    sources.push(v);
+                }
+            }
+        }
+    }
+    added.sort_unstable();
+    added.dedup();
+    let with = |e: usize| cut(e) || added.binary_search(&e).is_ok();
+    open(mesh, topo, faces, &with).is_disk().then_some(added)
 }
