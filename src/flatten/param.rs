@@ -532,7 +532,23 @@ fn spd_solve(
         .map_err(|e| chart.solver_error(method, format!("the system is singular ({e:?})")))?;
     let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
     let x = llt.solve(&b);
-    let out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    let mut out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    // Two steps of iterative refinement: the residual b − A x (A from its lower triangle)
+    // solved again and added, which brings an exactly developable chart to isometry within
+    // rounding (seam sides equal to 1e-9 mm and better).
+    for _ in 0..2 {
+        let mut r = rhs.to_vec();
+        for t in triplets {
+            r[t.row] -= t.val * out[t.col];
+            if t.row != t.col {
+                r[t.col] -= t.val * out[t.row];
+            }
+        }
+        let d = llt.solve(&Mat::<f64>::from_fn(n, 1, |i, _| r[i]));
+        for (i, o) in out.iter_mut().enumerate() {
+            *o += d[(i, 0)];
+        }
+    }
     if out.iter().any(|v| !v.is_finite()) {
         return Err(chart.solver_error(method, "the solve gave non-finite values"));
     }
