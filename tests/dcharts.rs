@@ -645,3 +645,54 @@ fn cli_refuses_bad_segment_settings() {
     let o = flatcut(&["flatten", &mesh.to_string_lossy(), "--segment", "quads"]);
     assert_ne!(o.status.code(), Some(0));
 }
+
+#[test]
+fn darts_lower_stretch_without_splitting() {
+    // A 60° spherical cap as one chart, paper (L2 1.003): laid whole it stretches 1.0044;
+    // splitting makes two pieces; darts from the rim toward the pole keep one piece and bring
+    // it under the tolerance (§5.2.3), shortened afterwards as far as it stays there (§5.3).
+    let mesh = cap(100.0, 60.0, 32, 10);
+    let n = mesh.faces.len();
+    let lay = |darts: usize, max_splits: usize| {
+        let o = FlattenOptions {
+            darts,
+            max_splits,
+            ..FlattenOptions::default()
+        };
+        let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
+        let (_, s) = fcharts::stretch(&flat);
+        check_flat(&flat);
+        assert_eq!(s.flipped, 0);
+        (flat, s)
+    };
+    let (plain, s0) = lay(0, 0);
+    let (split, s1) = lay(0, 3);
+    let (darted, s2) = lay(4, 3);
+    println!(
+        "cap 60°: whole L2 {:.5}; split {} pieces L2 {:.5}; darts {} pieces L2 {:.5} Linf {:.4}, {} cut edges",
+        s0.l2,
+        split.islands.len(),
+        s1.l2,
+        darted.islands.len(),
+        s2.l2,
+        s2.linf,
+        darted.surface.cuts.len()
+    );
+    assert_eq!(plain.islands.len(), 1);
+    assert!(s0.l2 > 1.003);
+    assert!(split.islands.len() >= 2);
+    assert_eq!(darted.islands.len(), 1);
+    assert!(s2.l2 < s0.l2 && s2.l2 <= 1.003, "L2 {} vs {}", s2.l2, s0.l2);
+    assert!(!darted.surface.cuts.is_empty());
+    assert!(darted.surface.warnings.is_empty());
+    // A dart is a partial cut: its edges are on the border twice, the tip joins them.
+    let p = pieces(&darted);
+    assert_eq!(p.len(), 1);
+    assert_eq!(p[0].border.len(), 1);
+    let sides: usize = p[0].seams.iter().filter(|s| s.partner == p[0].id).count();
+    assert!(sides >= 2 && sides % 2 == 0, "{sides}");
+    // Same input, same output.
+    let (again, _) = lay(4, 3);
+    assert_eq!(again.face_2d, darted.face_2d);
+    assert_eq!(again.surface.cuts, darted.surface.cuts);
+}
