@@ -91,6 +91,40 @@ fn fandisk_few_charts_near_isometric() {
 }
 
 #[test]
+fn straightening_shortens_fandisk_boundaries() {
+    // §5.2.2: boundaries re-routed through the fuzzy areas are shorter in total, and the
+    // targets still hold.
+    let mesh = load("fandisk.obj");
+    let topo = mesh.topology();
+    let plain = dcharts::segment(
+        &mesh,
+        &DChartsOptions {
+            straighten: false,
+            ..DChartsOptions::default()
+        },
+    )
+    .unwrap();
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    let before = dcharts::boundary_length(&mesh, &topo, &plain.chart);
+    let after = dcharts::boundary_length(&mesh, &topo, &seg.chart);
+    println!(
+        "fandisk boundaries: {before:.4} without straightening ({} charts), {after:.4} with ({} charts, {} segments re-routed)",
+        plain.count, seg.count, seg.straightened
+    );
+    assert_eq!(plain.straightened, 0);
+    assert!(seg.straightened > 0);
+    assert!(after < before, "{after} vs {before}");
+    let flat = fcharts::charts(
+        surface(mesh, Some(seg.chart.clone())),
+        &FlattenOptions::default(),
+    )
+    .unwrap();
+    check_flat(&flat);
+    let (_, s) = fcharts::stretch(&flat);
+    assert!(flat.islands.len() <= 10 && s.l2 <= 1.001 && s.flipped == 0);
+}
+
+#[test]
 fn cylinder_is_one_or_few_charts() {
     let mesh = load("cylinder.obj");
     let (seg, flat, s, secs) = run(mesh);
@@ -245,8 +279,17 @@ fn check_tube(mesh: Mesh, flat: &Flat) {
     let (a, b) = (&piece.seams[0], &piece.seams[1]);
     assert_eq!(a.partner, piece.id);
     assert_ne!(a.is_a, b.is_a);
-    assert!((a.length - b.length).abs() < 1e-9, "{} vs {}", a.length, b.length);
-    assert!((a.length - cut_len).abs() < 1e-9 * cut_len, "{} vs {cut_len}", a.length);
+    assert!(
+        (a.length - b.length).abs() < 1e-9,
+        "{} vs {}",
+        a.length,
+        b.length
+    );
+    assert!(
+        (a.length - cut_len).abs() < 1e-9 * cut_len,
+        "{} vs {cut_len}",
+        a.length
+    );
     assert_eq!(piece.marks.iter().filter(|m| m.id == ids[0]).count(), 2);
 }
 
@@ -287,14 +330,14 @@ fn closed_shell_is_cut_open_by_a_path() {
     let mut mesh = mesh;
     dcharts::triangulate(&mut mesh);
     let n = mesh.faces.len();
-    let flat = fcharts::charts(surface(mesh, Some(vec![0; n])), &FlattenOptions::default()).unwrap();
+    let flat =
+        fcharts::charts(surface(mesh, Some(vec![0; n])), &FlattenOptions::default()).unwrap();
     check_flat(&flat);
     let (_, s) = fcharts::stretch(&flat);
     assert!(s.l2.is_finite() && s.flipped == 0, "{s:?}");
     let p = pieces(&flat);
     assert_eq!(p.len(), flat.islands.len());
 }
-
 
 /// A spherical cap of half-angle `deg` on a sphere of radius `r`: `rings` rings of `n`.
 fn cap(r: f64, deg: f64, n: usize, rings: usize) -> Mesh {

@@ -134,7 +134,9 @@ impl Charts<'_> {
     /// The chart's faces opened along `cuts` and laid flat: the opened chart becomes a mesh of
     /// its own (vertices split along the cuts), parameterised, then turned counter-clockwise.
     fn lay(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
-        let op = open(self.mesh, self.topo, faces, &|e| cuts.binary_search(&e).is_ok());
+        let op = open(self.mesh, self.topo, faces, &|e| {
+            cuts.binary_search(&e).is_ok()
+        });
         let local = Mesh {
             vertices: op.vertex.iter().map(|&v| self.mesh.vertices[v]).collect(),
             faces: faces
@@ -343,10 +345,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         {
             darts(&ctx, &mut laid, opts, overlap_eps)?;
         }
-        if laid.stretch.l2 > opts.tolerance
-            && t.splits < opts.max_splits
-            && laid.faces.len() >= 8
-        {
+        if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
             // Darts are dropped: each half gets its own.
             let t = Todo {
                 faces: laid.faces,

@@ -510,6 +510,7 @@ fn spd_solve(
     triplets: &[Triplet<usize, usize, f64>],
     rhs: &[f64],
     symbolic: &mut Option<SymbolicLlt<usize>>,
+    refine: usize,
 ) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
         return Ok(Vec::new());
@@ -533,10 +534,10 @@ fn spd_solve(
     let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
     let x = llt.solve(&b);
     let mut out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-    // Two steps of iterative refinement: the residual b − A x (A from its lower triangle)
-    // solved again and added, which brings an exactly developable chart to isometry within
-    // rounding (seam sides equal to 1e-9 mm and better).
-    for _ in 0..2 {
+    // `refine` steps of iterative refinement: the residual b − A x (A from its lower
+    // triangle) solved again and added; LSCM takes two, which brings an exactly developable
+    // chart to isometry within rounding (seam sides equal to 1e-9 mm and better).
+    for _ in 0..refine {
         let mut r = rhs.to_vec();
         for t in triplets {
             r[t.row] -= t.val * out[t.col];
@@ -628,7 +629,7 @@ fn lscm_solve(
             }
         }
     }
-    let x = spd_solve(chart, method, n, &triplets, &rhs, &mut None)?;
+    let x = spd_solve(chart, method, n, &triplets, &rhs, &mut None, 2)?;
     Ok((0..nv)
         .map(|v| match var[v] {
             Some(kk) => DVec2::new(x[2 * kk], x[2 * kk + 1]),
@@ -785,7 +786,7 @@ fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
             local_r1[t] = r1;
             local_d[t] = d;
         }
-        let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic)?;
+        let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic, 0)?;
         let mut d_alpha = vec![[0.0f64; 3]; nt];
         let mut d_lam_t = vec![0.0f64; nt];
         // Largest step fraction keeping every angle inside (0, π) with a margin (a damped

@@ -74,6 +74,12 @@ pub struct DChartsOptions {
     pub eta: f64,
     /// Face rings on each side of a common boundary tested for merging (default 2).
     pub merge_rings: usize,
+    /// Straighten the boundaries between charts through their fuzzy areas (§5.2.2; default
+    /// on).
+    pub straighten: bool,
+    /// Fuzzy areas take the faces fitting the other chart's proxy below this fraction of
+    /// `F_max` (default 0.1).
+    pub fuzzy: f64,
 }
 
 impl Default for DChartsOptions {
@@ -90,6 +96,8 @@ impl Default for DChartsOptions {
             small_hole: 0.002,
             eta: 1e-3,
             merge_rings: 2,
+            straighten: true,
+            fuzzy: 0.1,
         }
     }
 }
@@ -107,6 +115,8 @@ pub struct Segmentation {
     pub added: usize,
     /// Merges made.
     pub merged: usize,
+    /// Boundary segments re-routed by straightening.
+    pub straightened: usize,
     /// Splits made so that every chart is a disk (charts with handles; tubes and closed
     /// shells are cut open instead).
     pub split: usize,
@@ -703,6 +713,12 @@ pub fn segment(mesh: &Mesh, o: &DChartsOptions) -> Result<Segmentation, DChartsE
     let mut chart = st.assign;
     let mut count = st.proxies.len();
     compact_ids(&mut chart, &mut count);
+    let straightened = if o.straighten {
+        straighten(mesh, &topo, &g, o, &mut chart)
+    } else {
+        0
+    };
+    compact_ids(&mut chart, &mut count);
     let mut split = make_disks(mesh, &topo, &g, &mut chart, &mut count);
     let merged = merge(mesh, &topo, &g, o, &mut chart, &mut count);
     split += make_disks(mesh, &topo, &g, &mut chart, &mut count);
@@ -725,6 +741,7 @@ pub fn segment(mesh: &Mesh, o: &DChartsOptions) -> Result<Segmentation, DChartsE
         iterations,
         added,
         merged,
+        straightened,
         split,
         cuts,
     })
@@ -1091,7 +1108,13 @@ pub fn open(mesh: &Mesh, topo: &Topology, faces: &[usize], cut: &dyn Fn(usize) -
     for (k, &f) in faces.iter().enumerate() {
         let vs = &mesh.faces[f].verts;
         for (i, &e) in topo.face_edges[f].iter().enumerate() {
-            if topo.edges[e].uses.iter().filter(|u| at[u.0] != NONE).count() > 2 {
+            if topo.edges[e]
+                .uses
+                .iter()
+                .filter(|u| at[u.0] != NONE)
+                .count()
+                > 2
+            {
                 nonmanifold = true;
             }
             if !inner(topo, &at, e, cut) {
@@ -1385,4 +1408,343 @@ pub fn disk_cuts(
     added.dedup();
     let with = |e: usize| cut(e) || added.binary_search(&e).is_ok();
     open(mesh, topo, faces, &with).is_disk().then_some(added)
+}
+
+/// Total length of the chart boundaries: mesh edges between two different charts.
+pub fn boundary_length(mesh: &Mesh, topo: &Topology, chart: &[usize]) -> f64 {
+    topo.edges
+        .iter()
+        .filter(|e| match e.uses[..] {
+            [(f, _), (h, _)] => chart.get(f) != chart.get(h),
+            _ => false,
+        })
+        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
+        .sum()
+}
+
+/// Boundary straightening (§5.2.2 of the thesis' post-processing): for each pair of adjacent
+/// charts, the fuzzy area is grown from their common boundary into each chart over the faces
+/// that fit the *other* chart's proxy below `F_max` (so both fit them). Each boundary segment
+/// between the two (a chain of edges with two end vertices; closed loops are left alone, the
+/// thesis uses a min-cut there) is replaced by the shortest path between its ends along edges
+/// inside the fuzzy area (its inner vertices touch only the two charts and not the mesh
+/// boundary), and the fuzzy faces are given back to the side of the new path they lie on
+/// (flood from each chart's faces outside the fuzzy area). A change is kept only when the
+/// segment got shorter and both charts stay connected. Proxies are those refitted to the
+/// charts as they are. Returns the number of segments re-routed.
+fn straighten(
+    mesh: &Mesh,
+    topo: &Topology,
+    g: &Graph,
+    o: &DChartsOptions,
+    chart: &mut [usize],
+) -> usize {
+    let nf = chart.len();
+    let nv = mesh.vertices.len();
+    let count = chart.iter().copied().max().map_or(0, |m| m + 1);
+    let mut mo = vec![Moments::default(); count];
+    for f in 0..nf {
+        mo[chart[f]].add(g.normal[f], g.area[f]);
+    }
+    let proxies: Vec<Option<Proxy>> = mo.iter().map(dcs::fit).collect();
+    let mut vf: Vec<Vec<usize>> = vec![Vec::new(); nv];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in &face.verts {
+            vf[v].push(f);
+        }
+    }
+    let mut on_mesh_boundary = vec![false; nv];
+    for e in &topo.edges {
+        if e.uses.len() != 2 {
+            on_mesh_boundary[e.verts[0]] = true;
+            on_mesh_boundary[e.verts[1]] = true;
+        }
+    }
+    let len = |e: usize| {
+        let [a, b] = topo.edges[e].verts;
+        mesh.vertices[a].distance(mesh.vertices[b])
+    };
+    let mut pairs: std::collections::BTreeSet<(usize, usize)> = Default::default();
+    for e in &topo.edges {
+        if let [(f, _), (h, _)] = e.uses[..] {
+            let (a, b) = (chart[f], chart[h]);
+            if a != b {
+                pairs.insert((a.min(b), a.max(b)));
+            }
+        }
+    }
+    let mut changed = 0;
+    let mut fuzzy = vec![false; nf];
+    for (a, b) in pairs {
+        let (Some(pa), Some(pb)) = (proxies[a], proxies[b]) else {
+            continue;
+        };
+        // Common boundary edges.
+        let common: Vec<usize> = (0..topo.edges.len())
+            .filter(|&e| match topo.edges[e].uses[..] {
+                [(f, _), (h, _)] => {
+                    (chart[f] == a && chart[h] == b) || (chart[f] == b && chart[h] == a)
+                }
+                _ => false,
+            })
+            .collect();
+        if common.is_empty() {
+            continue;
+        }
+        // Fuzzy area: grown from the boundary into each chart over faces fitting the other.
+        let mut region: Vec<usize> = Vec::new();
+        let fits = |f: usize| {
+            let other = if chart[f] == a { &pb } else { &pa };
+            other.error(g.normal[f]) < o.fuzzy * o.f_max
+        };
+        for &e in &common {
+            for &(f, _) in &topo.edges[e].uses {
+                if !fuzzy[f] && fits(f) {
+                    fuzzy[f] = true;
+                    region.push(f);
+                }
+            }
+        }
+        let mut k = 0;
+        while k < region.len() {
+            let t = region[k];
+            k += 1;
+            for &(u, _) in &g.adj[t] {
+                if !fuzzy[u] && chart[u] == chart[t] && fits(u) {
+                    fuzzy[u] = true;
+                    region.push(u);
+                }
+            }
+        }
+        // Segments: components of the common edges (through shared vertices), two ends each.
+        let mut deg: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for &e in &common {
+            for v in topo.edges[e].verts {
+                deg.entry(v).or_default().push(e);
+            }
+        }
+        let mut seen_e: std::collections::BTreeSet<usize> = Default::default();
+        let mut segments: Vec<(Vec<usize>, Vec<usize>)> = Vec::new(); // (edges, ends)
+        for &e0 in &common {
+            if seen_e.contains(&e0) {
+                continue;
+            }
+            let mut comp = vec![e0];
+            seen_e.insert(e0);
+            let mut i = 0;
+            while i < comp.len() {
+                let e = comp[i];
+                i += 1;
+                for v in topo.edges[e].verts {
+                    for &x in &deg[&v] {
+                        if seen_e.insert(x) {
+                            comp.push(x);
+                        }
+                    }
+                }
+            }
+            let mut verts: Vec<usize> = comp.iter().flat_map(|&e| topo.edges[e].verts).collect();
+            verts.sort_unstable();
+            verts.dedup();
+            let ends: Vec<usize> = verts
+                .iter()
+                .copied()
+                .filter(|v| deg[v].len() == 1)
+                .collect();
+            let branching = verts.iter().any(|v| deg[v].len() > 2);
+            if ends.len() == 2 && !branching {
+                segments.push((comp, ends));
+            }
+        }
+        for (old, ends) in segments {
+            let old_len: f64 = old.iter().map(|&e| len(e)).sum();
+            // Edges allowed: inside the fuzzy area, or the old segment itself.
+            let clean = |v: usize| {
+                !on_mesh_boundary[v] && vf[v].iter().all(|&f| chart[f] == a || chart[f] == b)
+            };
+            let mut adj: std::collections::BTreeMap<usize, Vec<(usize, usize)>> =
+                Default::default();
+            let mut allowed: Vec<usize> = old.clone();
+            for &f in &region {
+                for &e in &topo.face_edges[f] {
+                    if let [(x, _), (y, _)] = topo.edges[e].uses[..] {
+                        if fuzzy[x] && fuzzy[y] {
+                            allowed.push(e);
+                        }
+                    }
+                }
+            }
+            allowed.sort_unstable();
+            allowed.dedup();
+            for &e in &allowed {
+                let [p, q] = topo.edges[e].verts;
+                let ok = |v: usize| ends.contains(&v) || clean(v);
+                if ok(p) && ok(q) {
+                    adj.entry(p).or_default().push((q, e));
+                    adj.entry(q).or_default().push((p, e));
+                }
+            }
+            // Dijkstra from ends[0] to ends[1] over the allowed edges.
+            let mut dist: std::collections::BTreeMap<usize, f64> = Default::default();
+            let mut via: std::collections::BTreeMap<usize, usize> = Default::default();
+            let mut heap = BinaryHeap::new();
+            dist.insert(ends[0], 0.0);
+            heap.push(Entry {
+                key: 0.0,
+                face: ends[0],
+                d: 0.0,
+            });
+            while let Some(Entry { key, face: v, .. }) = heap.pop() {
+                if key > dist[&v] || v == ends[1] {
+                    if v == ends[1] {
+                        break;
+                    }
+                    continue;
+                }
+                for &(u, e) in adj.get(&v).map(|x| x.as_slice()).unwrap_or(&[]) {
+                    let nd = key + len(e);
+                    if dist.get(&u).is_none_or(|&d| nd < d) {
+                        dist.insert(u, nd);
+                        via.insert(u, e);
+                        heap.push(Entry {
+                            key: nd,
+                            face: u,
+                            d: nd,
+                        });
+                    }
+                }
+            }
+            let Some(&new_len) = dist.get(&ends[1]) else {
+                continue;
+            };
+            if new_len >= old_len * (1.0 - 1e-9) {
+                continue;
+            }
+            let mut path: Vec<usize> = Vec::new();
+            let mut v = ends[1];
+            while v != ends[0] && path.len() <= allowed.len() {
+                let e = via[&v];
+                path.push(e);
+                let [p, q] = topo.edges[e].verts;
+                v = if p == v { q } else { p };
+            }
+            // The new boundary between the two: the other segments and the new path.
+            path.extend(common.iter().copied().filter(|e| !old.contains(e)));
+            path.sort_unstable();
+            // Reassign the fuzzy faces: flood from a's faces outside the fuzzy area, not
+            // crossing the new boundary; what a does not reach goes to b.
+            let saved: Vec<(usize, usize)> = region.iter().map(|&f| (f, chart[f])).collect();
+            let mut to_a = vec![false; 0];
+            to_a.resize(region.len(), false);
+            let idx: std::collections::BTreeMap<usize, usize> =
+                region.iter().enumerate().map(|(i, &f)| (f, i)).collect();
+            let mut stack: Vec<usize> = Vec::new();
+            for &f in &region {
+                // Fuzzy faces next to a's non-fuzzy faces, across an edge not on the path.
+                for (i, &(u, _)) in g.adj[f].iter().enumerate() {
+                    let _ = i;
+                    if chart[u] == a && !fuzzy[u] {
+                        let e = shared_edge(topo, f, u);
+                        if e.is_some_and(|e| path.binary_search(&e).is_err()) && !to_a[idx[&f]] {
+                            to_a[idx[&f]] = true;
+                            stack.push(f);
+                        }
+                    }
+                }
+            }
+            let any_outside_a = (0..nf).any(|f| chart[f] == a && !fuzzy[f]);
+            let any_outside_b = (0..nf).any(|f| chart[f] == b && !fuzzy[f]);
+            if !any_outside_a || !any_outside_b {
+                continue;
+            }
+            while let Some(f) = stack.pop() {
+                for &(u, _) in &g.adj[f] {
+                    if let Some(&iu) = idx.get(&u) {
+                        if to_a[iu] {
+                            continue;
+                        }
+                        let e = shared_edge(topo, f, u);
+                        if e.is_some_and(|e| path.binary_search(&e).is_err()) {
+                            to_a[iu] = true;
+                            stack.push(u);
+                        }
+                    }
+                }
+            }
+            for (i, &f) in region.iter().enumerate() {
+                chart[f] = if to_a[i] { a } else { b };
+            }
+            let now: f64 = boundary_between(mesh, topo, chart, a, b);
+            let before_total: f64 = {
+                let cur: Vec<(usize, usize)> = region.iter().map(|&f| (f, chart[f])).collect();
+                for &(f, c) in &saved {
+                    chart[f] = c;
+                }
+                let t = boundary_between(mesh, topo, chart, a, b);
+                for &(f, c) in &cur {
+                    chart[f] = c;
+                }
+                t
+            };
+            if now < before_total * (1.0 - 1e-9)
+                && chart_connected(g, chart, a)
+                && chart_connected(g, chart, b)
+            {
+                changed += 1;
+                // The fuzzy area is stale after a change: this pair is done.
+                break;
+            }
+            for &(f, c) in &saved {
+                chart[f] = c;
+            }
+        }
+        for &f in &region {
+            fuzzy[f] = false;
+        }
+    }
+    changed
+}
+
+/// Whether the faces of chart `c` are connected (and there are some).
+fn chart_connected(g: &Graph, chart: &[usize], c: usize) -> bool {
+    let faces: Vec<usize> = (0..chart.len()).filter(|&f| chart[f] == c).collect();
+    let Some(&s) = faces.first() else {
+        return false;
+    };
+    let mut seen = vec![false; chart.len()];
+    seen[s] = true;
+    let mut n = 1;
+    let mut st = vec![s];
+    while let Some(f) = st.pop() {
+        for &(u, _) in &g.adj[f] {
+            if chart[u] == c && !seen[u] {
+                seen[u] = true;
+                n += 1;
+                st.push(u);
+            }
+        }
+    }
+    n == faces.len()
+}
+
+/// The edge two faces share, if any.
+fn shared_edge(topo: &Topology, f: usize, h: usize) -> Option<usize> {
+    topo.face_edges[f]
+        .iter()
+        .copied()
+        .find(|&e| topo.edges[e].uses.iter().any(|u| u.0 == h))
+}
+
+/// Length of the boundary between charts `a` and `b`.
+fn boundary_between(mesh: &Mesh, topo: &Topology, chart: &[usize], a: usize, b: usize) -> f64 {
+    topo.edges
+        .iter()
+        .filter(|e| match e.uses[..] {
+            [(f, _), (h, _)] => {
+                (chart[f] == a && chart[h] == b) || (chart[f] == b && chart[h] == a)
+            }
+            _ => false,
+        })
+        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
+        .sum()
 }
