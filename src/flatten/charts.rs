@@ -3,25 +3,40 @@
 //! area equals its 3D area), and [`flatten`] picks between that and the exact polyhedral
 //! [`super::unfold`] for the CLI.
 //!
+//! **Cuts inside a chart** ([`Surface::cuts`], thesis §5.2.3): a chart is opened along its cut
+//! edges before it is parameterised: [`crate::surface::dcharts::open`] gives one vertex per
+//! wedge of faces around each mesh vertex, so the vertices along a seam are split, and the
+//! opened chart is laid flat as a mesh of its own. A chart that is still not a disk gets the
+//! cuts of [`crate::surface::dcharts::disk_cuts`] (a tube the shortest seam between its rims);
+//! cuts a split leaves useless are dropped and found again. A cut edge is never `joined`, so
+//! the pattern stage draws it as a cut line with seam marks on both sides, like a seam
+//! between two pieces; [`Surface::cuts`] of the result lists the cuts that stayed inside a
+//! piece.
+//!
 //! The [`Flat`] it builds is the one the pattern stage already reads: `face_2d` per face
 //! corner, counter-clockwise (a chart laid out mirrored is mirrored back); `joined` for the
-//! edges inside a chart (their two copies coincide, the parameterisation being per vertex);
+//! edges inside a chart (their two copies coincide, the layout being per opened vertex);
 //! `dihedral` the signed bend of every interior edge, as [`super::unfold`] computes it.
 //!
-//! After the thesis' §5.3 ("overlaps cut away", "a piece over the material's tolerance"), a
-//! chart is split in two and both halves laid flat again when
-//! - its layout overlaps itself deeper than the unfolder's tolerance (a global overlap, or a
-//!   gusset folding over): split between the two overlapping faces
+//! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
+//! material's tolerance"), a chart
+//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap, or a
+//!   gusset folding over) is split between the two overlapping faces
 //!   ([`crate::surface::dcharts::split_between`]: each face goes with the nearer of the two,
-//!   through the chart), so the overlapping parts end up in different pieces;
+//!   through the chart), so the overlapping parts end up in different pieces; a chart that
+//!   needed seams to be a disk (a tube whose layout spirals over itself) is halved along
+//!   the bisector instead;
+//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts` below: up
+//!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
+//!   region, then shortened while it stays within the tolerance);
 //!
-//! and along the bisector of its two most distant faces ([`crate::surface::dcharts::bisect`])
-//! when
+//! and is split along the bisector of its two most distant faces
+//! ([`crate::surface::dcharts::bisect`]) when
 //! - it has a flipped triangle,
-//! - the parameteriser refuses it (not a disk),
-//! - or its L2 stretch is over [`FlattenOptions::tolerance`] — at most
-//!   [`FlattenOptions::max_splits`] times per chart; what is still over it then is reported
-//!   (a warning on the surface, and the stretch of every piece in `report.json`).
+//! - the parameteriser refuses it (no cut makes it a disk),
+//! - or its L2 stretch is still over the tolerance — at most [`FlattenOptions::max_splits`]
+//!   times per chart (its darts dropped, each half gets its own); what is still over it then
+//!   is reported (a warning on the surface, and the stretch of every piece in `report.json`).
 //!
 //! Material tolerances on the L2 stretch of a piece ([`material_tolerance`]), chosen here:
 //! paper 1.003 (paper does not stretch; 0.3 % is taken up by folding and gluing without a
@@ -52,7 +67,7 @@ pub struct FlattenOptions {
     /// Times a chart may be split for being over the tolerance (overlaps and flips are always
     /// split, down to single faces).
     pub max_splits: usize,
-    /// Most darts cut into a chart over the tolerance before it is split (see [`darts`]); 0
+    /// Most darts cut into a chart over the tolerance before it is split (see the module doc); 0
     /// for none.
     pub darts: usize,
 }
@@ -213,7 +228,8 @@ impl Charts<'_> {
     }
 }
 
-/// Lay each chart flat as one island (cutting and splitting where needed, see the module doc).
+/// Lay each chart flat as one island (cutting and splitting where needed, see the module
+/// doc).
 pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
     let mesh = &surface.mesh;
     let nf = mesh.faces.len();
@@ -564,8 +580,8 @@ fn darts(
         return Ok(());
     }
     // Shorten: keep the last `k` edges of each dart (those at the boundary).
-    for d in 0..made.len() {
-        let path = made[d].clone();
+    for dart in made.iter_mut() {
+        let path = dart.clone();
         let without: Vec<usize> = laid
             .cuts
             .iter()
@@ -595,7 +611,7 @@ fn darts(
             laid.cuts = with_last(k);
             laid.uv = uv;
             laid.stretch = s;
-            made[d] = path[path.len() - k..].to_vec();
+            *dart = path[path.len() - k..].to_vec();
         }
     }
     Ok(())

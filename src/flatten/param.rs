@@ -8,7 +8,9 @@
 //! eq. 8–10, written so that direct similarities cost nothing and mirror images do). Two vertices
 //! are pinned and the rest solved by sparse least squares: the normal equations AᵀA x = −Aᵀb
 //! (symmetric positive definite once two vertices are pinned) are factored by faer's sparse
-//! Cholesky with its fill-reducing ordering.
+//! Cholesky with its fill-reducing ordering, and the solution improved by two steps of
+//! iterative refinement (the normal equations square the condition number; refined, an
+//! exactly developable chart comes out isometric to ~1e-11 relative).
 //!
 //! **ABF++.** Unknowns: the 3 angles α of every triangle. Targets β: the 3D angles, scaled at
 //! each interior vertex so they sum to 2π (ABF, Sheffer & de Sturler 2001). Energy Σ (α − β)²/β²

@@ -18,15 +18,28 @@
 //!   [`DChartsOptions::small_hole`] of the total area (or one no chart touches) gets a new
 //!   chart grown inside it, recursively; the small ones are then grown into by the charts
 //!   around them without the `F_max` bound.
+//! - **Boundary straightening** (§5.2.3 first step, [`straighten`]): fuzzy areas grown from
+//!   each common boundary into both charts over the faces that fit the other chart's proxy
+//!   below [`DChartsOptions::fuzzy`] · `F_max`; each boundary segment (a chain with two ends)
+//!   is re-routed along the shortest path between its ends inside the fuzzy area, kept when
+//!   shorter and both charts stay connected. The thesis bounds the fuzzy area by `F_max`
+//!   itself; on the acceptance meshes that moves whole strips of faces between charts and
+//!   raises the stretch (mushroom L2 1.00033 → 1.00091), a tenth of it shortens the
+//!   boundaries as much (fandisk 12.95 → 12.39) without that. Closed boundary loops (the
+//!   thesis' min-cut case) are left as they are.
 //! - **Merging** (§5.2.3): two adjacent charts merge when the faces within
 //!   [`DChartsOptions::merge_rings`] rings of their common boundary fit a cylinder
 //!   (`θ = π/2`) with mean error below `η` ([`DChartsOptions::eta`]), best pair first, and
-//!   only when the merged chart is still a topological disk.
-//! - **Disks** (§5.2.3 "cuts connecting the boundary loops"): a chart that is not a disk
-//!   (a tube, a closed shell, a handle) is split in two along the bisector of its two most
-//!   distant faces ([`bisect`]) until every chart is a disk. The thesis cuts the chart open
-//!   instead; flatcut's surface stage gives every face a chart id and no in-chart cuts, so a
-//!   tube becomes two charts rather than one chart with a seam.
+//!   only when the merged chart can be cut into a disk ([`disk_cuts`]: no handle).
+//! - **Cuts** (§5.2.3 "cuts connecting the boundary loops"): a chart that is not a disk gets
+//!   seams inside it ([`disk_cuts`], [`Segmentation::cuts`], carried by
+//!   [`super::Surface::cuts`]): a tube the shortest path between its two rims, a sphere with
+//!   holes a tree of such paths, a closed shell one path between two far-apart vertices; bent
+//!   edges count shorter, so seams follow creases. Only a chart that cutting cannot make a
+//!   disk (a handle, or faces joined through a single vertex) is split in two along the
+//!   bisector of its two most distant faces ([`bisect`]). Darts (partial cuts toward the most
+//!   curved region) are made by the flatten stage, which knows the stretch
+//!   ([`crate::flatten::charts`]).
 //!
 //! Choices where the thesis is silent: `F` is taken as `F + 10⁻⁶` in the cost so that on an
 //! exactly developable region (F = 0 everywhere) compactness and straightness still order the
@@ -38,8 +51,8 @@
 //! reaches unreached components first). The result is deterministic: ties break on face
 //! index, charts are numbered by their smallest face.
 //!
-//! Not done (see the issue note): boundary straightening through fuzzy areas, darts and
-//! gussets (partial cuts inside a chart need in-chart seams the `Surface` cannot carry yet).
+//! Not done: cutting handles open (a chart with a handle is split instead), the min-cut
+//! straightening of closed boundary loops, gussets (a cut that would overlap is not made).
 
 use super::dcs::{self, Moments, Proxy};
 use crate::geom::mesh::{Mesh, Topology};
@@ -74,7 +87,7 @@ pub struct DChartsOptions {
     pub eta: f64,
     /// Face rings on each side of a common boundary tested for merging (default 2).
     pub merge_rings: usize,
-    /// Straighten the boundaries between charts through their fuzzy areas (§5.2.2; default
+    /// Straighten the boundaries between charts through their fuzzy areas (§5.2.3; default
     /// on).
     pub straighten: bool,
     /// Fuzzy areas take the faces fitting the other chart's proxy below this fraction of
@@ -1184,7 +1197,7 @@ pub fn open(mesh: &Mesh, topo: &Topology, faces: &[usize], cut: &dyn Fn(usize) -
 }
 
 /// Bends above this many degrees count fully as "sharp" when choosing where to cut.
-const SHARP_DEG: f64 = 30.0;
+pub const SHARP_DEG: f64 = 30.0;
 
 /// Length of edge `e` as a cut costs it: edges that bend are cheaper (down to a quarter at
 /// [`SHARP_DEG`] and beyond), so seams follow creases where there are some.
@@ -1234,7 +1247,6 @@ fn inner_graph(
 /// vertex it stopped at.
 fn vertex_paths(
     adj: &[Vec<(usize, usize)>],
-    topo: &Topology,
     w: &dyn Fn(usize) -> f64,
     sources: &[usize],
     stop: &dyn Fn(usize) -> bool,
@@ -1273,7 +1285,6 @@ fn vertex_paths(
             }
         }
     }
-    let _ = topo;
     (d, via, None)
 }
 
@@ -1288,7 +1299,7 @@ pub fn path_to(
     topo: &Topology,
 ) -> Option<Vec<usize>> {
     let stop = |v: usize| v == target;
-    let (_, via, hit) = vertex_paths(adj, topo, w, sources, &stop);
+    let (_, via, hit) = vertex_paths(adj, w, sources, &stop);
     hit.map(|v| trace(topo, &via, v))
 }
 
@@ -1347,17 +1358,17 @@ pub fn disk_cuts(
         }
     }
     let mut loop_of = vec![NONE; nv];
-    for l in 0..nl {
+    for (l, &v) in op.vertex.iter().enumerate() {
         if on_b[l] {
             let r = uf_find(&mut parent, l);
-            let v = op.vertex[l];
             loop_of[v] = loop_of[v].min(r);
         }
     }
     if op.loops == 0 {
-        let Some(&low) = faces.iter().flat_map(|&f| mesh.faces[f].verts.iter()).min() else {
-            return None;
-        };
+        let &low = faces
+            .iter()
+            .flat_map(|&f| mesh.faces[f].verts.iter())
+            .min()?;
         let never = |_: usize| false;
         let far = |d: &[f64]| -> usize {
             (0..nv)
@@ -1365,9 +1376,9 @@ pub fn disk_cuts(
                 .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
                 .unwrap_or(low)
         };
-        let (d0, _, _) = vertex_paths(&adj, topo, &w, &[low], &never);
+        let (d0, _, _) = vertex_paths(&adj, &w, &[low], &never);
         let a = far(&d0);
-        let (da, via, _) = vertex_paths(&adj, topo, &w, &[a], &never);
+        let (da, via, _) = vertex_paths(&adj, &w, &[a], &never);
         let b = far(&da);
         added = trace(topo, &via, b);
     } else {
@@ -1382,7 +1393,7 @@ pub fn disk_cuts(
         }
         for _ in 1..op.loops {
             let stop = |v: usize| loop_of[v] != NONE && !loop_reached.contains(&loop_of[v]);
-            let (_, via, hit) = vertex_paths(&adj, topo, &w, &sources, &stop);
+            let (_, via, hit) = vertex_paths(&adj, &w, &sources, &stop);
             let hit = hit?;
             let path = trace(topo, &via, hit);
             for &e in &path {
@@ -1422,7 +1433,7 @@ pub fn boundary_length(mesh: &Mesh, topo: &Topology, chart: &[usize]) -> f64 {
         .sum()
 }
 
-/// Boundary straightening (§5.2.2 of the thesis' post-processing): for each pair of adjacent
+/// Boundary straightening (thesis §5.2.3, post-processing): for each pair of adjacent
 /// charts, the fuzzy area is grown from their common boundary into each chart over the faces
 /// that fit the *other* chart's proxy below `F_max` (so both fit them). Each boundary segment
 /// between the two (a chain of edges with two end vertices; closed loops are left alone, the
@@ -1432,7 +1443,7 @@ pub fn boundary_length(mesh: &Mesh, topo: &Topology, chart: &[usize]) -> f64 {
 /// (flood from each chart's faces outside the fuzzy area). A change is kept only when the
 /// segment got shorter and both charts stay connected. Proxies are those refitted to the
 /// charts as they are. Returns the number of segments re-routed.
-fn straighten(
+pub fn straighten(
     mesh: &Mesh,
     topo: &Topology,
     g: &Graph,
@@ -1634,15 +1645,13 @@ fn straighten(
             // Reassign the fuzzy faces: flood from a's faces outside the fuzzy area, not
             // crossing the new boundary; what a does not reach goes to b.
             let saved: Vec<(usize, usize)> = region.iter().map(|&f| (f, chart[f])).collect();
-            let mut to_a = vec![false; 0];
-            to_a.resize(region.len(), false);
+            let mut to_a = vec![false; region.len()];
             let idx: std::collections::BTreeMap<usize, usize> =
                 region.iter().enumerate().map(|(i, &f)| (f, i)).collect();
             let mut stack: Vec<usize> = Vec::new();
             for &f in &region {
                 // Fuzzy faces next to a's non-fuzzy faces, across an edge not on the path.
-                for (i, &(u, _)) in g.adj[f].iter().enumerate() {
-                    let _ = i;
+                for &(u, _) in &g.adj[f] {
                     if chart[u] == a && !fuzzy[u] {
                         let e = shared_edge(topo, f, u);
                         if e.is_some_and(|e| path.binary_search(&e).is_err()) && !to_a[idx[&f]] {
