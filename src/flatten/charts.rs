@@ -1,7 +1,7 @@
 //! Flattening of a segmented smooth surface: every chart of [`Surface::charts`] becomes one
 //! island, laid flat by [`super::param::parameterize`] (LSCM / ABF++, scaled so that its 2D
 //! area equals its 3D area), and [`flatten`] picks between that and the exact polyhedral
-//! [`super::unfold`] for the CLI.
+//! [`super::unfold()`] for the CLI.
 //!
 //! **Cuts inside a chart** ([`Surface::cuts`], thesis §5.2.3): a chart is opened along its cut
 //! edges before it is parameterised: [`crate::surface::dcharts::open`] gives one vertex per
@@ -16,7 +16,7 @@
 //! The [`Flat`] it builds is the one the pattern stage already reads: `face_2d` per face
 //! corner, counter-clockwise (a chart laid out mirrored is mirrored back); `joined` for the
 //! edges inside a chart (their two copies coincide, the layout being per opened vertex);
-//! `dihedral` the signed bend of every interior edge, as [`super::unfold`] computes it.
+//! `dihedral` the signed bend of every interior edge, as [`super::unfold()`] computes it.
 //!
 //! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
 //! material's tolerance"), a chart

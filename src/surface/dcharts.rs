@@ -946,7 +946,7 @@ pub const CREASE_DEG: f64 = 20.0;
 
 /// Apply a mesh surface's issue-7 settings: the DCS approximation when asked, then, for
 /// `segment = "dcharts"` (or a smooth mesh without `segment`, see [`is_smooth`]), the charts
-/// ([`Surface::charts`]) and the creases inside them as the surface's bend lines. Polygons are
+/// ([`super::Surface::charts`]) and the creases inside them as the surface's bend lines. Polygons are
 /// split into triangles first (by ear clipping in their plane), since charts are
 /// parameterised triangle by triangle.
 pub fn apply(
