@@ -24,9 +24,10 @@
 //!   is re-routed along the shortest path between its ends inside the fuzzy area, kept when
 //!   shorter and both charts stay connected. The thesis bounds the fuzzy area by `F_max`
 //!   itself; on the acceptance meshes that moves whole strips of faces between charts and
-//!   raises the stretch (mushroom L2 1.00033 → 1.00091), a tenth of it shortens the
-//!   boundaries as much (fandisk 12.95 → 12.39) without that. Closed boundary loops (the
-//!   thesis' min-cut case) are left as they are.
+//!   raises the stretch (mushroom L2 1.00033 → 1.00091, fandisk boundaries only 12.95 →
+//!   12.8); a tenth of it shortens the fandisk's boundaries more (→ 12.39) and costs the
+//!   mushroom less (L2 1.00051). Closed boundary loops (the thesis' min-cut case) are left
+//!   as they are.
 //! - **Merging** (§5.2.3): two adjacent charts merge when the faces within
 //!   [`DChartsOptions::merge_rings`] rings of their common boundary fit a cylinder
 //!   (`θ = π/2`) with mean error below `η` ([`DChartsOptions::eta`]), best pair first, and
