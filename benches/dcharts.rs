@@ -24,6 +24,7 @@ fn segment_and_flatten(mesh: &Mesh) -> usize {
         name: "bench".into(),
         mesh: mesh.clone(),
         charts: Some(seg.chart),
+        cuts: seg.cuts,
         ..Default::default()
     };
     charts::charts(s, &FlattenOptions::default())

@@ -8,7 +8,9 @@
 //! eq. 8–10, written so that direct similarities cost nothing and mirror images do). Two vertices
 //! are pinned and the rest solved by sparse least squares: the normal equations AᵀA x = −Aᵀb
 //! (symmetric positive definite once two vertices are pinned) are factored by faer's sparse
-//! Cholesky with its fill-reducing ordering.
+//! Cholesky with its fill-reducing ordering, and the solution improved by two steps of
+//! iterative refinement (the normal equations square the condition number; refined, an
+//! exactly developable chart comes out isometric to ~1e-11 relative).
 //!
 //! **ABF++.** Unknowns: the 3 angles α of every triangle. Targets β: the 3D angles, scaled at
 //! each interior vertex so they sum to 2π (ABF, Sheffer & de Sturler 2001). Energy Σ (α − β)²/β²
@@ -510,6 +512,7 @@ fn spd_solve(
     triplets: &[Triplet<usize, usize, f64>],
     rhs: &[f64],
     symbolic: &mut Option<SymbolicLlt<usize>>,
+    refine: usize,
 ) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
         return Ok(Vec::new());
@@ -532,7 +535,23 @@ fn spd_solve(
         .map_err(|e| chart.solver_error(method, format!("the system is singular ({e:?})")))?;
     let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
     let x = llt.solve(&b);
-    let out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    let mut out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    // `refine` steps of iterative refinement: the residual b − A x (A from its lower
+    // triangle) solved again and added; LSCM takes two, which brings an exactly developable
+    // chart to isometry within rounding (seam sides equal to 1e-9 mm and better).
+    for _ in 0..refine {
+        let mut r = rhs.to_vec();
+        for t in triplets {
+            r[t.row] -= t.val * out[t.col];
+            if t.row != t.col {
+                r[t.col] -= t.val * out[t.row];
+            }
+        }
+        let d = llt.solve(&Mat::<f64>::from_fn(n, 1, |i, _| r[i]));
+        for (i, o) in out.iter_mut().enumerate() {
+            *o += d[(i, 0)];
+        }
+    }
     if out.iter().any(|v| !v.is_finite()) {
         return Err(chart.solver_error(method, "the solve gave non-finite values"));
     }
@@ -612,7 +631,7 @@ fn lscm_solve(
             }
         }
     }
-    let x = spd_solve(chart, method, n, &triplets, &rhs, &mut None)?;
+    let x = spd_solve(chart, method, n, &triplets, &rhs, &mut None, 2)?;
     Ok((0..nv)
         .map(|v| match var[v] {
             Some(kk) => DVec2::new(x[2 * kk], x[2 * kk + 1]),
@@ -769,7 +788,7 @@ fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
             local_r1[t] = r1;
             local_d[t] = d;
         }
-        let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic)?;
+        let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic, 0)?;
         let mut d_alpha = vec![[0.0f64; 3]; nt];
         let mut d_lam_t = vec![0.0f64; nt];
         // Largest step fraction keeping every angle inside (0, π) with a margin (a damped

@@ -38,6 +38,12 @@ pub struct Surface {
     /// charts that the flatten stage parameterises one by one; `None`: the faces are exact flat
     /// panels, unfolded as they are.
     pub charts: Option<Vec<usize>>,
+    /// Edges (their two mesh vertices, smaller first, sorted) cut open even where both faces are
+    /// in one chart: the seams that make a tube or a closed shell a disk, and darts (issue 7,
+    /// thesis §5.2.3). The flatten stage splits the vertices along them before parameterising
+    /// and the pattern stage draws them as cut lines with seam marks on both sides. Empty for
+    /// none; only meaningful with `charts`.
+    pub cuts: Vec<[usize; 2]>,
     /// Figures the source measured, written under the surface in `report.json` (strips: points
     /// on each curve, interior and locally convex bridges, bending energy; boundary surfaces:
     /// interior triangles, locally convex fraction, …); empty for none.
