@@ -951,14 +951,18 @@ fn bent_arc_on_a_parallel_circle_gives_its_cone() {
     // the folded arc's error (≤ tol) magnified by R/H along the axis (a pyramid over a polygon
     // whose corners are off the circle by δ has its apex off by δ·R/H): 2·tol·R/H.
     assert!(worst_axis < 2.0 * tol * big_r / h_apex, "{worst_axis}");
-    // The ruling ends lie on the cone: at distance ρ(1 − z/H) from the axis (apex side).
+    // The ruling ends lie on the cone: at distance ρ(1 − z/H) from the axis (apex side). (Not
+    // the sheet beyond the end rulings: it stays planar, §3.4.)
     let mut worst_cone = 0.0f64;
-    for v in &bent.mesh.vertices {
-        let z = v.z * apex.z.signum();
-        worst_cone =
-            worst_cone.max((DVec2::new(v.x, v.y).length() - rho * (1.0 - z / h_apex)).abs());
+    for r in &folds {
+        for &i in r.edges.iter().flatten() {
+            let v = bent.mesh.vertices[i];
+            let z = v.z * apex.z.signum();
+            worst_cone =
+                worst_cone.max((DVec2::new(v.x, v.y).length() - rho * (1.0 - z / h_apex)).abs());
+        }
     }
-    eprintln!("vertices off the cone by {worst_cone:.4} mm");
+    eprintln!("ruling ends off the cone by {worst_cone:.4} mm");
     assert!(worst_cone < 2.0 * tol * big_r / h_apex, "{worst_cone}");
 }
 
@@ -1082,6 +1086,18 @@ tolerance = 0.05
     assert!(worst < 1e-9);
     assert!((bent.lengths[0] - len).abs() / len < 1e-6);
     assert!(bent.drifts[0] <= 0.05);
+    // The normal turns against the curve here (c and κ vary: θ' ≠ 0); a finer tolerance must
+    // bring the folded curve closer (it would not with a wrong geodesic torsion).
+    let mut fine = b.clone();
+    fine.tolerance = 0.002;
+    let bent = geodesic::bend(&fine).unwrap();
+    eprintln!(
+        "flat Bézier at 0.002 mm: {} rulings, drift {:.5} mm",
+        bent.rulings.len(),
+        bent.drifts[0]
+    );
+    assert!(bent.drifts[0] <= 0.002, "{}", bent.drifts[0]);
+    assert!(worst_edge_error(&bent) < 1e-9);
     let o = flatcut(&["cut", &path, "--dry-run", "-o", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
@@ -1091,4 +1107,46 @@ fn geodesic_sector_area() -> f64 {
     let n = 30.0;
     let a = 60f64.to_radians() / n;
     0.5 * n * a.sin() * (180.0f64.powi(2) - 120.0f64.powi(2))
+}
+
+#[test]
+fn bent_arc_on_a_helix_follows_it_as_the_tolerance_shrinks() {
+    // A helix (κ = 0.0219/mm, τ = 0.0082/mm) carrying a flat arc of radius 100 mm: the normal
+    // turns along the curve (θ' = 0 but τ_g = τ + θ' ≠ 0 and the rulings are oblique). The
+    // folded arc must follow the helix to the tolerance at every tolerance: a wrong geodesic
+    // torsion would leave an error that does not shrink with the step.
+    let helix = Helix {
+        r: 40.0,
+        c: 15.0,
+        turns: 0.5,
+    };
+    let len = ArcLength::new(&helix).total();
+    let big_r = 100.0;
+    let sweep = (len / big_r).to_degrees();
+    for tol in [0.1, 0.01, 0.001] {
+        let spec = BentSpec {
+            outline: annulus_sector(80.0, 120.0, -5.0, sweep + 5.0),
+            holes: vec![],
+            pieces: vec![arc_piece(big_r, 0.0, sweep)],
+            tolerance: tol,
+            bend_lines: BendLines::All,
+        };
+        let bent = geodesic::bend_with(&spec, &[(&helix, None)]).unwrap();
+        let oblique = bent
+            .rulings
+            .iter()
+            .map(|r| r.dir.perp_dot(r.point.normalize()).abs())
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "helix on an arc at {tol} mm: {} rulings, drift {:.5} mm, isometry {:.1e}, rulings at least {:.1}° off the radius",
+            bent.rulings.len(),
+            bent.drifts[0],
+            worst_edge_error(&bent),
+            oblique.asin().to_degrees()
+        );
+        assert!(bent.drifts[0] <= tol, "{tol}: {}", bent.drifts[0]);
+        assert!(worst_edge_error(&bent) < 1e-9);
+        assert!((bent.lengths[0] - len).abs() / len < 1e-6);
+        assert!(oblique > 0.1, "{oblique}");
+    }
 }
