@@ -2079,7 +2079,7 @@ impl Ctx<'_> {
                 return Err(self.invalid(
                     self.line(v.span()),
                     &format!("{key}.{k}"),
-                    "is for mesh surfaces; a bent sheet takes `outline`, `line` and `control_points` or `handles`".to_string(),
+                    "is for mesh surfaces; a bent sheet takes `outline`, `line` (or `arc`, `flat_curve`) and `control_points` or `handles`".to_string(),
                 ));
             }
         }
@@ -2088,7 +2088,7 @@ impl Ctx<'_> {
                 return Err(self.invalid(
                     self.line(v.span()),
                     &format!("{key}.{k}"),
-                    "is for strips; a bent sheet takes `line` and `control_points` or `handles`"
+                    "is for strips; a bent sheet takes `line` (or `arc`, `flat_curve`) and `control_points` or `handles`"
                         .to_string(),
                 ));
             }
@@ -2297,7 +2297,8 @@ impl Ctx<'_> {
                     return Err(self.invalid(
                         pl,
                         pk.trim_end_matches('.'),
-                        "must be a table { line, control_points } or { line, handles }".to_string(),
+                        "must be a table { line | arc | flat_curve, control_points | handles }"
+                            .to_string(),
                     ));
                 };
                 const KEYS: [&str; 6] = [

@@ -624,6 +624,50 @@ fn bent_bad_input_exits_1_naming_the_key() {
         &format!("{head}{ok_outline}{ok_line}"),
         &["exactly one of `control_points` and `handles`"],
     );
+    // Curves on the sheet (§5): `arc` and `flat_curve`, exactly one of them or `line`.
+    let arc = "arc = { center = [100, 0], radius = 60, start_deg = 30, end_deg = 150 }\n";
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}{ok_line}{arc}{ok_ctrl}"),
+        &[
+            "bad.toml:4",
+            "exactly one of `line`, `arc` and `flat_curve`",
+        ],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = 60, start_deg = 30 }}\n{ok_ctrl}"),
+        &["surface[1].arc.end_deg", "missing"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = -6, start_deg = 30, end_deg = 90 }}\n{ok_ctrl}"),
+        &["surface[1].arc.radius", "positive"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ centre = [100, 0], radius = 6, start_deg = 30, end_deg = 90 }}\n{ok_ctrl}"),
+        &["surface[1].arc.centre", "unknown key"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = 120, start_deg = 30, end_deg = 150 }}\n{ok_ctrl}"),
+        &["bad.toml:4", "leaves the sheet at s = "],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}flat_curve = {{ kind = \"nurbs\", control = [[0, 50], [100, 60], [200, 50]] }}\n{ok_ctrl}"),
+        &["surface[1].flat_curve.kind", "bspline"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}{arc}{ok_ctrl}"),
+        &[
+            "bad.toml:4",
+            "bends less than the curve drawn on the sheet",
+            "short by",
+        ],
+    );
     assert_spec_fails(
         &dir,
         &format!("{head}outline = [200, -1]\n{ok_line}{ok_ctrl}"),
@@ -1052,6 +1096,45 @@ fn bent_arc_band_pattern_and_flat_curve_spec() {
     let len = spec.pieces[0].path.length();
     assert!((bent.lengths[0] - len).abs() / len < 1e-6);
     assert!(bent.drifts[0] <= spec.tolerance, "{}", bent.drifts[0]);
+    // Its control curve is a quintic Bézier within 0.03 % of the circle of radius 100, so the
+    // band is nearly the cone with its apex 111.8 mm off the circle's plane: rulings nearly
+    // radial on the sheet, their ends near the cone (the tolerance, magnified by R/H as in the
+    // exact cone's test, plus what the Bézier's curvature error turns the rulings by).
+    let h_apex = (150.0f64 * 150.0 - 100.0 * 100.0).sqrt();
+    let folds: Vec<_> = bent.rulings.iter().filter(|r| r.piece == Some(0)).collect();
+    let tilt = folds
+        .iter()
+        .map(|r| {
+            r.dir
+                .perp_dot(r.point.normalize())
+                .abs()
+                .asin()
+                .to_degrees()
+        })
+        .fold(0.0, f64::max);
+    let z_sign = folds
+        .iter()
+        .flat_map(|r| r.edges.iter().flatten())
+        .map(|&i| bent.mesh.vertices[i])
+        .map(|v| v.z * (v.x.hypot(v.y) - 100.0))
+        .sum::<f64>()
+        .signum();
+    let mut off_cone = 0.0f64;
+    for &i in folds.iter().flat_map(|r| r.edges.iter().flatten()) {
+        let v = bent.mesh.vertices[i];
+        let z = -v.z * z_sign;
+        off_cone = off_cone.max((v.x.hypot(v.y) - 100.0 * (1.0 - z / h_apex)).abs());
+    }
+    eprintln!(
+        "arc band: {} rulings, at most {tilt:.3}° off the radius, ends within {off_cone:.3} mm of the cone, drift {:.4} mm",
+        folds.len(),
+        bent.drifts[0]
+    );
+    assert!(tilt < 0.5, "{tilt}");
+    assert!(
+        off_cone < 2.0 * spec.tolerance * 150.0 / h_apex,
+        "{off_cone}"
+    );
 
     // A Bézier drawn on the sheet (`flat_curve`), gently curved, on a curve bent much more.
     let dir = scratch("bent-flat-curve");
