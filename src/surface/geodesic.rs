@@ -1,5 +1,6 @@
-//! Bent sheets (issue 5): a flat sheet bent so that a straight line drawn on it follows a 3D
-//! control curve — the geodesic-controlled developables of Bo & Wang 2007 (seed 004).
+//! Bent sheets (issue 5): a flat sheet bent so that a line or curve drawn on it follows a 3D
+//! control curve — the geodesic-controlled developables of Bo & Wang 2007 (seed 004), with
+//! their extension to non-geodesic control curves (§5).
 //!
 //! The sheet is given flat (an outline, holes allowed) with one curve on it per curved piece —
 //! a straight line, or a planar curve ([`FlatPath`]: a circular arc or a Bézier / B-spline) —
@@ -69,14 +70,15 @@
 //!   faces the surface normal `n`, chosen at the first curved point of the control curve: the
 //!   given start normal for handles, else the side with `n·z > 0` (then `n·y > 0`, `n·x > 0`
 //!   when `n` is horizontal; for a curve on the sheet, of its two normals the one with the
-//!   larger `n·z`, then `n·y`, then `n·x`). Bending a sheet that lies printed side up keeps it up at the start.
-//!   Where the curve is straight (an inflection, κ = 0) the normal is carried over unchanged.
+//!   larger `n·z`, then `n·y`, then `n·x`). Bending a sheet that lies printed side up keeps it
+//!   up at the start. Where the curve is straight (an inflection, κ = 0) the normal is carried
+//!   over unchanged.
 //! - Folds turning by less than 1e-9 rad are left out (straight stretches stay planar).
 //! - Curves on the sheet (§5): `κ_n` is taken as 0 where `κ_n² < 1e-10 κ²` (the control curve
 //!   lies flat on the sheet there to 1e-5 of its curvature: an exact circle fitted to length
 //!   lands here, not on rounding noise), and a curvature short of `|c|` by 1e-9 relative is
 //!   rounding, not a refusal. Of the two normals (branches σ = ±1) the first curved point takes
-//!   the one by the sign rule below, later points the one nearer the previous normal. `θ'` is
+//!   the one by the sign rule above, later points the one nearer the previous normal. `θ'` is
 //!   a central difference over ±1 µm of arc length (one-sided at the ends), on the point's
 //!   branch. The flat curve must lie on the sheet (256 samples); rulings are drawn through its
 //!   points at the folds, so a flat curve's own curvature needs no sampling.
