@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flatcut::geom::curve::Curve;
-use flatcut::surface::geodesic::{self, BentSpec, Control, LengthFit, PieceSpec};
+use flatcut::surface::geodesic::{self, BentSpec, Control, FlatPath, LengthFit, PieceSpec};
 use flatcut::surface::strip::BendLines;
 use glam::{DVec2, DVec3};
 
@@ -18,7 +18,7 @@ fn a4(tolerance: f64) -> BentSpec {
         ],
         holes: vec![],
         pieces: vec![PieceSpec {
-            line: [DVec2::new(105.0, 0.0), DVec2::new(105.0, 297.0)],
+            path: FlatPath::Line([DVec2::new(105.0, 0.0), DVec2::new(105.0, 297.0)]),
             control: Control::Curve(Curve::Bezier {
                 control: vec![
                     DVec3::new(105.0, 0.0, 0.0),
@@ -80,6 +80,19 @@ fn bench(c: &mut Criterion) {
     let fine = a4(0.01);
     g.bench_function("bend+unfold A4 0.01mm", |b| {
         b.iter(|| bend_and_unfold(&fine))
+    });
+    // A curve on the sheet (§5): the lamp-shade band bent onto its cone by its middle arc.
+    let band = flatcut::spec::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/patterns/bent-arc-band.toml"
+    )))
+    .expect("pattern loads")
+    .surfaces[0]
+        .bent
+        .clone()
+        .expect("a bent sheet");
+    g.bench_function("bend+unfold arc band 0.1mm", |b| {
+        b.iter(|| bend_and_unfold(&band))
     });
     g.finish();
 }

@@ -100,14 +100,19 @@
 //!
 //! A `kind = "bent-sheet"` surface is a flat sheet bent along a control curve (see
 //! `surface::geodesic`): `outline` (required: `[width, height]` from the origin, or a list of
-//! `[x, y]` points), `holes` (optional list of point lists), `line` (required: two points on the
-//! sheet), exactly one of `control_points` (a list of `[x, y, z]` Bézier control points, or a
+//! `[x, y]` points), `holes` (optional list of point lists), exactly one of `line` (two points on
+//! the sheet: the control curve is a geodesic), `arc` (`{ center = [x, y], radius, start_deg,
+//! end_deg }`, degrees from +x, counter-clockwise when `end_deg > start_deg`) and `flat_curve`
+//! (Bézier control points `[[x, y], ...]` on the sheet, or `{ kind = "bspline", control,
+//! degree }`): a curve on the sheet whose curvature the bent sheet keeps as geodesic curvature
+//! (§5), then exactly one of `control_points` (a list of `[x, y, z]` Bézier control points, or a
 //! curve table of kind `bezier` or `bspline`) and `handles` (`{ start, start_normal, end,
 //! end_normal }`), `length_fit` ("scale" default, "trim"), `tolerance` (mm, default 0.05),
 //! `bend_lines` (as strips) and `name`. Several curved pieces: `pieces = [{ line, control_points
-//! | handles, length_fit }, ...]` instead of the top-level keys. Errors about the geometry (a
-//! point off the sheet, the curve of regression on the sheet) name the line of `line` (or of
-//! `pieces`).
+//! | handles, length_fit }, ...]` (with `arc` or `flat_curve` in place of `line` as above)
+//! instead of the top-level keys. Errors about the geometry (a point off the sheet, the curve of
+//! regression on the sheet, a control curve curving less than the curve on the sheet) name the
+//! line of `line`, `arc` or `flat_curve` (or of `pieces`).
 //!
 //! # Boundaries (issue 6)
 //!
@@ -620,6 +625,8 @@ struct RawSurface {
     outline: Option<Spanned<toml::Value>>,
     holes: Option<Spanned<toml::Value>>,
     line: Option<Spanned<toml::Value>>,
+    arc: Option<Spanned<toml::Value>>,
+    flat_curve: Option<Spanned<toml::Value>>,
     control_points: Option<Spanned<toml::Value>>,
     handles: Option<Spanned<toml::Value>>,
     length_fit: Option<Spanned<toml::Value>>,
@@ -1789,7 +1796,9 @@ impl Ctx<'_> {
 // kind = "bent-sheet"
 // outline = [210, 297]              # width × height from (0, 0), or [[x, y], ...]
 // holes = [[[80, 120], [130, 120], [130, 170], [80, 170]]]   # optional
-// line = [[105, 0], [105, 297]]     # a straight line on the sheet, start to end
+// line = [[105, 0], [105, 297]]     # a straight line on the sheet, start to end, or
+// arc = { center = [105, 0], radius = 150, start_deg = 60, end_deg = 120 }   # an arc, or
+// flat_curve = [[0, 40], [50, 48], [110, 32], [160, 40]]   # a Bézier on the sheet (§5)
 // control_points = [[0, 0, 0], [0, 100, 60], [0, 200, -60], [0, 297, 0]]   # a Bézier, or
 // control_points = { kind = "bspline", control = [...], degree = 3 }
 // handles = { start = [0, 0, 0], start_normal = [0, 0, 1], end = [0, 250, 0], end_normal = [0, 0, 1] }
@@ -1806,6 +1815,8 @@ impl Ctx<'_> {
             ("outline", &s.outline),
             ("holes", &s.holes),
             ("line", &s.line),
+            ("arc", &s.arc),
+            ("flat_curve", &s.flat_curve),
             ("control_points", &s.control_points),
             ("handles", &s.handles),
             ("length_fit", &s.length_fit),
@@ -1877,6 +1888,183 @@ impl Ctx<'_> {
             .collect()
     }
 
+    /// The curve on the sheet of one bent piece: exactly one of `line` (two points), `arc`
+    /// (`{ center, radius, start_deg, end_deg }`) and `flat_curve` (Bézier control points
+    /// `[[x, y], ...]` or `{ kind = "bezier" | "bspline", control, degree }`).
+    fn flat_path(
+        &self,
+        pk: &str,
+        [line, arc, curve]: [Option<&toml::Value>; 3],
+        at: usize,
+    ) -> Result<crate::surface::geodesic::FlatPath, SpecError> {
+        use crate::surface::geodesic::{FlatPath, Spline};
+        let num = |v: Option<&toml::Value>| match v {
+            Some(toml::Value::Integer(i)) => Some(*i as f64),
+            Some(toml::Value::Float(f)) if f.is_finite() => Some(*f),
+            _ => None,
+        };
+        match (line, arc, curve) {
+            (Some(lv), None, None) => {
+                let pts = self.pts2(lv, &format!("{pk}line"), at, 2)?;
+                if pts.len() != 2 {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{pk}line"),
+                        format!(
+                            "must be exactly two points [[x0, y0], [x1, y1]], got {}",
+                            pts.len()
+                        ),
+                    ));
+                }
+                Ok(FlatPath::Line([pts[0], pts[1]]))
+            }
+            (None, Some(av), None) => {
+                let ak = format!("{pk}arc");
+                const KEYS: [&str; 4] = ["center", "radius", "start_deg", "end_deg"];
+                let toml::Value::Table(t) = av else {
+                    return Err(self.invalid(
+                        at,
+                        &ak,
+                        format!(
+                            "must be a table {{ center = [x, y], radius, start_deg, end_deg }}, got {}",
+                            av.type_str()
+                        ),
+                    ));
+                };
+                if let Some(k) = t.keys().find(|k| !KEYS.contains(&k.as_str())) {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{ak}.{k}"),
+                        format!("unknown key; expected {}", one_of(&KEYS)),
+                    ));
+                }
+                let center = match t.get("center") {
+                    Some(v) => self.pt2(v, &format!("{ak}.center"), at)?,
+                    None => {
+                        return Err(self.invalid(
+                            at,
+                            &format!("{ak}.center"),
+                            "missing: the arc's centre on the sheet [x, y] (mm)".to_string(),
+                        ))
+                    }
+                };
+                let get = |k: &str, what: &str| {
+                    num(t.get(k)).ok_or_else(|| {
+                        self.invalid(
+                            at,
+                            &format!("{ak}.{k}"),
+                            format!("missing or not a finite number: {what}"),
+                        )
+                    })
+                };
+                let radius = get("radius", "the arc's radius (mm)")?;
+                let start_deg = get("start_deg", "the angle of the arc's start (degrees from +x)")?;
+                let end_deg = get(
+                    "end_deg",
+                    "the angle of the arc's end (degrees from +x; counter-clockwise when larger than start_deg)",
+                )?;
+                if radius <= 0.0 {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{ak}.radius"),
+                        format!("must be positive (mm), got {radius}"),
+                    ));
+                }
+                let sweep = (end_deg - start_deg).abs();
+                if sweep == 0.0 || sweep > 360.0 {
+                    return Err(self.invalid(
+                        at,
+                        &format!("{ak}.end_deg"),
+                        format!(
+                            "the arc must turn by more than 0° and at most 360°, got start_deg {start_deg}, end_deg {end_deg}"
+                        ),
+                    ));
+                }
+                Ok(FlatPath::Arc {
+                    center,
+                    radius,
+                    start_deg,
+                    end_deg,
+                })
+            }
+            (None, None, Some(cv)) => {
+                let ck = format!("{pk}flat_curve");
+                let z = |p: Vec<glam::DVec2>| -> Vec<glam::DVec3> {
+                    p.iter().map(|q| glam::DVec3::new(q.x, q.y, 0.0)).collect()
+                };
+                match cv {
+                    toml::Value::Array(_) => {
+                        Ok(FlatPath::Curve(Spline::bezier(z(self.pts2(cv, &ck, at, 3)?))))
+                    }
+                    toml::Value::Table(t) => {
+                        const KEYS: [&str; 3] = ["kind", "control", "degree"];
+                        if let Some(k) = t.keys().find(|k| !KEYS.contains(&k.as_str())) {
+                            return Err(self.invalid(
+                                at,
+                                &format!("{ck}.{k}"),
+                                format!("unknown key; expected {}", one_of(&KEYS)),
+                            ));
+                        }
+                        let control = match t.get("control") {
+                            Some(v) => z(self.pts2(v, &format!("{ck}.control"), at, 3)?),
+                            None => {
+                                return Err(self.invalid(
+                                    at,
+                                    &format!("{ck}.control"),
+                                    "missing: the control points on the sheet [[x, y], ...]"
+                                        .to_string(),
+                                ))
+                            }
+                        };
+                        match t.get("kind").and_then(|v| v.as_str()) {
+                            Some("bezier") | None => Ok(FlatPath::Curve(Spline::bezier(control))),
+                            Some("bspline") => {
+                                let degree = match t.get("degree") {
+                                    None => 3,
+                                    Some(toml::Value::Integer(d)) if (2..=9).contains(d) => {
+                                        *d as usize
+                                    }
+                                    Some(v) => {
+                                        return Err(self.invalid(
+                                            at,
+                                            &format!("{ck}.degree"),
+                                            format!("must be an integer from 2 to 9, got {v}"),
+                                        ))
+                                    }
+                                };
+                                Ok(FlatPath::Curve(Spline::bspline(control, degree)))
+                            }
+                            Some(k) => Err(self.invalid(
+                                at,
+                                &format!("{ck}.kind"),
+                                format!("must be \"bezier\" or \"bspline\", got \"{k}\""),
+                            )),
+                        }
+                    }
+                    v => Err(self.invalid(
+                        at,
+                        &ck,
+                        format!(
+                            "must be Bézier control points [[x, y], ...] or a table {{ kind = \"bspline\", control, degree }}, got {}",
+                            v.type_str()
+                        ),
+                    )),
+                }
+            }
+            (None, None, None) => Err(self.invalid(
+                at,
+                &format!("{pk}line"),
+                "missing: the curve on the sheet the control curve bends: `line = [[x0, y0], [x1, y1]]`, `arc = { center = [x, y], radius, start_deg, end_deg }` or `flat_curve = [[x, y], ...]`".to_string(),
+            )),
+            _ => Err(self.invalid(
+                at,
+                &format!("{pk}line"),
+                "give exactly one of `line`, `arc` and `flat_curve` (the curve on the sheet)"
+                    .to_string(),
+            )),
+        }
+    }
+
     /// One `kind = "bent-sheet"` entry.
     fn bent_surface(
         &self,
@@ -1885,13 +2073,13 @@ impl Ctx<'_> {
         header_line: usize,
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
-        use crate::surface::geodesic::{Control, LengthFit, PieceSpec};
+        use crate::surface::geodesic::{Control, FlatPath, LengthFit, PieceSpec};
         for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
             if let Some(v) = v {
                 return Err(self.invalid(
                     self.line(v.span()),
                     &format!("{key}.{k}"),
-                    "is for mesh surfaces; a bent sheet takes `outline`, `line` and `control_points` or `handles`".to_string(),
+                    "is for mesh surfaces; a bent sheet takes `outline`, `line` (or `arc`, `flat_curve`) and `control_points` or `handles`".to_string(),
                 ));
             }
         }
@@ -1900,7 +2088,7 @@ impl Ctx<'_> {
                 return Err(self.invalid(
                     self.line(v.span()),
                     &format!("{key}.{k}"),
-                    "is for strips; a bent sheet takes `line` and `control_points` or `handles`"
+                    "is for strips; a bent sheet takes `line` (or `arc`, `flat_curve`) and `control_points` or `handles`"
                         .to_string(),
                 ));
             }
@@ -1980,30 +2168,12 @@ impl Ctx<'_> {
         }
         // One piece from a table of keys (the surface itself or an entry of `pieces`).
         let piece = |pk: &str,
-                     line: Option<&toml::Value>,
+                     path: FlatPath,
                      control: Option<&toml::Value>,
                      handles: Option<&toml::Value>,
                      fit: Option<&toml::Value>,
                      at: usize|
          -> Result<PieceSpec, SpecError> {
-            let lv = line.ok_or_else(|| {
-                self.invalid(
-                    at,
-                    &format!("{pk}line"),
-                    "missing: the straight line on the sheet the control curve bends, [[x0, y0], [x1, y1]]".to_string(),
-                )
-            })?;
-            let pts = self.pts2(lv, &format!("{pk}line"), at, 2)?;
-            if pts.len() != 2 {
-                return Err(self.invalid(
-                    at,
-                    &format!("{pk}line"),
-                    format!(
-                        "must be exactly two points [[x0, y0], [x1, y1]], got {}",
-                        pts.len()
-                    ),
-                ));
-            }
             let control = match (control, handles) {
                 (Some(_), Some(_)) | (None, None) => {
                     return Err(self.invalid(
@@ -2086,11 +2256,7 @@ impl Ctx<'_> {
                     ))
                 }
             };
-            Ok(PieceSpec {
-                line: [pts[0], pts[1]],
-                control,
-                fit,
-            })
+            Ok(PieceSpec { path, control, fit })
         };
         let mut pieces = Vec::new();
         let line_no;
@@ -2099,6 +2265,8 @@ impl Ctx<'_> {
             line_no = pl;
             for (k, v) in [
                 ("line", &s.line),
+                ("arc", &s.arc),
+                ("flat_curve", &s.flat_curve),
                 ("control_points", &s.control_points),
                 ("handles", &s.handles),
                 ("length_fit", &s.length_fit),
@@ -2129,24 +2297,32 @@ impl Ctx<'_> {
                     return Err(self.invalid(
                         pl,
                         pk.trim_end_matches('.'),
-                        "must be a table { line, control_points } or { line, handles }".to_string(),
+                        "must be a table { line | arc | flat_curve, control_points | handles }"
+                            .to_string(),
                     ));
                 };
+                const KEYS: [&str; 6] = [
+                    "line",
+                    "arc",
+                    "flat_curve",
+                    "control_points",
+                    "handles",
+                    "length_fit",
+                ];
                 for k in t.keys() {
-                    if !["line", "control_points", "handles", "length_fit"].contains(&k.as_str()) {
+                    if !KEYS.contains(&k.as_str()) {
                         return Err(self.invalid(
                             pl,
                             &format!("{pk}{k}"),
-                            format!(
-                                "unknown key; expected {}",
-                                one_of(&["line", "control_points", "handles", "length_fit"])
-                            ),
+                            format!("unknown key; expected {}", one_of(&KEYS)),
                         ));
                     }
                 }
+                let path =
+                    self.flat_path(&pk, [t.get("line"), t.get("arc"), t.get("flat_curve")], pl)?;
                 pieces.push(piece(
                     &pk,
-                    t.get("line"),
+                    path,
                     t.get("control_points"),
                     t.get("handles"),
                     t.get("length_fit"),
@@ -2154,20 +2330,30 @@ impl Ctx<'_> {
                 )?);
             }
         } else {
-            let at = s.line.as_ref().map_or(header_line, |v| self.line(v.span()));
+            let flat_key = s.line.as_ref().or(s.arc.as_ref()).or(s.flat_curve.as_ref());
+            let at = flat_key.map_or(header_line, |v| self.line(v.span()));
             line_no = at;
             let cl = s
                 .control_points
                 .as_ref()
                 .or(s.handles.as_ref())
                 .map_or(at, |v| self.line(v.span()));
+            let path = self.flat_path(
+                &format!("{key}."),
+                [
+                    s.line.as_ref().map(|v| v.get_ref()),
+                    s.arc.as_ref().map(|v| v.get_ref()),
+                    s.flat_curve.as_ref().map(|v| v.get_ref()),
+                ],
+                at,
+            )?;
             pieces.push(piece(
                 &format!("{key}."),
-                s.line.as_ref().map(|v| v.get_ref()),
+                path,
                 s.control_points.as_ref().map(|v| v.get_ref()),
                 s.handles.as_ref().map(|v| v.get_ref()),
                 s.length_fit.as_ref().map(|v| v.get_ref()),
-                if s.line.is_some() { cl } else { at },
+                if flat_key.is_some() { cl } else { at },
             )?);
         }
         let name = self

@@ -8,7 +8,8 @@ use common::*;
 use flatcut::geom::curve::Curve;
 use flatcut::output::hpgl;
 use flatcut::surface::geodesic::{
-    self, ArcLength, BentSpec, Control, GeodesicError, LengthFit, Param, PieceSpec, Spline,
+    self, ArcLength, BentSpec, Control, FlatPath, GeodesicError, LengthFit, Param, PieceSpec,
+    Spline,
 };
 use flatcut::surface::strip::BendLines;
 use glam::{DVec2, DVec3};
@@ -61,7 +62,9 @@ fn worst_edge_error(bent: &geodesic::Bent) -> f64 {
 
 /// The folded line in 3D: the line's start, its crossings with the rulings of `piece`, its end.
 fn folded_line(spec: &BentSpec, bent: &geodesic::Bent, piece: usize) -> Option<Vec<DVec3>> {
-    let [a, b] = spec.pieces[piece].line;
+    let FlatPath::Line([a, b]) = spec.pieces[piece].path else {
+        return None;
+    };
     let d = (b - a).normalize();
     let mut pts = Vec::new();
     let on_mesh = |p: DVec2| -> Option<DVec3> {
@@ -167,13 +170,13 @@ fn bent_isometry_triangles_and_control_curve_length() {
             bent.mesh.faces.len(),
             bent.rulings.len(),
             bent.lengths[0],
-            spec.pieces[0].line[0].distance(spec.pieces[0].line[1]),
+            spec.pieces[0].path.length(),
             bent.drifts[0]
         );
         assert!(worst < 1e-6, "{path}: {worst}");
         // The control curve after re-parameterisation is as long as the line, and so is the
         // folded line through the mesh.
-        let len = spec.pieces[0].line[0].distance(spec.pieces[0].line[1]);
+        let len = spec.pieces[0].path.length();
         assert!((bent.lengths[0] - len).abs() / len < 1e-6, "{path}");
         // (Not where the line crosses a hole: the lamp panel's.)
         if let Some(line) = folded_line(&spec, &bent, 0) {
@@ -282,7 +285,7 @@ fn rect(w: f64, h: f64) -> Vec<DVec2> {
 
 fn piece(line: [DVec2; 2], control: Vec<DVec3>) -> PieceSpec {
     PieceSpec {
-        line,
+        path: FlatPath::Line(line),
         control: Control::Curve(Curve::Bezier { control }),
         fit: LengthFit::Scale,
     }
@@ -298,7 +301,7 @@ fn bent_helix_gives_the_circular_cylinder() {
         outline: rect(len, 40.0),
         holes: vec![],
         pieces: vec![PieceSpec {
-            line: [DVec2::new(0.0, 20.0), DVec2::new(len, 20.0)],
+            path: FlatPath::Line([DVec2::new(0.0, 20.0), DVec2::new(len, 20.0)]),
             control: Control::Curve(Curve::Bezier { control: vec![] }),
             fit: LengthFit::Trim,
         }],
@@ -509,7 +512,7 @@ fn bent_hole_beside_the_rulings_and_two_pieces() {
     // The second piece's rulings turned so that they reach the first piece's: refused.
     let mut crossing = spec.clone();
     crossing.holes.clear();
-    crossing.pieces[1].line = [DVec2::new(60.0, 0.0), DVec2::new(60.0, 100.0)];
+    crossing.pieces[1].path = FlatPath::Line([DVec2::new(60.0, 0.0), DVec2::new(60.0, 100.0)]);
     match geodesic::bend(&crossing) {
         Err(GeodesicError::Crossing { a, b, .. }) => assert_eq!((a, b), (1, 2)),
         other => panic!("expected crossing rulings, got {:?}", other.map(|_| ())),
@@ -548,7 +551,7 @@ fn bent_handles_meet_their_normals() {
         outline: rect(200.0, 80.0),
         holes: vec![],
         pieces: vec![PieceSpec {
-            line: [DVec2::new(0.0, 40.0), DVec2::new(200.0, 40.0)],
+            path: FlatPath::Line([DVec2::new(0.0, 40.0), DVec2::new(200.0, 40.0)]),
             control: Control::Handles {
                 start: DVec3::ZERO,
                 start_normal: n0,
@@ -620,6 +623,50 @@ fn bent_bad_input_exits_1_naming_the_key() {
         &dir,
         &format!("{head}{ok_outline}{ok_line}"),
         &["exactly one of `control_points` and `handles`"],
+    );
+    // Curves on the sheet (§5): `arc` and `flat_curve`, exactly one of them or `line`.
+    let arc = "arc = { center = [100, 0], radius = 60, start_deg = 30, end_deg = 150 }\n";
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}{ok_line}{arc}{ok_ctrl}"),
+        &[
+            "bad.toml:4",
+            "exactly one of `line`, `arc` and `flat_curve`",
+        ],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = 60, start_deg = 30 }}\n{ok_ctrl}"),
+        &["surface[1].arc.end_deg", "missing"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = -6, start_deg = 30, end_deg = 90 }}\n{ok_ctrl}"),
+        &["surface[1].arc.radius", "positive"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ centre = [100, 0], radius = 6, start_deg = 30, end_deg = 90 }}\n{ok_ctrl}"),
+        &["surface[1].arc.centre", "unknown key"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}arc = {{ center = [100, 0], radius = 120, start_deg = 30, end_deg = 150 }}\n{ok_ctrl}"),
+        &["bad.toml:4", "leaves the sheet at s = "],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}flat_curve = {{ kind = \"nurbs\", control = [[0, 50], [100, 60], [200, 50]] }}\n{ok_ctrl}"),
+        &["surface[1].flat_curve.kind", "bspline"],
+    );
+    assert_spec_fails(
+        &dir,
+        &format!("{head}{ok_outline}{arc}{ok_ctrl}"),
+        &[
+            "bad.toml:4",
+            "bends less than the curve drawn on the sheet",
+            "short by",
+        ],
     );
     assert_spec_fails(
         &dir,
@@ -749,4 +796,440 @@ height = 297
         "{}",
         stderr(&o)
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Non-geodesic control curves (§5): a curve on the sheet whose geodesic curvature is kept
+// ---------------------------------------------------------------------------------------------
+
+/// A circle of radius `r` about `centre` in the plane z = `z`, from angle `a0` over `sweep`
+/// (radians, counter-clockwise seen from +z): exact derivatives.
+struct Circle {
+    centre: DVec2,
+    r: f64,
+    z: f64,
+    a0: f64,
+    sweep: f64,
+}
+
+impl Param for Circle {
+    fn domain(&self) -> (f64, f64) {
+        (self.a0, self.a0 + self.sweep)
+    }
+    fn eval(&self, u: f64) -> [DVec3; 4] {
+        let (s, c) = u.sin_cos();
+        let r = self.r;
+        [
+            DVec3::new(self.centre.x + r * c, self.centre.y + r * s, self.z),
+            DVec3::new(-r * s, r * c, 0.0),
+            DVec3::new(-r * c, -r * s, 0.0),
+            DVec3::new(r * s, -r * c, 0.0),
+        ]
+    }
+}
+
+/// An annulus sector about the origin between radii `r0` and `r1`, angles `a0`..`a1` (degrees).
+fn annulus_sector(r0: f64, r1: f64, a0: f64, a1: f64) -> Vec<DVec2> {
+    let n = 48;
+    let at = |r: f64, i: usize| {
+        let a = (a0 + (a1 - a0) * i as f64 / n as f64).to_radians();
+        DVec2::new(r * a.cos(), r * a.sin())
+    };
+    let mut out: Vec<DVec2> = (0..=n).map(|i| at(r1, i)).collect();
+    out.extend((0..=n).rev().map(|i| at(r0, i)));
+    out
+}
+
+fn arc_piece(radius: f64, start_deg: f64, end_deg: f64) -> PieceSpec {
+    PieceSpec {
+        path: FlatPath::Arc {
+            center: DVec2::ZERO,
+            radius,
+            start_deg,
+            end_deg,
+        },
+        control: Control::Curve(Curve::Bezier { control: vec![] }),
+        fit: LengthFit::Scale,
+    }
+}
+
+#[test]
+fn bent_arc_on_the_same_planar_arc_stays_flat() {
+    // The flat arc of radius 60 from 10° to 100°, and as control curve that very arc in space.
+    let (r, a0, a1) = (60.0, 10.0, 100.0);
+    let spec = BentSpec {
+        outline: annulus_sector(40.0, 80.0, 0.0, 110.0),
+        holes: vec![],
+        pieces: vec![arc_piece(r, a0, a1)],
+        tolerance: 0.05,
+        bend_lines: BendLines::All,
+    };
+    let circle = Circle {
+        centre: DVec2::ZERO,
+        r,
+        z: 0.0,
+        a0: f64::to_radians(a0),
+        sweep: f64::to_radians(a1 - a0),
+    };
+    let bent = geodesic::bend_with(&spec, &[(&circle, None)]).unwrap();
+    let worst_fold = bent
+        .rulings
+        .iter()
+        .map(|r| r.angle.abs())
+        .fold(0.0, f64::max);
+    // The sheet is where it lay: every vertex at its flat position, z = 0.
+    let moved = bent
+        .mesh
+        .vertices
+        .iter()
+        .zip(&bent.flat)
+        .map(|(v, f)| v.distance(DVec3::new(f.x, f.y, 0.0)))
+        .fold(0.0, f64::max);
+    eprintln!(
+        "planar arc r {r}: {} rulings, largest fold {worst_fold:.2e} rad, vertices moved {moved:.2e} mm, drift {:.2e} mm",
+        bent.rulings.len(),
+        bent.drifts[0]
+    );
+    assert!(worst_fold <= 1e-9, "{worst_fold}");
+    assert!(bent.bends.is_empty());
+    assert!(moved < 1e-9, "{moved}");
+    assert!(worst_edge_error(&bent) < 1e-9);
+    // Turned the other way round (clockwise on the sheet, the curve from its other end) it
+    // is still the same flat sheet, printed side down (the sign of g follows the flat curve).
+    let cw = BentSpec {
+        pieces: vec![arc_piece(r, a1, a0)],
+        ..spec.clone()
+    };
+    let back = Circle {
+        centre: DVec2::new(0.0, 0.0),
+        r,
+        z: 0.0,
+        a0: f64::to_radians(a0),
+        sweep: f64::to_radians(a1 - a0),
+    };
+    let bent = geodesic::bend_with(&cw, &[(&back, None)]).unwrap();
+    let worst_fold = bent.rulings.iter().map(|r| r.angle).fold(0.0, f64::max);
+    let flat_z = bent
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| v.z.abs())
+        .fold(0.0, f64::max);
+    assert!(worst_fold <= 1e-9 && flat_z < 1e-9, "{worst_fold} {flat_z}");
+}
+
+/// Closest distance between the 3D line through `p` along `d` and the point `q`.
+fn line_point_distance(p: DVec3, d: DVec3, q: DVec3) -> f64 {
+    (q - p).cross(d.normalize()).length()
+}
+
+#[test]
+fn bent_arc_on_a_parallel_circle_gives_its_cone() {
+    // A cone with its apex H above the centre of a circle of radius ρ: the slant distance to the
+    // circle is R = √(ρ² + H²) = 100, and the cone develops into a disc of radius R on which the
+    // circle is an arc of radius R (its geodesic curvature 1/R is kept).
+    let (rho, h_apex): (f64, f64) = (60.0, 80.0);
+    let big_r = (rho * rho + h_apex * h_apex).sqrt();
+    let sweep3 = 100.0f64; // degrees of the circle in space
+    let sweep2 = sweep3 * rho / big_r; // degrees of the arc on the sheet
+    let (a0, a1) = (30.0, 30.0 + sweep2);
+    let tol = 0.02;
+    let spec = BentSpec {
+        outline: annulus_sector(70.0, 130.0, a0 - 2.0, a1 + 2.0),
+        holes: vec![],
+        pieces: vec![arc_piece(big_r, a0, a1)],
+        tolerance: tol,
+        bend_lines: BendLines::All,
+    };
+    let circle = Circle {
+        centre: DVec2::ZERO,
+        r: rho,
+        z: 0.0,
+        a0: 0.0,
+        sweep: sweep3.to_radians(),
+    };
+    let bent = geodesic::bend_with(&spec, &[(&circle, None)]).unwrap();
+    // (c) Isometry on every triangle, and the control curve as long as the arc on the sheet.
+    let worst = worst_edge_error(&bent);
+    let flat_len = spec.pieces[0].path.length();
+    let len_err = (bent.lengths[0] - flat_len).abs() / flat_len;
+    assert!(worst < 1e-9, "{worst}");
+    assert!(len_err < 1e-6, "{} vs {flat_len}", bent.lengths[0]);
+    // On the sheet the rulings are the radii of the disc: they cross the arc at right angles
+    // (a parallel circle is a line of curvature: τ_g = 0).
+    let folds: Vec<_> = bent.rulings.iter().filter(|r| r.piece == Some(0)).collect();
+    assert!(folds.len() > 20, "{}", folds.len());
+    let radial = folds
+        .iter()
+        .map(|r| r.dir.perp_dot(r.point.normalize()).abs())
+        .fold(0.0, f64::max);
+    assert!(radial < 1e-9, "flat rulings off the radius by {radial}");
+    // In space every ruling runs through one point (the folded sheet is a pyramid over the
+    // disc's centre), and that point is the cone's apex, on the side the normal rule picks.
+    // The common point: where the last ruling comes closest to the first one.
+    let (first, last) = (folds[0], folds[folds.len() - 1]);
+    let (v0, v1) = (
+        bent.mesh.vertices[first.edges[0][0]],
+        bent.mesh.vertices[last.edges[0][0]],
+    );
+    let n = first.dir_3d.cross(last.dir_3d);
+    let t = (v1 - v0).cross(last.dir_3d).dot(n) / n.length_squared();
+    let q = v0 + first.dir_3d * t;
+    let apex = DVec3::new(0.0, 0.0, h_apex * q.z.signum());
+    let mut through = 0.0f64;
+    let mut worst_axis = 0.0f64;
+    for r in &folds {
+        let p = bent.mesh.vertices[r.edges[0][0]];
+        through = through.max(line_point_distance(p, r.dir_3d, q));
+        worst_axis = worst_axis.max(line_point_distance(p, r.dir_3d, apex));
+    }
+    eprintln!(
+        "cone ρ {rho} H {h_apex} (R {big_r}): {} rulings, isometry {worst:.1e}, length {len_err:.1e}, drift {:.4} mm, rulings meet within {through:.1e} mm, pass the apex {apex} within {worst_axis:.4} mm",
+        folds.len(),
+        bent.drifts[0]
+    );
+    assert!(bent.drifts[0] <= tol, "{}", bent.drifts[0]);
+    // (Flat rulings radial to 1e-9 rad over R = 100 mm: 1e-7 mm, and rounding in 30 folds.)
+    assert!(through < 1e-6, "{through}");
+    // The polyhedral cone's apex is the disc centre carried by the folds: its position inherits
+    // the folded arc's error (≤ tol) magnified by R/H along the axis (a pyramid over a polygon
+    // whose corners are off the circle by δ has its apex off by δ·R/H): 2·tol·R/H.
+    assert!(worst_axis < 2.0 * tol * big_r / h_apex, "{worst_axis}");
+    // The ruling ends lie on the cone: at distance ρ(1 − z/H) from the axis (apex side). (Not
+    // the sheet beyond the end rulings: it stays planar, §3.4.)
+    let mut worst_cone = 0.0f64;
+    for r in &folds {
+        for &i in r.edges.iter().flatten() {
+            let v = bent.mesh.vertices[i];
+            let z = v.z * apex.z.signum();
+            worst_cone =
+                worst_cone.max((DVec2::new(v.x, v.y).length() - rho * (1.0 - z / h_apex)).abs());
+        }
+    }
+    eprintln!("ruling ends off the cone by {worst_cone:.4} mm");
+    assert!(worst_cone < 2.0 * tol * big_r / h_apex, "{worst_cone}");
+}
+
+#[test]
+fn bent_arc_control_curve_too_straight_exits_1_with_position() {
+    let dir = scratch("bent-arc-short");
+    // An arc of radius 50 on the sheet, a control curve that is nearly straight in its middle.
+    let spec = write_spec(
+        &dir,
+        "short.toml",
+        r#"
+[[surface]]
+kind = "bent-sheet"
+name = "band"
+outline = [[-80, 0], [80, 0], [80, 70], [-80, 70]]
+arc = { center = [0, 0], radius = 50, start_deg = 30, end_deg = 150 }
+control_points = [[0, 0, 0], [40, 0, 40], [80, 0, 0], [120, 0, 40]]
+"#,
+    );
+    let o = flatcut(&["cut", &spec, "--dry-run", "-o", dir.to_str().unwrap()]);
+    let err = stderr(&o);
+    eprintln!("{err}");
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("short.toml:6"), "{err}");
+    assert!(
+        err.contains("bends less than the curve drawn on the sheet"),
+        "{err}"
+    );
+    let s: f64 = err
+        .split("s = ")
+        .nth(1)
+        .and_then(|t| t.split(" mm").next())
+        .and_then(|t| t.parse().ok())
+        .expect("arc length in the message");
+    // The S-shaped control curve is straight at its inflection, half way along.
+    let len = 50.0 * 120f64.to_radians();
+    assert!((s - 0.5 * len).abs() < 1.0, "{s} of {len}");
+    assert!(err.contains("short by"), "{err}");
+    assert!(!dir.join("band.plt").exists());
+    // The library's figures: the shortfall is the flat curvature minus the curve's.
+    let b = flatcut::spec::load(std::path::Path::new(&spec))
+        .unwrap()
+        .surfaces[0]
+        .bent
+        .clone()
+        .unwrap();
+    match geodesic::bend(&b) {
+        Err(GeodesicError::Curvature {
+            s: s2,
+            kappa,
+            c,
+            short,
+            ..
+        }) => {
+            assert!((s2 - s).abs() < 0.01);
+            assert!((c - 0.02).abs() < 1e-12, "{c}");
+            assert!(kappa < 1e-3, "{kappa}");
+            assert!(short > 0.0 && (short - (c - kappa)).abs() < 1e-12);
+        }
+        other => panic!("expected a curvature error, got {:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn bent_arc_band_pattern_and_flat_curve_spec() {
+    let out = scratch("bent-arc-band");
+    let o = flatcut(&[
+        "cut",
+        "patterns/bent-arc-band.toml",
+        "--device",
+        "hpgl-pens",
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The blank is the annulus sector: area (π/6)(180² − 120²), within 0.1 %.
+    let plt = std::fs::read_to_string(out.join("bent-arc-band.plt")).unwrap();
+    let cuts = cut_contours(&plt);
+    assert_eq!(cuts.len(), 1);
+    let (area, _) = area_perimeter(&cuts[0]);
+    let want = geodesic_sector_area();
+    eprintln!("arc band blank {area:.2} mm² vs {want:.2} mm²");
+    assert!((area - want).abs() / want < 1e-3, "{area} vs {want}");
+    let (spec, bent) = bent_of("patterns/bent-arc-band.toml");
+    assert!(worst_edge_error(&bent) < 1e-9);
+    let len = spec.pieces[0].path.length();
+    assert!((bent.lengths[0] - len).abs() / len < 1e-6);
+    assert!(bent.drifts[0] <= spec.tolerance, "{}", bent.drifts[0]);
+    // Its control curve is a quintic Bézier within 0.03 % of the circle of radius 100, so the
+    // band is nearly the cone with its apex 111.8 mm off the circle's plane: rulings nearly
+    // radial on the sheet, their ends near the cone (the tolerance, magnified by R/H as in the
+    // exact cone's test, plus what the Bézier's curvature error turns the rulings by).
+    let h_apex = (150.0f64 * 150.0 - 100.0 * 100.0).sqrt();
+    let folds: Vec<_> = bent.rulings.iter().filter(|r| r.piece == Some(0)).collect();
+    let tilt = folds
+        .iter()
+        .map(|r| {
+            r.dir
+                .perp_dot(r.point.normalize())
+                .abs()
+                .asin()
+                .to_degrees()
+        })
+        .fold(0.0, f64::max);
+    let z_sign = folds
+        .iter()
+        .flat_map(|r| r.edges.iter().flatten())
+        .map(|&i| bent.mesh.vertices[i])
+        .map(|v| v.z * (v.x.hypot(v.y) - 100.0))
+        .sum::<f64>()
+        .signum();
+    let mut off_cone = 0.0f64;
+    for &i in folds.iter().flat_map(|r| r.edges.iter().flatten()) {
+        let v = bent.mesh.vertices[i];
+        let z = -v.z * z_sign;
+        off_cone = off_cone.max((v.x.hypot(v.y) - 100.0 * (1.0 - z / h_apex)).abs());
+    }
+    eprintln!(
+        "arc band: {} rulings, at most {tilt:.3}° off the radius, ends within {off_cone:.3} mm of the cone, drift {:.4} mm",
+        folds.len(),
+        bent.drifts[0]
+    );
+    assert!(tilt < 0.5, "{tilt}");
+    assert!(
+        off_cone < 2.0 * spec.tolerance * 150.0 / h_apex,
+        "{off_cone}"
+    );
+
+    // A Bézier drawn on the sheet (`flat_curve`), gently curved, on a curve bent much more.
+    let dir = scratch("bent-flat-curve");
+    let path = write_spec(
+        &dir,
+        "s.toml",
+        r#"
+[[surface]]
+kind = "bent-sheet"
+outline = [160, 80]
+flat_curve = [[0, 40], [50, 48], [110, 32], [160, 40]]
+control_points = [[0, 0, 0], [40, 0, 40], [120, 0, 40], [160, 0, 0]]
+tolerance = 0.05
+"#,
+    );
+    let b = flatcut::spec::load(std::path::Path::new(&path))
+        .unwrap()
+        .surfaces[0]
+        .bent
+        .clone()
+        .unwrap();
+    assert!(matches!(b.pieces[0].path, FlatPath::Curve(_)));
+    let bent = geodesic::bend(&b).unwrap();
+    let worst = worst_edge_error(&bent);
+    let len = b.pieces[0].path.length();
+    eprintln!(
+        "flat Bézier: {} rulings, isometry {worst:.1e}, curve {:.6} for {len:.6} mm, drift {:.4} mm",
+        bent.rulings.len(),
+        bent.lengths[0],
+        bent.drifts[0]
+    );
+    assert!(worst < 1e-9);
+    assert!((bent.lengths[0] - len).abs() / len < 1e-6);
+    assert!(bent.drifts[0] <= 0.05);
+    // The normal turns against the curve here (c and κ vary: θ' ≠ 0); a finer tolerance must
+    // bring the folded curve closer (it would not with a wrong geodesic torsion).
+    let mut fine = b.clone();
+    fine.tolerance = 0.002;
+    let bent = geodesic::bend(&fine).unwrap();
+    eprintln!(
+        "flat Bézier at 0.002 mm: {} rulings, drift {:.5} mm",
+        bent.rulings.len(),
+        bent.drifts[0]
+    );
+    assert!(bent.drifts[0] <= 0.002, "{}", bent.drifts[0]);
+    assert!(worst_edge_error(&bent) < 1e-9);
+    let o = flatcut(&["cut", &path, "--dry-run", "-o", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+fn geodesic_sector_area() -> f64 {
+    // The pattern's outline is the sector polygon with 30 chords per arc.
+    let n = 30.0;
+    let a = 60f64.to_radians() / n;
+    0.5 * n * a.sin() * (180.0f64.powi(2) - 120.0f64.powi(2))
+}
+
+#[test]
+fn bent_arc_on_a_helix_follows_it_as_the_tolerance_shrinks() {
+    // A helix (κ = 0.0219/mm, τ = 0.0082/mm) carrying a flat arc of radius 100 mm: the normal
+    // turns along the curve (θ' = 0 but τ_g = τ + θ' ≠ 0 and the rulings are oblique). The
+    // folded arc must follow the helix to the tolerance at every tolerance: a wrong geodesic
+    // torsion would leave an error that does not shrink with the step.
+    let helix = Helix {
+        r: 40.0,
+        c: 15.0,
+        turns: 0.5,
+    };
+    let len = ArcLength::new(&helix).total();
+    let big_r = 100.0;
+    let sweep = (len / big_r).to_degrees();
+    for tol in [0.1, 0.01, 0.001] {
+        let spec = BentSpec {
+            outline: annulus_sector(80.0, 120.0, -5.0, sweep + 5.0),
+            holes: vec![],
+            pieces: vec![arc_piece(big_r, 0.0, sweep)],
+            tolerance: tol,
+            bend_lines: BendLines::All,
+        };
+        let bent = geodesic::bend_with(&spec, &[(&helix, None)]).unwrap();
+        let oblique = bent
+            .rulings
+            .iter()
+            .map(|r| r.dir.perp_dot(r.point.normalize()).abs())
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "helix on an arc at {tol} mm: {} rulings, drift {:.5} mm, isometry {:.1e}, rulings at least {:.1}° off the radius",
+            bent.rulings.len(),
+            bent.drifts[0],
+            worst_edge_error(&bent),
+            oblique.asin().to_degrees()
+        );
+        assert!(bent.drifts[0] <= tol, "{tol}: {}", bent.drifts[0]);
+        assert!(worst_edge_error(&bent) < 1e-9);
+        assert!((bent.lengths[0] - len).abs() / len < 1e-6);
+        assert!(oblique > 0.1, "{oblique}");
+    }
 }

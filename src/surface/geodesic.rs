@@ -1,29 +1,45 @@
-//! Bent sheets (issue 5): a flat sheet bent so that a straight line drawn on it follows a 3D
-//! control curve — the geodesic-controlled developables of Bo & Wang 2007 (seed 004).
+//! Bent sheets (issue 5): a flat sheet bent so that a line or curve drawn on it follows a 3D
+//! control curve — the geodesic-controlled developables of Bo & Wang 2007 (seed 004), with
+//! their extension to non-geodesic control curves (§5).
 //!
-//! The sheet is given flat (an outline, holes allowed) with one straight line on it per curved
-//! piece, and for each line a 3D control curve (Bézier or B-spline control points, or two
-//! handles: end points with surface normals). The surface is the rectifying developable of the
+//! The sheet is given flat (an outline, holes allowed) with one curve on it per curved piece —
+//! a straight line, or a planar curve ([`FlatPath`]: a circular arc or a Bézier / B-spline) —
+//! and for each a 3D control curve (Bézier or B-spline control points, or two handles: end
+//! points with surface normals). For a line the surface is the rectifying developable of the
 //! control curve, `X(s, t) = p(s) + t·r(s)` with `r` along the Darboux vector `τT + κB`
 //! (eq. 1, §3.1), mapped onto the flat outline by the isometry of §3.3 (steps 1–4: arc length
 //! along the line, ruling angle kept, rulings cut by the outline, distances measured along the
 //! ruling).
 //!
+//! For a curve on the sheet (§5, "non-geodesic control curves") the flat curve's signed
+//! curvature `c(s)` is the geodesic curvature the control curve keeps on the bent sheet: with
+//! the surface normal `n ⟂ T` and `b = n × T`, `p'' = κN = c·b + κ_n·n`, so
+//! `n = σ(κ_n/κ) N + (c/κ) B` with `κ_n = √(κ² − c²)` (writing `n = cos θ N + sin θ B`,
+//! `sin θ = c/κ`). The developable is the envelope of the tangent planes along `p`: its rulings
+//! follow the tangent-plane part of the Darboux vector of the frame `(T, b, n)`,
+//! `τ_g T − κ_n b`, with the geodesic torsion `τ_g = τ + θ'` (for `c = 0` this is eq. 1). The
+//! part `c·n` of the Darboux vector turns the curve inside the sheet, which the flat curve does
+//! by itself. The sign of `c` (the flat curve turning left, seen from the printed side, is
+//! `c > 0`) fixes which side of the control curve the sheet's printed side faces.
+//!
 //! # How it is computed
 //!
 //! The smooth surface is replaced by a *folded* one that is exactly developable: the flat sheet
 //! is folded along straight ruling lines, `s_k = k·h` apart along the line (`h = L / n`), each
-//! fold turning the sheet beyond it about the ruling by `|ω(s_k)|·h`, where `ω = τT + κB` is
-//! the Darboux vector of the arc-length parameterised control curve at `s_k`, expressed in the
-//! curve's own frame (tangent `T`, surface normal `n = ±N`, `b = n × T`): the flat ruling
-//! direction is `(ω·T) d + (ω·b) d⊥` for the line direction `d`. This is the midpoint rule for
-//! the Frenet frame's rotation about the Darboux vector (the "instantaneous rotation axis" of
-//! §3.1), so the folded line follows the control curve to O(h²), while every face is a piece
-//! of the flat sheet moved rigidly: the mesh is isometric to the outline to rounding, the line's
-//! folded length is the flat line's exactly, and the flatten stage gets back the outline.
-//! `n` is chosen so that the sheet is bent by `h` steps with a sagitta `h²|ω|/8` within the
-//! sampling tolerance; the folded line's largest distance from the control curve is measured
-//! and reported in a warning when it exceeds the tolerance.
+//! fold turning the sheet beyond it about the ruling by `|ω(s_k)|·h`, where `ω = τ_g T − κ_n b`
+//! is the folding part of the Darboux vector of the arc-length parameterised control curve at
+//! `s_k`, expressed in the curve's own frame (tangent `T`, surface normal `n` (`±N` for a
+//! line), `b = n × T`): the flat ruling runs through the flat curve's point at `s_k` in the
+//! direction `(ω·T) d + (ω·b) d⊥`, `d` the flat curve's unit tangent there. This is the
+//! midpoint rule for the frame's rotation about the Darboux vector (the "instantaneous rotation
+//! axis" of §3.1; for a curve on the sheet a Strang splitting: the in-sheet turn is exact
+//! between folds), so the folded curve follows the control curve to O(h²), while every face
+//! is a piece of the flat sheet moved rigidly: the mesh is isometric to the outline to
+//! rounding, the curve's folded length is the flat curve's exactly, and the flatten stage gets
+//! back the outline. `n` is chosen so that the sheet is bent by `h` steps with a sagitta
+//! `h²|ω|/8` within the sampling tolerance; the folded curve's largest distance from the
+//! control curve (at the folds) is measured and reported in a warning when it exceeds the
+//! tolerance.
 //!
 //! Regions the rulings do not reach (corners beyond the first and last ruling, the sheet beyond
 //! the line's ends, the sheet between several curved pieces) are simply not folded: they stay
@@ -39,7 +55,10 @@
 //! intersection is `l(s) = sin α / α'` along the ruling). A sheet is refused when that point
 //! lies on the sheet (eq. 6), with the arc length along the line (mm), its distance from the
 //! line and how deep inside the sheet it is. Rulings of different pieces may not cross on the
-//! sheet either (checked between every pair, not only end rulings).
+//! sheet either (checked between every pair, not only end rulings). A control curve that
+//! curves less than the curve on the sheet somewhere (`|p''| < |c|`, §5 last paragraph: no
+//! surface gives it that geodesic curvature) is refused with the arc length (mm) of the largest
+//! shortfall and the shortfall (1/mm), probed at 513 points along the curve.
 //!
 //! # Choices where the paper is silent
 //!
@@ -50,9 +69,19 @@
 //! - Which side of the sheet faces where: the sheet's printed side (+z of the flat outline)
 //!   faces the surface normal `n`, chosen at the first curved point of the control curve: the
 //!   given start normal for handles, else the side with `n·z > 0` (then `n·y > 0`, `n·x > 0`
-//!   when `n` is horizontal). Bending a sheet that lies printed side up keeps it up at the start.
-//!   Where the curve is straight (an inflection, κ = 0) the normal is carried over unchanged.
+//!   when `n` is horizontal; for a curve on the sheet, of its two normals the one with the
+//!   larger `n·z`, then `n·y`, then `n·x`). Bending a sheet that lies printed side up keeps it
+//!   up at the start. Where the curve is straight (an inflection, κ = 0) the normal is carried
+//!   over unchanged.
 //! - Folds turning by less than 1e-9 rad are left out (straight stretches stay planar).
+//! - Curves on the sheet (§5): `κ_n` is taken as 0 where `κ_n² < 1e-10 κ²` (the control curve
+//!   lies flat on the sheet there to 1e-5 of its curvature: an exact circle fitted to length
+//!   lands here, not on rounding noise), and a curvature short of `|c|` by 1e-9 relative is
+//!   rounding, not a refusal. Of the two normals (branches σ = ±1) the first curved point takes
+//!   the one by the sign rule above, later points the one nearer the previous normal. `θ'` is
+//!   a central difference over ±1 µm of arc length (one-sided at the ends), on the point's
+//!   branch. The flat curve must lie on the sheet (256 samples); rulings are drawn through its
+//!   points at the folds, so a flat curve's own curvature needs no sampling.
 //! - Rulings continue across holes (a ruling of a developable is a straight line through all of
 //!   it); beyond the first boundary on each side they stop (§3.3). A hole that no ruling crosses
 //!   gets a straight cut line of zero angle through it so that every face of the mesh is a
@@ -94,13 +123,160 @@ pub struct BentSpec {
     pub bend_lines: BendLines,
 }
 
-/// One curved piece: the straight line on the flat sheet and the 3D curve it must follow.
+/// One curved piece: the curve on the flat sheet (a straight line, or a planar curve whose
+/// geodesic curvature is kept, §5) and the 3D curve it must follow.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PieceSpec {
-    /// Start and end of the line on the flat sheet (mm).
-    pub line: [DVec2; 2],
+    /// The curve on the flat sheet (mm), from its start to its end.
+    pub path: FlatPath,
     pub control: Control,
     pub fit: LengthFit,
+}
+
+/// The curve drawn on the flat sheet that a control curve bends.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FlatPath {
+    /// A straight line from the first point to the second: the control curve is a geodesic
+    /// (eq. 1).
+    Line([DVec2; 2]),
+    /// A circular arc about `center` from the angle `start_deg` to `end_deg` (degrees from +x;
+    /// counter-clockwise when `end_deg > start_deg`, clockwise otherwise), at most one turn.
+    Arc {
+        center: DVec2,
+        radius: f64,
+        start_deg: f64,
+        end_deg: f64,
+    },
+    /// A Bézier or B-spline curve on the sheet (its control points' z is 0).
+    Curve(Spline),
+}
+
+impl FlatPath {
+    /// Length on the sheet (mm).
+    pub fn length(&self) -> f64 {
+        match self {
+            FlatPath::Line([a, b]) => a.distance(*b),
+            FlatPath::Arc {
+                radius,
+                start_deg,
+                end_deg,
+                ..
+            } => radius * (end_deg - start_deg).to_radians().abs(),
+            FlatPath::Curve(c) => ArcLength::new(c).total(),
+        }
+    }
+
+    /// Point, unit tangent and signed curvature (1/mm, > 0 turning left) at arc length `s`.
+    pub fn at(&self, s: f64) -> (DVec2, DVec2, f64) {
+        let f = Flat::new(self);
+        let q = f.at(s);
+        (q.p, q.t, q.c)
+    }
+}
+
+/// A [`FlatPath`] ready to be evaluated by arc length.
+enum Flat<'a> {
+    Line {
+        a: DVec2,
+        d: DVec2,
+        len: f64,
+    },
+    Arc {
+        center: DVec2,
+        r: f64,
+        phi0: f64,
+        sign: f64,
+        len: f64,
+    },
+    Curve {
+        curve: &'a Spline,
+        arc: ArcLength<'a>,
+    },
+}
+
+/// A point of the flat curve: position, unit tangent, signed curvature.
+struct FlatPoint {
+    p: DVec2,
+    t: DVec2,
+    c: f64,
+}
+
+impl<'a> Flat<'a> {
+    fn new(path: &'a FlatPath) -> Flat<'a> {
+        match path {
+            FlatPath::Line([a, b]) => {
+                let len = a.distance(*b);
+                Flat::Line {
+                    a: *a,
+                    d: (*b - *a) / len,
+                    len,
+                }
+            }
+            FlatPath::Arc {
+                center,
+                radius,
+                start_deg,
+                end_deg,
+            } => Flat::Arc {
+                center: *center,
+                r: *radius,
+                phi0: start_deg.to_radians(),
+                sign: if end_deg >= start_deg { 1.0 } else { -1.0 },
+                len: path.length(),
+            },
+            FlatPath::Curve(curve) => Flat::Curve {
+                curve,
+                arc: ArcLength::new(curve),
+            },
+        }
+    }
+
+    fn len(&self) -> f64 {
+        match self {
+            Flat::Line { len, .. } | Flat::Arc { len, .. } => *len,
+            Flat::Curve { arc, .. } => arc.total(),
+        }
+    }
+
+    /// A straight line: no geodesic curvature anywhere.
+    fn straight(&self) -> bool {
+        matches!(self, Flat::Line { .. })
+    }
+
+    fn at(&self, s: f64) -> FlatPoint {
+        match self {
+            Flat::Line { a, d, .. } => FlatPoint {
+                p: *a + *d * s,
+                t: *d,
+                c: 0.0,
+            },
+            Flat::Arc {
+                center,
+                r,
+                phi0,
+                sign,
+                ..
+            } => {
+                let phi = phi0 + sign * s / r;
+                let (sn, cs) = phi.sin_cos();
+                FlatPoint {
+                    p: *center + DVec2::new(cs, sn) * *r,
+                    t: DVec2::new(-sn, cs) * *sign,
+                    c: sign / r,
+                }
+            }
+            Flat::Curve { curve, arc } => {
+                let [p, d1, d2, _] = curve.eval(arc.param(s));
+                let v = DVec2::new(d1.x, d1.y);
+                let sp = v.length().max(1e-300);
+                FlatPoint {
+                    p: DVec2::new(p.x, p.y),
+                    t: v / sp,
+                    c: v.perp_dot(DVec2::new(d2.x, d2.y)) / (sp * sp * sp),
+                }
+            }
+        }
+    }
 }
 
 /// How the 3D curve is given.
@@ -158,6 +334,15 @@ pub enum GeodesicError {
         sb: f64,
         x: f64,
         y: f64,
+    },
+    #[error("piece {piece}: the control curve bends less than the curve drawn on the sheet at s = {s:.2} mm along it: its curvature is {kappa:.6}/mm, the flat curve's {c:.6}/mm (radius {radius:.2} mm), short by {short:.6}/mm; a curve keeps its geodesic curvature when the sheet bends, so in space it must curve at least as much (§5): bend the control curve more there or draw a straighter curve on the sheet")]
+    Curvature {
+        piece: usize,
+        s: f64,
+        kappa: f64,
+        c: f64,
+        radius: f64,
+        short: f64,
     },
     #[error("{0}")]
     Mesh(String),
@@ -697,19 +882,101 @@ struct PieceFolds {
     warnings: Vec<String>,
 }
 
-/// The sign rule for the surface normal at the first curved point (see the module doc).
-fn orient(n: DVec3, up: Option<DVec3>) -> DVec3 {
+/// Curvature (1/mm) below which a control curve counts as straight.
+const KMIN: f64 = 1e-9;
+/// Below this `κ_n² / κ²` counts as zero: the control curve lies flat on the sheet there (its
+/// normal curvature is under 1e-5 of its curvature; exact circles fitted to length land here).
+const FLAT_KN2: f64 = 1e-10;
+/// A control curve's curvature may fall short of the flat curve's by this much (relative)
+/// before it is refused: rounding, not geometry.
+const SHORT_REL: f64 = 1e-9;
+
+/// |κ_n| = √(κ² − c²) (§5: the normal part of `p''` once the geodesic part `c` is taken).
+fn kn_abs(kappa: f64, c: f64) -> f64 {
+    let kn2 = kappa * kappa - c * c;
+    if kn2 <= FLAT_KN2 * kappa * kappa {
+        0.0
+    } else {
+        kn2.sqrt()
+    }
+}
+
+/// The two surface normals (branches σ = +1 and −1) along which the control curve has the
+/// flat curve's geodesic curvature `c`: `n = σ (κ_n/κ) N + (c/κ) B`, so that
+/// `p'' = c (n × T) + σ κ_n n` (§5). `None` where the curve is straight.
+fn normals_for(l: &Local, c: f64) -> Option<[DVec3; 2]> {
+    let kappa = l.k.length();
+    if kappa <= KMIN {
+        return None;
+    }
+    if c == 0.0 {
+        let n = l.k.normalize();
+        return Some([n, -n]);
+    }
+    let nn = l.k / kappa;
+    let bb = l.t.cross(nn);
+    let a = kn_abs(kappa, c) / kappa;
+    let beta = (c / kappa).clamp(-1.0, 1.0);
+    Some([
+        (nn * a + bb * beta).normalize(),
+        (nn * -a + bb * beta).normalize(),
+    ])
+}
+
+/// `θ'` for the surface normal `n = cos θ N + sin θ B` with `tan θ = c / (σ κ_n)` on branch
+/// `sigma`: the geodesic torsion is `τ_g = τ + θ'`. Central difference over ±1 µm (one-sided
+/// at the ends); zero on a straight flat line.
+fn theta_rate(
+    curve: &dyn Param,
+    arc: &ArcLength,
+    flat: &Flat,
+    s: f64,
+    sigma: f64,
+    len: f64,
+) -> f64 {
+    if flat.straight() {
+        return 0.0;
+    }
+    let delta = 1e-3_f64.min(1e-3 * len);
+    let theta = |s: f64| -> Option<f64> {
+        let l = local(curve, arc.param(s))?;
+        let kappa = l.k.length();
+        if kappa <= KMIN {
+            return None;
+        }
+        let c = flat.at(s).c;
+        Some(c.atan2(sigma * kn_abs(kappa, c)))
+    };
+    let (s0, s1) = ((s - delta).max(0.0), (s + delta).min(len));
+    match (theta(s0), theta(s1)) {
+        (Some(a), Some(b)) if s1 > s0 => {
+            let pi = std::f64::consts::PI;
+            let mut d = b - a;
+            if d > pi {
+                d -= 2.0 * pi;
+            } else if d < -pi {
+                d += 2.0 * pi;
+            }
+            d / (s1 - s0)
+        }
+        _ => 0.0,
+    }
+}
+
+/// Pick the branch of [`normals_for`] by the sign rule at the first curved point (see the
+/// module doc): the one further along the hint, then +z, +y, +x. Returns the index.
+fn orient_pair(n: &[DVec3; 2], up: Option<DVec3>) -> usize {
     let refs = match up {
         Some(u) => vec![u],
         None => vec![DVec3::Z, DVec3::Y, DVec3::X],
     };
     for r in refs {
-        let d = n.dot(r);
-        if d.abs() > 1e-6 {
-            return if d > 0.0 { n } else { -n };
+        let d = (n[0] - n[1]).dot(r);
+        if d.abs() > 2e-6 {
+            return if d > 0.0 { 0 } else { 1 };
         }
     }
-    n
+    0
 }
 
 /// Rotation about the line through `q` (z = 0) with unit direction `dir` by `angle`.
@@ -723,12 +990,13 @@ fn fold_map(q: DVec2, dir: DVec2, angle: f64) -> DAffine3 {
 fn piece_folds(
     piece: usize,
     spec: &PieceSpec,
+    flat: &Flat,
     curve: &dyn Param,
     up: Option<DVec3>,
     tol: f64,
 ) -> Result<PieceFolds, GeodesicError> {
     let cerr = |message: String| GeodesicError::Control { piece, message };
-    let len = spec.line[0].distance(spec.line[1]);
+    let len = flat.len();
     let mut warnings = Vec::new();
 
     // Length (§4.1.3).
@@ -776,11 +1044,46 @@ fn piece_folds(
     let probes = 256;
     let mut wmax: f64 = 0.0;
     let (f0, f1) = fitted.domain();
-    for j in 0..=probes {
-        // |ω| does not depend on the parameterisation: probe evenly in the parameter.
-        let u = f0 + (f1 - f0) * j as f64 / probes as f64;
-        if let Some(l) = local(&fitted, u) {
-            wmax = wmax.max(l.omega.length());
+    if flat.straight() {
+        for j in 0..=probes {
+            // |ω| does not depend on the parameterisation: probe evenly in the parameter.
+            let u = f0 + (f1 - f0) * j as f64 / probes as f64;
+            if let Some(l) = local(&fitted, u) {
+                wmax = wmax.max(l.omega.length());
+            }
+        }
+    } else {
+        // A curve drawn on the sheet: probe by arc length (the flat curvature is given so),
+        // refuse a control curve that curves less than it (§5), and bound the folding part
+        // of ω by (|τ| + |θ'|, κ_n).
+        let probes = 2 * probes;
+        let mut worst: Option<(f64, f64, f64)> = None;
+        for j in 0..=probes {
+            let s = len * j as f64 / probes as f64;
+            let Some(l) = local(&fitted, arc.param(s)) else {
+                continue;
+            };
+            let c = flat.at(s).c;
+            let kappa = l.k.length();
+            let short = c.abs() - kappa;
+            if short > SHORT_REL * c.abs() && worst.is_none_or(|w| short > w.1.abs() - w.2) {
+                worst = Some((s, c, kappa));
+            }
+            let tau = l.omega.dot(l.t);
+            let dtheta = theta_rate(&fitted, &arc, flat, s, 1.0, len);
+            let tg = tau.abs() + dtheta.abs();
+            let kn = kn_abs(kappa, c);
+            wmax = wmax.max((tg * tg + kn * kn).sqrt());
+        }
+        if let Some((s, c, kappa)) = worst {
+            return Err(GeodesicError::Curvature {
+                piece: piece + 1,
+                s,
+                kappa,
+                c: c.abs(),
+                radius: 1.0 / c.abs(),
+                short: c.abs() - kappa,
+            });
         }
     }
     if !wmax.is_finite() {
@@ -792,7 +1095,7 @@ fn piece_folds(
         len
     };
     const MAX_STEPS: usize = 200_000;
-    let folds_at = |n: usize| folds_at_n(piece, n, &fitted, &arc, spec.line, up, tol);
+    let folds_at = |n: usize| folds_at_n(piece, n, &fitted, &arc, flat, up, tol);
     let mut n = ((len / h_max).ceil() as usize).max(2);
     // The folded line strays O(h²) from the curve: refine until it is within the tolerance.
     let mut tries = 0;
@@ -821,23 +1124,19 @@ fn piece_folds(
 }
 
 /// [`piece_folds`] at `n` steps: the folds, the placement and the largest distance of the
-/// folded line from the curve.
+/// folded flat curve from the control curve.
 #[allow(clippy::too_many_arguments)]
 fn folds_at_n(
     piece: usize,
     n: usize,
     fitted: &dyn Param,
     arc: &ArcLength,
-    line: [DVec2; 2],
+    flat: &Flat,
     up: Option<DVec3>,
     tol: f64,
 ) -> Result<(Vec<Ruling>, DAffine3, f64), GeodesicError> {
-    let _ = tol;
     let cerr = |message: String| GeodesicError::Control { piece, message };
-    let [a, b] = line;
-    let len = a.distance(b);
-    let d = (b - a) / len;
-    let dp = d.perp();
+    let len = flat.len();
     let length = arc.total();
     const MAX_STEPS: usize = 200_000;
     if n > MAX_STEPS {
@@ -847,8 +1146,9 @@ fn folds_at_n(
     }
     let h = len / n as f64;
 
-    // Frames at s = h/2 (the first segment) and at each fold s_k = k h.
-    let mut at: Vec<(f64, Local)> = Vec::with_capacity(n + 1);
+    // Frames at s = h/2 (the first segment) and at each fold s_k = k h, with the flat
+    // curve's curvature there.
+    let mut at: Vec<(f64, Local, f64)> = Vec::with_capacity(n + 1);
     for k in 0..n {
         let s = if k == 0 { 0.5 * h } else { k as f64 * h };
         let l = local(fitted, arc.param(s))
@@ -856,12 +1156,15 @@ fn folds_at_n(
         if !(l.omega.is_finite() && l.t.is_finite()) {
             return Err(cerr(format!("is not smooth at s = {s:.2} mm")));
         }
-        at.push((s, l));
+        let c = flat.at(s).c;
+        at.push((s, l, c));
     }
-    // Surface normals: ±K, continuous; carried over where K vanishes.
-    let kmin = 1e-9;
-    let first = at.iter().position(|(_, l)| l.k.length() > kmin);
+    // Surface normals (§5; ±K for a line), continuous; carried over where K vanishes. The
+    // branch σ (+1: first of `normals_for`) is kept for the geodesic torsion.
+    let cands: Vec<Option<[DVec3; 2]>> = at.iter().map(|(_, l, c)| normals_for(l, *c)).collect();
+    let first = cands.iter().position(|c| c.is_some());
     let mut normals = vec![DVec3::ZERO; at.len()];
+    let mut sigma = vec![1.0; at.len()];
     match first {
         None => {
             let t = at[0].1.t;
@@ -876,61 +1179,73 @@ fn folds_at_n(
             normals.fill(n0);
         }
         Some(f) => {
-            normals[f] = orient(at[f].1.k.normalize(), up);
+            let pair = cands[f].unwrap_or([DVec3::Z, -DVec3::Z]);
+            let i0 = orient_pair(&pair, up);
+            normals[f] = pair[i0];
+            sigma[f] = if i0 == 0 { 1.0 } else { -1.0 };
             for i in (0..f).rev() {
                 let t = at[i].1.t;
                 let v = normals[i + 1] - t * normals[i + 1].dot(t);
                 normals[i] = v.normalize_or(normals[i + 1]);
             }
             for i in f + 1..at.len() {
-                let (t, k) = (at[i].1.t, at[i].1.k);
+                let t = at[i].1.t;
                 let prev = normals[i - 1];
-                normals[i] = if k.length() > kmin {
-                    let kn = k.normalize();
-                    if kn.dot(prev) >= 0.0 {
-                        kn
-                    } else {
-                        -kn
+                normals[i] = match cands[i] {
+                    Some(pair) => {
+                        if pair[0].dot(prev) >= pair[1].dot(prev) {
+                            pair[0]
+                        } else {
+                            sigma[i] = -1.0;
+                            pair[1]
+                        }
                     }
-                } else {
-                    (prev - t * prev.dot(t)).normalize_or(prev)
+                    None => (prev - t * prev.dot(t)).normalize_or(prev),
                 };
             }
         }
     }
 
-    // Placement: flat (d, d⊥, z) at `a` ↦ (T, b, n) at p(0), b = n × T.
+    // Placement: the flat frame (d, d⊥, z) of the first segment ↦ (T, b, n) there,
+    // b = n × T, with the flat curve's start at p(0).
     let (t0, n0) = (at[0].1.t, normals[0]);
     let b0 = n0.cross(t0).normalize();
     let n0 = t0.cross(b0);
     let p0 = fitted.eval(fitted.domain().0)[0];
+    let a = flat.at(0.0).p;
+    let d = flat.at(at[0].0).t;
+    let dp = d.perp();
     let world = glam::DMat3::from_cols(t0, b0, n0);
-    let flat = glam::DMat3::from_cols(
+    let flat_frame = glam::DMat3::from_cols(
         DVec3::new(d.x, d.y, 0.0),
         DVec3::new(dp.x, dp.y, 0.0),
         DVec3::Z,
     );
     let place = DAffine3::from_translation(p0)
-        * DAffine3::from_mat3(world * flat.transpose())
+        * DAffine3::from_mat3(world * flat_frame.transpose())
         * DAffine3::from_translation(-DVec3::new(a.x, a.y, 0.0));
 
     let mut folds = Vec::new();
     for k in 1..n {
-        let (s, l) = &at[k];
+        let (s, l, _) = &at[k];
         let t = l.t;
         let nn = normals[k];
         let bb = nn.cross(t);
-        let (wt, wb) = (l.omega.dot(t), l.omega.dot(bb));
+        // The folding part of the Darboux vector: τ_g T − κ_n b (κ_g n turns the curve
+        // inside the sheet, which the flat curve does by itself).
+        let wt = l.omega.dot(t) + theta_rate(fitted, arc, flat, *s, sigma[k], len);
+        let wb = l.omega.dot(bb);
         let mag = (wt * wt + wb * wb).sqrt();
         let angle = mag * h;
         if angle < 1e-9 {
             continue;
         }
-        let dir = (d * wt + dp * wb) / mag;
+        let q = flat.at(*s);
+        let dir = (q.t * wt + q.t.perp() * wb) / mag;
         folds.push(Ruling {
             piece: Some(piece),
             s: *s,
-            point: a + d * *s,
+            point: q.p,
             dir,
             angle,
             extent: (0.0, 0.0),
@@ -939,7 +1254,7 @@ fn folds_at_n(
         });
     }
 
-    // How far the folded line strays from the control curve.
+    // How far the folded flat curve strays from the control curve.
     let mut m = place;
     let mut drift: f64 = 0.0;
     let mut fi = 0;
@@ -950,7 +1265,7 @@ fn folds_at_n(
             m *= fold_map(f.point, f.dir, f.angle);
             fi += 1;
         }
-        let flat_pt = a + d * s;
+        let flat_pt = flat.at(s).p;
         let v = m.transform_point3(DVec3::new(flat_pt.x, flat_pt.y, 0.0));
         let target = fitted.eval(arc.param(s.min(length)))[0];
         drift = drift.max(v.distance(target));
@@ -1087,7 +1402,7 @@ pub type ControlParam = (Box<dyn Param>, Option<DVec3>, Vec<String>);
 /// The control curve of a piece as something to evaluate, and the normal hint for handles.
 pub fn control_param(piece: usize, spec: &PieceSpec) -> Result<ControlParam, GeodesicError> {
     let cerr = |message: String| GeodesicError::Control { piece, message };
-    let len = spec.line[0].distance(spec.line[1]);
+    let len = spec.path.length();
     let finite = |c: &[DVec3]| c.iter().all(|p| p.is_finite());
     match &spec.control {
         Control::Curve(Curve::Bezier { control }) => {
@@ -1239,29 +1554,87 @@ pub fn bend_with(
             "a bent sheet needs at least one line with its control curve".into(),
         ));
     }
-    // Lines.
+    // Lines and curves on the sheet.
+    let on_sheet = |q: DVec2| {
+        let r = &rings[0];
+        (0..r.len()).any(|j| polygon::segment_distance(q, r[j], r[(j + 1) % r.len()]) <= 1e-6)
+            || polygon::contains(r, q)
+    };
     for (i, p) in spec.pieces.iter().enumerate() {
         let lerr = |message: String| GeodesicError::Line { piece: i, message };
-        let [a, b] = p.line;
-        if !(a.is_finite() && b.is_finite()) {
-            return Err(lerr("a point is not finite".into()));
+        match &p.path {
+            FlatPath::Line([a, b]) => {
+                let (a, b) = (*a, *b);
+                if !(a.is_finite() && b.is_finite()) {
+                    return Err(lerr("a point is not finite".into()));
+                }
+                if a.distance(b) < 1e-6 {
+                    return Err(lerr("its two points are the same".into()));
+                }
+                for q in [a, b] {
+                    if !on_sheet(q) {
+                        return Err(lerr(format!(
+                            "point ({}, {}) is not on the sheet",
+                            q.x, q.y
+                        )));
+                    }
+                }
+                continue;
+            }
+            FlatPath::Arc {
+                center,
+                radius,
+                start_deg,
+                end_deg,
+            } => {
+                if !(center.is_finite() && start_deg.is_finite() && end_deg.is_finite()) {
+                    return Err(lerr("the arc's centre and angles must be finite".into()));
+                }
+                if !(radius.is_finite() && *radius >= 1e-3) {
+                    return Err(lerr(format!(
+                        "the arc's radius must be at least 0.001 mm, got {radius}"
+                    )));
+                }
+                let sweep = (end_deg - start_deg).abs();
+                if !(radius * sweep.to_radians() >= 1e-6 && sweep <= 360.0) {
+                    return Err(lerr(format!(
+                        "the arc must sweep more than nothing and at most 360°, from start_deg {start_deg} to end_deg {end_deg}"
+                    )));
+                }
+            }
+            FlatPath::Curve(c) => {
+                if c.control().len() < 2 || c.control().iter().any(|q| !q.is_finite()) {
+                    return Err(lerr(
+                        "a curve on the sheet needs at least 2 finite control points".into(),
+                    ));
+                }
+                let l = p.path.length();
+                if l.is_nan() || l < 1e-6 {
+                    return Err(lerr("the curve on the sheet has no length".into()));
+                }
+            }
         }
-        if a.distance(b) < 1e-6 {
-            return Err(lerr("its two points are the same".into()));
-        }
-        for q in [a, b] {
-            let on = (0..rings[0].len()).any(|j| {
-                polygon::segment_distance(q, rings[0][j], rings[0][(j + 1) % rings[0].len()])
-                    <= 1e-6
-            });
-            if !(on || polygon::contains(&rings[0], q)) {
+        // A curve: every sample on the sheet, and regular.
+        let f = Flat::new(&p.path);
+        let len = f.len();
+        const SAMPLES: usize = 256;
+        for j in 0..=SAMPLES {
+            let s = len * j as f64 / SAMPLES as f64;
+            let q = f.at(s);
+            if !(q.p.is_finite() && q.t.is_finite() && q.c.is_finite()) {
                 return Err(lerr(format!(
-                    "point ({}, {}) is not on the sheet",
-                    q.x, q.y
+                    "the curve on the sheet is not smooth at s = {s:.2} mm (a cusp or a repeated control point?)"
+                )));
+            }
+            if !on_sheet(q.p) {
+                return Err(lerr(format!(
+                    "the curve leaves the sheet at s = {s:.2} mm, point ({:.2}, {:.2})",
+                    q.p.x, q.p.y
                 )));
             }
         }
     }
+    let flats: Vec<Flat> = spec.pieces.iter().map(|p| Flat::new(&p.path)).collect();
 
     // Folds of every piece.
     let mut warnings = Vec::new();
@@ -1270,7 +1643,7 @@ pub fn bend_with(
     let mut lengths = Vec::new();
     let mut drifts = Vec::new();
     for (i, (p, (c, up))) in spec.pieces.iter().zip(curves).enumerate() {
-        let mut pf = piece_folds(i, p, *c, *up, tol)?;
+        let mut pf = piece_folds(i, p, &flats[i], *c, *up, tol)?;
         if i == 0 {
             place = pf.place;
         }
@@ -1528,15 +1901,15 @@ pub fn bend_with(
         faces.push(loop_);
     }
     // Region transforms, breadth first from the face holding the first piece's start.
-    let p0 = &spec.pieces[0];
-    let d0 = (p0.line[1] - p0.line[0]).normalize();
     let first_fold = rulings
         .iter()
         .filter(|r| r.piece == Some(0))
         .map(|r| r.s)
         .next()
-        .unwrap_or(p0.line[0].distance(p0.line[1]));
-    let probe = p0.line[0] + d0 * (0.5 * first_fold).min(1e-3 * first_fold.max(1.0));
+        .unwrap_or(flats[0].len());
+    let probe = flats[0]
+        .at((0.5 * first_fold).min(1e-3 * first_fold.max(1.0)))
+        .p;
     let face_poly = |f: usize| -> Vec<DVec2> { faces[f].iter().map(|&h| pos[from(h)]).collect() };
     let root = (0..faces.len())
         .find(|&f| polygon::contains(&face_poly(f), probe))
@@ -1549,10 +1922,7 @@ pub fn bend_with(
         .iter()
         .map(|r| {
             let line_dir = match r.piece {
-                Some(p) => {
-                    let l = spec.pieces[p].line;
-                    (l[1] - l[0]).normalize()
-                }
+                Some(p) => flats[p].at(r.s).t,
                 None => r.dir.perp(),
             };
             r.dir.perp_dot(line_dir) > 0.0
