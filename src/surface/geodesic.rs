@@ -313,9 +313,9 @@ impl LengthFit {
 pub enum GeodesicError {
     #[error("outline: {0}")]
     Outline(String),
-    #[error("piece {piece}: line: {message}")]
+    #[error("piece {}: line: {message}", .piece + 1)]
     Line { piece: usize, message: String },
-    #[error("piece {piece}: control curve: {message}")]
+    #[error("piece {}: control curve: {message}", .piece + 1)]
     Control { piece: usize, message: String },
     #[error("piece {piece}: the curve of regression enters the sheet at s = {s:.2} mm along the line (ruling through ({x:.2}, {y:.2})): the singular point lies {dist:.2} mm from the line along the ruling, {depth:.2} mm inside the sheet's edge; bend or twist the control curve less there")]
     Regression {
