@@ -31,7 +31,8 @@
 //!   Stop when the best is good enough (`good_interior`, `good_fairness`), the queue is empty,
 //!   or after `max_iterations` (the paper: "less than a thousand for all the models").
 //!   A hull without any valid chart makes each of its triangles a chart (the pathological case).
-//! - §6 darts, several loops, rulings, alternatives; §7 B-spline smoothing and radial offset.
+//! - §6 darts, several loops (connecting charts first, else the shortest tree), rulings,
+//!   alternatives; §7 B-spline smoothing and radial offset.
 //!
 //! # Choices where the paper is silent
 //!
@@ -48,19 +49,54 @@
 //! - Chart area threshold: relative to the hull of the subloop being split (deeper subloops
 //!   are small; against the top hull they would never have charts).
 //! - Subloop plane for the fairness bound: Newell's normal through the centroid.
-//! - Darts: the paper duplicates the dart polyline with reversed orientation into one closed
-//!   boundary. Two copies of the same points would make a boundary triangulation degenerate,
-//!   so the copies are opened into a narrow V: at the mouth by `dart_width` (default 2 % of
-//!   the dart's length) along the boundary, narrowing linearly to the single tip vertex. The
-//!   flat piece then has the dart cut out, which is what a pattern needs.
-//! - Several loops: the first is the outer one, the others are holes (reversed if their
-//!   Newell normal agrees with the outer's). Each hole is joined to the region holding the
-//!   vertex nearest to it by two edges: the shortest one, and one from the region vertex half
-//!   way round to its nearest hole vertex. (The paper's single shortest tree would make a
-//!   loop that runs both ways along one edge, which needs duplicate vertices.) Those edges and
-//!   the user's rulings are constraints: they split the boundary into subloops solved
-//!   separately, and do not count as polyline edges for charts (§6.1). The paper's first
-//!   choice, hull charts connecting loops, is not implemented.
+//! - Darts (§6.1): a dart is a polyline from a loop point (of any loop) to its tip, inserted
+//!   twice with reversed orientation into its loop: the loop point and the dart's points are
+//!   duplicated (left copy, tip once, right copy), and the two copies *coincide* in 3D — the
+//!   sewn dart. The triangulation treats them as two boundary sections, so the flat piece
+//!   opens them into the V that a pattern cuts out. Coinciding points break hulls and local
+//!   convexity predicates, so, as the §7 radial offset does, hulls are computed on perturbed
+//!   points only: the copies opened into a narrow V (at the mouth `width`, default 2 % of the
+//!   dart's length, along the boundary, narrowing to the tip); triangles and all angles use
+//!   the real points. A triangle with two copies of one point, a triangle without area, or
+//!   an edge in space used by more than two triangles (the surface folded onto itself around
+//!   the tip) is refused in charts, envelopes, covers and results. Should no valid
+//!   triangulation exist with coinciding sides, the dart is opened into that V for real and a
+//!   warning says so (the old behaviour, kept only as this fallback).
+//! - Several loops (§6): the first loop is the outer one, the others holes (reversed if their
+//!   Newell normal agrees with the outer's, so that the surface lies left of every loop).
+//!   First, charts that connect loops: on the hull of all the loops' points (radial offset
+//!   applied) charts are found as in §3 — triangles with an input edge, all wound like the
+//!   loops, joined across edges that are not loop edges — and a chart is *connecting* when it
+//!   touches two loops or more. The validity conditions are those of single charts (smooth
+//!   inside and against the neighbouring interior hull triangles, at least `min_chart_area`
+//!   of the hull), plus, adapted to several loops: its subtraction must leave simple loops
+//!   with each touched loop entered once (so they merge into one loop, or vanish when the
+//!   chart covers the band between them, as on a lamp collar), and keep every ruling
+//!   possible. The largest valid one is taken (the paper does not say which: the largest is
+//!   the §5.1.2 potential's choice), subtracted, and the search for connecting charts is
+//!   repeated on the loops left; its triangles are part of the result. Then the user's
+//!   rulings between loops join them, then the *shortest tree* of connecting edges: Kruskal
+//!   over all vertex pairs of different loops by length, skipping an edge that comes within
+//!   1e-9 × the size of a loop edge, a chart edge, a ruling or an earlier tree edge (in
+//!   space; this is exact for planar panels), or that shares an end with another joining
+//!   edge or a ruling. A joining edge `a b` is walked both ways (… a, b, around the hole, b,
+//!   a, …): the search sees `a` and `b` twice, as two copies nudged apart for the hulls only
+//!   (1 % of the shorter of the joining edge and their loop edge, along the loop edge), and
+//!   the same validity test refuses triangles that would use the edge or a vertex twice. In
+//!   the result both copies are one vertex, so the joining edge is an ordinary interior edge
+//!   with a triangle on each side: the mesh is a disk with holes (Euler characteristic
+//!   1 − holes), its boundary exactly the input loops. Joining edges and chart rims are
+//!   treated as interior edges for chart extraction (§6.1).
+//! - Rulings (§6.1) name points of any loop. Between two loops a ruling is a joining edge
+//!   (taken before the shortest tree); within the joined loop it is a constraint edge that
+//!   splits it into regions searched separately.
+//! - The flat piece of a surface with holes: the flatten stage unfolds it face by face. If a
+//!   hole's loop closes up in the plane (a planar panel, or any panel whose surface around
+//!   the hole is developable as a disk) the piece is one piece with the hole cut out, which
+//!   is what a cutter user wants (no slit to tape). A band around a hole that cannot lie flat
+//!   closed (a lamp collar: a cone-like band) is cut open along one edge by the unfolder
+//!   (where joining is cheapest) into one piece with a slit there, the seam the user glues:
+//!   that is unavoidable, since no flat piece without a cut has that shape.
 //! - Alternatives: every distinct complete triangulation met is kept; the N best are returned.
 //! - The radial offset is skipped when it leaves fewer loop edges on the hull than the input
 //!   points do (a scalloped edge near the centre of mass sinks inside its hull when pushed).
@@ -88,7 +124,7 @@ pub struct Options {
     pub good_interior: usize,
     /// …and at most this sum of squared dihedral angles (radians²).
     pub good_fairness: f64,
-    /// Branch-and-bound iterations at most (per subloop split by rulings or holes).
+    /// Branch-and-bound iterations at most (per region split by rulings).
     pub max_iterations: usize,
     /// §7 radial offset, relative to the mean distance from the centre of mass.
     pub offset: f64,
@@ -536,23 +572,33 @@ pub fn check(input: &Input) -> Result<(), BoundaryError> {
 pub fn triangulate(input: &Input, opts: &Options) -> Result<Output, BoundaryError> {
     let t0 = Instant::now();
     let prep = prepare(input, opts, false)?;
+    let relaxed = |o: &Output| o.warnings.iter().any(|w| w.starts_with(RELAXED));
     let (out, ok) = search(prep, opts, t0);
-    if ok {
+    if ok && (input.darts.is_empty() || !relaxed(&out)) {
         return Ok(out);
     }
     if !input.darts.is_empty() {
+        // The fallback: darts opened into a narrow V, when the coincident sides gave no valid
+        // triangulation or only one over the limits and the V gives one within them.
         let prep = prepare(input, opts, true)?;
-        let (mut out, ok) = search(prep, opts, t0);
-        if ok {
-            out.warnings.insert(
+        let (mut open, open_ok) = search(prep, opts, t0);
+        if open_ok && (!ok || !relaxed(&open)) {
+            open.warnings.insert(
                 0,
-                "the darts could not be triangulated with their two sides coinciding: they were opened into a narrow V (`width`, default 2 % of the dart's length)".into(),
+                "the darts could not be triangulated within the limits with their two sides coinciding: they were opened into a narrow V (`width`, default 2 % of the dart's length)".into(),
             );
-            return Ok(out);
+            open.figures.seconds = t0.elapsed().as_secs_f64();
+            return Ok(open);
         }
+    }
+    if ok {
+        return Ok(out);
     }
     Err(BoundaryError::NoTriangulation)
 }
+
+/// How the warning that the limits were relaxed starts.
+const RELAXED: &str = "no triangulation with every dihedral angle under";
 
 fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepared, BoundaryError> {
     check_loops(&input.loops)?;
@@ -615,7 +661,10 @@ fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepared, Bounda
         let mut ends = [0; 2];
         for (e, &(l, i)) in ru.iter().enumerate() {
             if l >= nl {
-                return Err(err(format!("names loop {} but there are {nl} loops", l + 1)));
+                return Err(err(format!(
+                    "names loop {} but there are {nl} loops",
+                    l + 1
+                )));
             }
             let n = input.loops[l].len();
             if i >= n {
@@ -842,9 +891,8 @@ fn connecting_chart(
     }
     let nf = hull.faces.len();
     let face = |f: usize| hull.faces[f].map(|x| ids[x]);
-    let on_loop = |a: usize, b: usize| {
-        edge_cycle.contains_key(&(a, b)) || edge_cycle.contains_key(&(b, a))
-    };
+    let on_loop =
+        |a: usize, b: usize| edge_cycle.contains_key(&(a, b)) || edge_cycle.contains_key(&(b, a));
     let mut sense: Vec<Option<bool>> = vec![None; nf];
     let mut has_edge = vec![false; nf];
     for f in 0..nf {
@@ -867,7 +915,12 @@ fn connecting_chart(
                 vote = Some(v);
             }
         }
-        if !mixed {
+        let wound = if vote == Some(false) {
+            [t[0], t[2], t[1]]
+        } else {
+            t
+        };
+        if !mixed && sites_valid(verts, site, &[wound]) {
             sense[f] = vote;
         }
     }
@@ -1271,6 +1324,7 @@ fn solve(
         opts.max_dihedral_deg.to_radians(),
         opts.min_chart_area,
     );
+    s.base = base.to_vec();
     let mut r = s.run(opts);
     let mut relaxed = Search::new(
         pts,
@@ -1280,10 +1334,11 @@ fn solve(
         std::f64::consts::PI,
         0.0,
     );
+    relaxed.base = base.to_vec();
     if r.best.is_none() {
         let r2 = relaxed.run(opts);
         warnings.push(format!(
-            "no triangulation with every dihedral angle under {}° and charts over {} % of their hull: the limits were relaxed",
+            "{RELAXED} {}° and charts over {} % of their hull: the limits were relaxed",
             opts.max_dihedral_deg,
             100.0 * opts.min_chart_area
         ));
@@ -1397,6 +1452,8 @@ struct Search<'a> {
     m: usize,
     thr: f64,
     min_area: f64,
+    /// The hull points before the radial offset (tried for flat subloops).
+    base: Vec<DVec3>,
     charts: Vec<Chart>,
     chart_ids: HashMap<Vec<[usize; 3]>, usize>,
     subs: HashMap<Vec<usize>, Rc<Sub>>,
@@ -1423,6 +1480,7 @@ impl<'a> Search<'a> {
             m: p.len(),
             thr,
             min_area,
+            base: Vec::new(),
             charts: Vec::new(),
             chart_ids: HashMap::new(),
             subs: HashMap::new(),
@@ -1587,7 +1645,15 @@ impl<'a> Search<'a> {
             // A flat subloop: ear clipping in its plane, on the input points (the offset ones
             // if those fold over), one envelope since both sides are the same.
             let op: Vec<DVec3> = sub.iter().map(|&v| self.p[v]).collect();
-            for pts in [&op, &hp] {
+            let bp: Vec<DVec3> = sub
+                .iter()
+                .filter_map(|&v| self.base.get(v))
+                .copied()
+                .collect();
+            for pts in [&op, &bp, &hp] {
+                if pts.len() != q {
+                    continue;
+                }
                 let n = newell(pts).normalize_or_zero();
                 if n == DVec3::ZERO {
                     continue;
@@ -1632,7 +1698,7 @@ impl<'a> Search<'a> {
                 if is_sub_edge(x, y) {
                     has_edge[f] = true;
                     edge_seen += 1;
-                    if counts(x, y) {
+                    if counts(x, y) && self.valid(&[sorted(*t)]) {
                         eligible[f] = true;
                     }
                 }
