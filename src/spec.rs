@@ -2370,10 +2370,12 @@ impl Ctx<'_> {
                     Some(Value::Integer(n)) if *n >= 1 && (*n as usize) <= loops.len() => {
                         (*n - 1) as usize
                     }
-                    Some(_) => return Err(bad(&format!(
+                    Some(_) => {
+                        return Err(bad(&format!(
                         "`loop` must be the number (from 1) of the loop the dart is on, at most {}",
                         loops.len()
-                    ))),
+                    )))
+                    }
                 };
                 let at =
                     match t.get("at") {

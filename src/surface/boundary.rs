@@ -59,9 +59,12 @@
 //!   dart's length, along the boundary, narrowing to the tip); triangles and all angles use
 //!   the real points. A triangle with two copies of one point, a triangle without area, or
 //!   an edge in space used by more than two triangles (the surface folded onto itself around
-//!   the tip) is refused in charts, envelopes, covers and results. Should no valid
-//!   triangulation exist with coinciding sides, the dart is opened into that V for real and a
-//!   warning says so (the old behaviour, kept only as this fallback).
+//!   the tip) is refused in charts, envelopes, covers and results. Should the coinciding
+//!   sides give no valid triangulation, or only one over the limits while the V gives one
+//!   within them, the darts are opened into that V for real and a warning says so (the old
+//!   behaviour, kept only as this fallback; with neither valid the result is an error). A
+//!   dart tip that lies off the surface the rest of the boundary asks for (the dart takes
+//!   fabric in) is what makes the flat V open; a tip barely off it can need the fallback.
 //! - Several loops (§6): the first loop is the outer one, the others holes (reversed if their
 //!   Newell normal agrees with the outer's, so that the surface lies left of every loop).
 //!   First, charts that connect loops: on the hull of all the loops' points (radial offset
@@ -86,7 +89,9 @@
 //!   the result both copies are one vertex, so the joining edge is an ordinary interior edge
 //!   with a triangle on each side: the mesh is a disk with holes (Euler characteristic
 //!   1 − holes), its boundary exactly the input loops. Joining edges and chart rims are
-//!   treated as interior edges for chart extraction (§6.1).
+//!   treated as interior edges for chart extraction (§6.1). The dihedral angles across a
+//!   connecting chart's rim are measured in the figures but not bounded by the search of the
+//!   region next to it.
 //! - Rulings (§6.1) name points of any loop. Between two loops a ruling is a joining edge
 //!   (taken before the shortest tree); within the joined loop it is a constraint edge that
 //!   splits it into regions searched separately.
