@@ -994,7 +994,7 @@ fn connecting_chart(
             (0..3).all(|e| {
                 let g = hull.neighbours[f][e];
                 g == usize::MAX
-                    || !(comp[g] == f0 || !has_edge[g])
+                    || (comp[g] != f0 && has_edge[g])
                     || angle(unit_normal(verts, face(f)), unit_normal(verts, face(g))) < thr
             })
         });
