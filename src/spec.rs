@@ -120,10 +120,13 @@
 //! polyline (see `surface::boundary`, Rose et al.). Exactly one of: `loop` (an inline list of
 //! points, closed by itself, or a closed curve table as above), `loop_csv` (a CSV file of
 //! points) or `loops` (a list of loops, the first the outer one, the others holes). Optional:
-//! `darts = [{ at = 12, points = [[x, y, z], ...], width = 2 }]` (from loop point `at`,
-//! counted from 1, to the tip, the last point; `width` the opening at the mouth in mm),
-//! `rulings = [[i, j], ...]` (edges between loop points, counted from 1, that the surface
-//! must contain), `max_dihedral` (degrees, default 60), `min_chart_area` (percent of the hull,
+//! `darts = [{ at = 12, points = [[x, y, z], ...], loop = 1, width = 2 }]` (from point `at` of
+//! loop `loop` (default 1), counted from 1, to the tip, the last point; the dart's two sides
+//! coincide in 3D; `width` is the opening at the mouth in mm used only if they cannot be
+//! triangulated so), `rulings = [[i, j], ...]` (edges between points of the first loop,
+//! counted from 1, that the surface must contain) or `[[[l, i], [m, j]], ...]` (point `i` of
+//! loop `l` to point `j` of loop `m`: within a loop a ruling splits the surface, between loops
+//! it joins them), `max_dihedral` (degrees, default 60), `min_chart_area` (percent of the hull,
 //! default 2), `max_iterations` (default 1000), `good_interior` and `good_fairness` (stop as
 //! soon as a triangulation has at most that many interior triangles and that sum of squared
 //! dihedral angles in radians²; default 0 and 0), `smooth` (resample a B-spline through the
@@ -2540,14 +2543,26 @@ impl Ctx<'_> {
                     return Err(bad("must be a table { at = N, points = [[x, y, z], ...] }"));
                 };
                 for name in t.keys() {
-                    if !["at", "points", "width"].contains(&name.as_str()) {
+                    if !["at", "points", "width", "loop"].contains(&name.as_str()) {
                         return Err(self.invalid(
                             darts_line,
                             &format!("{dk}.{name}"),
-                            "unknown key; expected one of at, points, width".into(),
+                            "unknown key; expected one of at, points, width, loop".into(),
                         ));
                     }
                 }
+                let looop = match t.get("loop") {
+                    None => 0,
+                    Some(Value::Integer(n)) if *n >= 1 && (*n as usize) <= loops.len() => {
+                        (*n - 1) as usize
+                    }
+                    Some(_) => {
+                        return Err(bad(&format!(
+                        "`loop` must be the number (from 1) of the loop the dart is on, at most {}",
+                        loops.len()
+                    )))
+                    }
+                };
                 let at =
                     match t.get("at") {
                         Some(Value::Integer(n)) if *n >= 1 => (*n - 1) as usize,
@@ -2567,7 +2582,12 @@ impl Ctx<'_> {
                     Some(Value::Float(f)) if f.is_finite() && *f > 0.0 => Some(*f),
                     Some(_) => return Err(bad("`width` must be a positive number of millimetres")),
                 };
-                darts.push(Dart { at, points, width });
+                darts.push(Dart {
+                    looop,
+                    at,
+                    points,
+                    width,
+                });
             }
         }
         let mut rulings = Vec::new();
@@ -2576,21 +2596,31 @@ impl Ctx<'_> {
             rulings_line = self.line(v.span());
             let k = format!("{key}.rulings");
             let msg =
-                "must be a list of point-number pairs [[i, j], ...] (points of the loop, from 1)";
+                "must be a list of point-number pairs [[i, j], ...] (points of the first loop, from 1) or [[loop, i], [loop, j]] pairs (loops and points from 1)";
             let Value::Array(items) = v.get_ref() else {
                 return Err(self.invalid(rulings_line, &k, msg.into()));
+            };
+            let num = |x: &Value| match x {
+                Value::Integer(n) if *n >= 1 => Some((*n - 1) as usize),
+                _ => None,
+            };
+            let end = |x: &Value| match x {
+                Value::Integer(_) => num(x).map(|i| (0, i)),
+                Value::Array(p) if p.len() == 2 => num(&p[0]).zip(num(&p[1])),
+                _ => None,
             };
             for (i, it) in items.iter().enumerate() {
                 match it {
                     Value::Array(a)
                         if a.len() == 2
-                            && a.iter().all(|x| matches!(x, Value::Integer(n) if *n >= 1)) =>
+                            && end(&a[0]).is_some()
+                            && end(&a[1]).is_some()
+                            && matches!(a[0], Value::Integer(_))
+                                == matches!(a[1], Value::Integer(_)) =>
                     {
-                        let n = |x: &Value| match x {
-                            Value::Integer(n) => (*n - 1) as usize,
-                            _ => 0,
-                        };
-                        rulings.push([n(&a[0]), n(&a[1])]);
+                        if let (Some(x), Some(y)) = (end(&a[0]), end(&a[1])) {
+                            rulings.push([x, y]);
+                        }
                     }
                     _ => {
                         return Err(self.invalid(
@@ -2628,7 +2658,9 @@ impl Ctx<'_> {
                 | BoundaryError::Repeated { looop, .. }
                 | BoundaryError::Open { looop } => at_loop(*looop),
                 BoundaryError::SelfIntersecting { la, .. } => at_loop(*la),
-                BoundaryError::NoLoop => (header_line, format!("{key}.loop")),
+                BoundaryError::NoLoop
+                | BoundaryError::Loops(_)
+                | BoundaryError::NoTriangulation => (header_line, format!("{key}.loops")),
             };
             return Err(self.invalid(line, &k, e.to_string()));
         }
@@ -3402,7 +3434,7 @@ good_fairness = 0.5
         );
         assert_eq!(b.input.darts[0].at, 0);
         assert_eq!(b.input.darts[0].width, Some(4.0));
-        assert_eq!(b.input.rulings, vec![[1, 4]]);
+        assert_eq!(b.input.rulings, vec![[(0, 1), (0, 4)]]);
         assert_eq!(b.options.max_dihedral_deg, 45.0);
         assert!((b.options.min_chart_area - 0.03).abs() < 1e-15);
         assert_eq!(b.options.max_iterations, 200);
@@ -3413,10 +3445,14 @@ good_fairness = 0.5
 [[surface]]
 kind = "boundary"
 loops = [{ kind = "ellipse", center = [0, 0, 0], rx = 100, ry = 60 }, [[-10, -10, 0], [10, -10, 0], [0, 10, 0]]]
+darts = [{ loop = 2, at = 3, points = [[0, 0, 0]] }]
+rulings = [[[1, 1], [2, 1]]]
 "#)
         .unwrap();
         let b = spec.surfaces[0].boundary.as_ref().unwrap();
         assert_eq!(b.input.loops.len(), 2);
+        assert_eq!((b.input.darts[0].looop, b.input.darts[0].at), (1, 2));
+        assert_eq!(b.input.rulings, vec![[(0, 0), (1, 0)]]);
         assert!(b.input.loops[0].len() > 8);
     }
 }

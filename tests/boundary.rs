@@ -328,30 +328,65 @@ fn alternatives_are_distinct_boundary_triangulations() {
     }
 }
 
+/// Where each vertex lands in the flat (the first face corner seen), for a one-island flat.
+fn flat_positions(mesh: &Mesh, flat: &flatcut::flatten::Flat) -> Vec<Option<glam::DVec2>> {
+    let mut at = vec![None; mesh.vertices.len()];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for (i, &v) in face.verts.iter().enumerate() {
+            at[v].get_or_insert(flat.face_2d[f][i]);
+        }
+    }
+    at
+}
+
+fn flat_area(flat: &flatcut::flatten::Flat) -> f64 {
+    flat.face_2d
+        .iter()
+        .map(|p| 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]))
+        .sum()
+}
+
 #[test]
-fn dart_opens_into_the_flat_piece() {
+fn dart_sides_coincide_in_3d_and_open_in_the_flat_piece() {
     let pts = csv("dress-panel");
-    let tip = DVec3::new(0.0, 80.0, -0.36);
+    let tip = DVec3::new(0.0, 80.0, -8.0);
     let out = triangulate(
         &Input {
             loops: vec![pts.clone()],
             darts: vec![Dart {
                 at: 0,
                 points: vec![tip],
-                width: Some(12.0),
+                ..Default::default()
             }],
             ..Default::default()
         },
         &Options::default(),
     )
     .unwrap();
-    // The dart adds the two mouth copies and the tip in place of point 1.
+    eprintln!("dress panel: {:?}", out.figures);
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+    // The dart adds the two mouth copies and the tip in place of point 1; the copies coincide.
     let nv = out.mesh.vertices.len();
     assert_eq!(nv, pts.len() + 2);
     assert_eq!(out.mesh.vertices[1], tip);
-    assert!((out.mesh.vertices[0].distance(out.mesh.vertices[2]) - 12.0).abs() < 1e-9);
+    assert_eq!(out.mesh.vertices[0], pts[0]);
+    assert_eq!(out.mesh.vertices[2], pts[0]);
     check_boundary_triangulation(&out.mesh, &one_loop(nv));
-    check_unfolds(&out.mesh);
+    for f in 0..out.mesh.faces.len() {
+        assert!(out.mesh.face_area(f) > 1e-6, "face {f} is degenerate");
+    }
+    let flat = check_unfolds(&out.mesh);
+    assert_eq!(flat.islands.len(), 1, "one piece");
+    // The flat piece opens the dart: the two copies of the mouth land apart, the tip once.
+    let at = flat_positions(&out.mesh, &flat);
+    let gap = at[0].unwrap().distance(at[2].unwrap());
+    eprintln!("dress panel dart: mouth opens {gap:.3} mm in the flat piece");
+    assert!(gap > 1.0, "the dart opens: {gap}");
+    // The flat piece's area is the 3D area.
+    let a3: f64 = (0..out.mesh.faces.len())
+        .map(|f| out.mesh.face_area(f))
+        .sum();
+    assert!((flat_area(&flat) - a3).abs() <= 1e-9 * a3);
     // The same through the spec (the pattern file).
     let spec = flatcut::spec::load(&manifest("patterns/dress-panel.toml")).unwrap();
     let s = flatcut::surface::build(&spec.surfaces[0]).unwrap();
@@ -359,35 +394,213 @@ fn dart_opens_into_the_flat_piece() {
     assert!(s.figures.iter().any(|(k, _)| *k == "interior_triangles"));
 }
 
-#[test]
-fn holes_are_bridged_into_an_annulus() {
-    // A band on a cylinder with a window cut in it.
-    let ring = |r: f64, w: f64, n: usize, x0: f64| -> Vec<DVec3> {
-        (0..n)
-            .map(|k| {
-                let t = TAU * k as f64 / n as f64;
-                let (x, s) = (x0 + w * t.cos(), r * t.sin());
-                DVec3::new(
-                    x,
-                    120.0 * (s / 120.0).sin(),
-                    120.0 * (1.0 - (s / 120.0).cos()),
-                )
-            })
-            .collect()
-    };
-    let outer = ring(90.0, 120.0, 32, 0.0);
-    let hole = ring(30.0, 40.0, 12, 10.0);
+/// Loops as vertex ids in the order `triangulate` numbers them (no darts).
+fn loop_ids(loops: &[Vec<DVec3>]) -> Vec<Vec<usize>> {
+    let mut start = 0;
+    loops
+        .iter()
+        .map(|l| {
+            let ids = (start..start + l.len()).collect();
+            start += l.len();
+            ids
+        })
+        .collect()
+}
+
+/// Triangulate several loops, check the invariants, unfold (edges to 1e-9), check the flat
+/// area against the 3D area; returns the output and the flat.
+fn several_loops(
+    name: &str,
+    loops: Vec<Vec<DVec3>>,
+) -> (flatcut::surface::boundary::Output, flatcut::flatten::Flat) {
     let out = triangulate(
         &Input {
-            loops: vec![outer.clone(), hole.clone()],
+            loops: loops.clone(),
             ..Default::default()
         },
         &Options::default(),
     )
     .unwrap();
-    let loops = vec![(0..32).collect::<Vec<_>>(), (32..44).collect()];
-    check_boundary_triangulation(&out.mesh, &loops);
-    assert_eq!(out.mesh.faces.len(), 32 + 12, "n + 2h − 2 triangles");
+    let all: Vec<DVec3> = loops.iter().flatten().copied().collect();
+    assert_eq!(
+        out.mesh.vertices, all,
+        "{name}: vertices are the input points"
+    );
+    check_boundary_triangulation(&out.mesh, &loop_ids(&loops));
+    let n = all.len();
+    let h = loops.len() - 1;
+    assert_eq!(
+        out.mesh.faces.len(),
+        n + 2 * h - 2,
+        "{name}: n + 2h − 2 triangles"
+    );
+    for f in 0..out.mesh.faces.len() {
+        assert!(
+            out.mesh.face_area(f) > 1e-6,
+            "{name}: face {f} is degenerate"
+        );
+    }
+    let flat = check_unfolds(&out.mesh);
+    let a3: f64 = (0..out.mesh.faces.len())
+        .map(|f| out.mesh.face_area(f))
+        .sum();
+    let a2 = flat_area(&flat);
+    assert!(
+        (a2 - a3).abs() <= 1e-9 * a3,
+        "{name}: flat area {a2} vs {a3}"
+    );
+    let f = &out.figures;
+    eprintln!(
+        "{name}: {n} points in {} loops, {} connecting charts, {} joining edges, {} interior triangles, {}/{} locally convex, largest dihedral {:.2}°, {} iterations, {:.3} s, {} flat piece(s), warnings {:?}",
+        loops.len(),
+        f.connecting_charts,
+        f.joining_edges,
+        f.interior_triangles,
+        f.convex_edges,
+        f.interior_edges,
+        f.largest_dihedral_deg,
+        f.iterations,
+        f.seconds,
+        flat.islands.len(),
+        out.warnings
+    );
+    (out, flat)
+}
+
+/// A ring of `n` points on a cylinder of radius 120 about the x axis (a bent panel).
+fn bent_ring(r: f64, w: f64, n: usize, x0: f64, y0: f64) -> Vec<DVec3> {
+    (0..n)
+        .map(|k| {
+            let t = TAU * k as f64 / n as f64;
+            let (x, s) = (x0 + w * t.cos(), y0 + r * t.sin());
+            DVec3::new(
+                x,
+                120.0 * (s / 120.0).sin(),
+                120.0 * (1.0 - (s / 120.0).cos()),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_window_in_a_bent_panel_is_joined_by_the_shortest_edge() {
+    let loops = vec![
+        bent_ring(90.0, 120.0, 32, 0.0, 0.0),
+        bent_ring(30.0, 40.0, 12, 10.0, 0.0),
+    ];
+    let (out, _) = several_loops("bent panel, one window", loops);
+    assert_eq!(
+        out.figures.connecting_charts + out.figures.joining_edges,
+        1,
+        "one connection for one hole"
+    );
+}
+
+#[test]
+fn a_band_between_two_non_planar_loops_is_one_connecting_chart() {
+    // A lamp collar: a wavy lower rim and a smaller wavy upper rim.
+    let rim = |r: f64, z: f64, a: f64, waves: f64, n: usize| -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let t = TAU * k as f64 / n as f64;
+                DVec3::new(r * t.cos(), r * t.sin(), z + a * (waves * t).sin())
+            })
+            .collect()
+    };
+    let loops = vec![rim(100.0, 0.0, 8.0, 3.0, 48), rim(60.0, 80.0, 5.0, 2.0, 36)];
+    let (out, flat) = several_loops("band", loops);
+    assert!(
+        out.figures.connecting_charts >= 1,
+        "a hull chart joins the rims"
+    );
+    assert_eq!(out.figures.joining_edges, 0);
+    assert_eq!(out.figures.interior_triangles, 0);
+    assert!(out.figures.convex_fraction() >= 0.9);
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+    assert_eq!(flat.islands.len(), 1, "one piece (cut open along one edge)");
+}
+
+#[test]
+fn a_panel_with_two_holes_keeps_both_holes() {
+    // Planar, tilted: the flat piece is the polygon with its two holes, no folds.
+    let rot = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.8);
+    let ring = |cx: f64, cy: f64, rx: f64, ry: f64, n: usize| -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let t = TAU * k as f64 / n as f64;
+                rot * DVec3::new(cx + rx * t.cos(), cy + ry * t.sin(), 0.0)
+            })
+            .collect()
+    };
+    let loops = vec![
+        ring(0.0, 0.0, 150.0, 90.0, 40),
+        ring(-60.0, 0.0, 30.0, 20.0, 12),
+        ring(60.0, 10.0, 25.0, 35.0, 10),
+    ];
+    let (out, flat) = several_loops("planar panel, two holes", loops.clone());
+    assert_eq!(flat.islands.len(), 1, "one piece with the holes cut out");
+    assert!(out.figures.largest_dihedral_deg < 1e-6);
+    let poly = |l: &[DVec3]| {
+        let n = l.len();
+        let mut a = DVec3::ZERO;
+        for k in 0..n {
+            a += l[k].cross(l[(k + 1) % n]);
+        }
+        0.5 * a.length()
+    };
+    let expect = poly(&loops[0]) - poly(&loops[1]) - poly(&loops[2]);
+    assert!((flat_area(&flat) - expect).abs() <= 1e-9 * expect);
+    assert_eq!(
+        out.figures.joining_edges, 2,
+        "the shortest tree over three loops"
+    );
+    // Bent: the same panel on a cylinder.
+    let loops = vec![
+        bent_ring(90.0, 150.0, 40, 0.0, 0.0),
+        bent_ring(20.0, 30.0, 12, -60.0, 0.0),
+        bent_ring(30.0, 25.0, 10, 60.0, 10.0),
+    ];
+    several_loops("bent panel, two holes", loops);
+}
+
+#[test]
+fn darts_and_rulings_on_any_loop() {
+    // A bent panel whose window has a dart, and a ruling joining the window to the rim.
+    let loops = vec![
+        bent_ring(90.0, 120.0, 32, 0.0, 0.0),
+        bent_ring(30.0, 40.0, 12, 10.0, 0.0),
+    ];
+    let hole = &loops[1];
+    // The dart runs from the window's point 7 outwards, taking the panel in 8 mm.
+    let tip = hole[6] + (hole[6] - hole[0]) * 0.3 - DVec3::Z * 8.0;
+    let input = Input {
+        loops: loops.clone(),
+        darts: vec![Dart {
+            looop: 1,
+            at: 6,
+            points: vec![tip],
+            ..Default::default()
+        }],
+        rulings: vec![[(0, 0), (1, 0)]],
+    };
+    let out = triangulate(&input, &Options::default()).unwrap();
+    eprintln!("window with a dart: {:?}, {:?}", out.figures, out.warnings);
+    // Loop 2 gains the dart: its point 7 becomes two copies with the tip between them.
+    let n0 = loops[0].len();
+    let v = &out.mesh.vertices;
+    assert_eq!(v.len(), n0 + 12 + 2);
+    assert_eq!(v[n0 + 6], v[n0 + 8], "the dart's sides coincide");
+    assert_eq!(v[n0 + 7], tip);
+    let hole_ids: Vec<usize> = (n0..n0 + 14).collect();
+    check_boundary_triangulation(&out.mesh, &[(0..n0).collect(), hole_ids]);
+    assert_eq!(out.figures.connecting_charts + out.figures.joining_edges, 1);
+    let topo = out.mesh.topology();
+    let e = topo
+        .edges
+        .iter()
+        .find(|e| e.verts == [0, n0])
+        .expect("the ruling between the loops is an edge");
+    assert_eq!(e.uses.len(), 2, "interior edge");
     check_unfolds(&out.mesh);
 }
 
@@ -398,7 +611,7 @@ fn rulings_are_edges_of_the_result() {
     let out = triangulate(
         &Input {
             loops: vec![pts],
-            rulings: vec![[5, 30], [12, 24]],
+            rulings: vec![[(0, 5), (0, 30)], [(0, 12), (0, 24)]],
             ..Default::default()
         },
         &Options::default(),
@@ -415,7 +628,12 @@ fn rulings_are_edges_of_the_result() {
         assert_eq!(e.uses.len(), 2, "interior edge");
     }
     // Crossing rulings and neighbours are refused.
-    for bad in [vec![[5, 30], [10, 40]], vec![[3, 4]], vec![[0, 99]]] {
+    for bad in [
+        vec![[(0, 5), (0, 30)], [(0, 10), (0, 40)]],
+        vec![[(0, 3), (0, 4)]],
+        vec![[(0, 0), (0, 99)]],
+        vec![[(0, 0), (1, 2)]],
+    ] {
         let e = triangulate(
             &Input {
                 loops: vec![csv("taco")],
@@ -595,7 +813,7 @@ fn same_boundary_gives_the_same_triangulation() {
         darts: vec![Dart {
             at: 0,
             points: vec![DVec3::new(0.0, 80.0, -0.36)],
-            width: None,
+            ..Default::default()
         }],
         ..Default::default()
     };

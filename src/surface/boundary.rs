@@ -31,7 +31,8 @@
 //!   Stop when the best is good enough (`good_interior`, `good_fairness`), the queue is empty,
 //!   or after `max_iterations` (the paper: "less than a thousand for all the models").
 //!   A hull without any valid chart makes each of its triangles a chart (the pathological case).
-//! - §6 darts, several loops, rulings, alternatives; §7 B-spline smoothing and radial offset.
+//! - §6 darts, several loops (connecting charts first, else the shortest tree), rulings,
+//!   alternatives; §7 B-spline smoothing and radial offset.
 //!
 //! # Choices where the paper is silent
 //!
@@ -48,19 +49,59 @@
 //! - Chart area threshold: relative to the hull of the subloop being split (deeper subloops
 //!   are small; against the top hull they would never have charts).
 //! - Subloop plane for the fairness bound: Newell's normal through the centroid.
-//! - Darts: the paper duplicates the dart polyline with reversed orientation into one closed
-//!   boundary. Two copies of the same points would make a boundary triangulation degenerate,
-//!   so the copies are opened into a narrow V: at the mouth by `dart_width` (default 2 % of
-//!   the dart's length) along the boundary, narrowing linearly to the single tip vertex. The
-//!   flat piece then has the dart cut out, which is what a pattern needs.
-//! - Several loops: the first is the outer one, the others are holes (reversed if their
-//!   Newell normal agrees with the outer's). Each hole is joined to the region holding the
-//!   vertex nearest to it by two edges: the shortest one, and one from the region vertex half
-//!   way round to its nearest hole vertex. (The paper's single shortest tree would make a
-//!   loop that runs both ways along one edge, which needs duplicate vertices.) Those edges and
-//!   the user's rulings are constraints: they split the boundary into subloops solved
-//!   separately, and do not count as polyline edges for charts (§6.1). The paper's first
-//!   choice, hull charts connecting loops, is not implemented.
+//! - Darts (§6.1): a dart is a polyline from a loop point (of any loop) to its tip, inserted
+//!   twice with reversed orientation into its loop: the loop point and the dart's points are
+//!   duplicated (left copy, tip once, right copy), and the two copies *coincide* in 3D — the
+//!   sewn dart. The triangulation treats them as two boundary sections, so the flat piece
+//!   opens them into the V that a pattern cuts out. Coinciding points break hulls and local
+//!   convexity predicates, so, as the §7 radial offset does, hulls are computed on perturbed
+//!   points only: the copies opened into a narrow V (at the mouth `width`, default 2 % of the
+//!   dart's length, along the boundary, narrowing to the tip); triangles and all angles use
+//!   the real points. A triangle with two copies of one point, a triangle without area, or
+//!   an edge in space used by more than two triangles (the surface folded onto itself around
+//!   the tip) is refused in charts, envelopes, covers and results. Should the coinciding
+//!   sides give no valid triangulation, or only one over the limits while the V gives one
+//!   within them, the darts are opened into that V for real and a warning says so (the old
+//!   behaviour, kept only as this fallback; with neither valid the result is an error). A
+//!   dart tip that lies off the surface the rest of the boundary asks for (the dart takes
+//!   fabric in) is what makes the flat V open; a tip barely off it can need the fallback.
+//! - Several loops (§6): the first loop is the outer one, the others holes (reversed if their
+//!   Newell normal agrees with the outer's, so that the surface lies left of every loop).
+//!   First, charts that connect loops: on the hull of all the loops' points (radial offset
+//!   applied) charts are found as in §3 — triangles with an input edge, all wound like the
+//!   loops, joined across edges that are not loop edges — and a chart is *connecting* when it
+//!   touches two loops or more. The validity conditions are those of single charts (smooth
+//!   inside and against the neighbouring interior hull triangles, at least `min_chart_area`
+//!   of the hull), plus, adapted to several loops: its subtraction must leave simple loops
+//!   with each touched loop entered once (so they merge into one loop, or vanish when the
+//!   chart covers the band between them, as on a lamp collar), and keep every ruling
+//!   possible. The largest valid one is taken (the paper does not say which: the largest is
+//!   the §5.1.2 potential's choice), subtracted, and the search for connecting charts is
+//!   repeated on the loops left; its triangles are part of the result. Then the user's
+//!   rulings between loops join them, then the *shortest tree* of connecting edges: Kruskal
+//!   over all vertex pairs of different loops by length, skipping an edge that comes within
+//!   1e-9 × the size of a loop edge, a chart edge, a ruling or an earlier tree edge (in
+//!   space; this is exact for planar panels), or that shares an end with another joining
+//!   edge or a ruling. A joining edge `a b` is walked both ways (… a, b, around the hole, b,
+//!   a, …): the search sees `a` and `b` twice, as two copies nudged apart for the hulls only
+//!   (1 % of the shorter of the joining edge and their loop edge, along the loop edge), and
+//!   the same validity test refuses triangles that would use the edge or a vertex twice. In
+//!   the result both copies are one vertex, so the joining edge is an ordinary interior edge
+//!   with a triangle on each side: the mesh is a disk with holes (Euler characteristic
+//!   1 − holes), its boundary exactly the input loops. Joining edges and chart rims are
+//!   treated as interior edges for chart extraction (§6.1). The dihedral angles across a
+//!   connecting chart's rim are measured in the figures but not bounded by the search of the
+//!   region next to it.
+//! - Rulings (§6.1) name points of any loop. Between two loops a ruling is a joining edge
+//!   (taken before the shortest tree); within the joined loop it is a constraint edge that
+//!   splits it into regions searched separately.
+//! - The flat piece of a surface with holes: the flatten stage unfolds it face by face. If a
+//!   hole's loop closes up in the plane (a planar panel, or any panel whose surface around
+//!   the hole is developable as a disk) the piece is one piece with the hole cut out, which
+//!   is what a cutter user wants (no slit to tape). A band around a hole that cannot lie flat
+//!   closed (a lamp collar: a cone-like band) is cut open along one edge by the unfolder
+//!   (where joining is cheapest) into one piece with a slit there, the seam the user glues:
+//!   that is unavoidable, since no flat piece without a cut has that shape.
 //! - Alternatives: every distinct complete triangulation met is kept; the N best are returned.
 //! - The radial offset is skipped when it leaves fewer loop edges on the hull than the input
 //!   points do (a scalloped edge near the centre of mass sinks inside its hull when pushed).
@@ -73,7 +114,7 @@
 use crate::geom::hull::{self, segment_on_hull};
 use crate::geom::mesh::{Face, Mesh};
 use glam::{DVec2, DVec3};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::rc::Rc;
 use std::time::Instant;
 
@@ -88,7 +129,7 @@ pub struct Options {
     pub good_interior: usize,
     /// …and at most this sum of squared dihedral angles (radians²).
     pub good_fairness: f64,
-    /// Branch-and-bound iterations at most (per subloop split by rulings or holes).
+    /// Branch-and-bound iterations at most (per region split by rulings).
     pub max_iterations: usize,
     /// §7 radial offset, relative to the mean distance from the centre of mass.
     pub offset: f64,
@@ -110,22 +151,27 @@ impl Default for Options {
     }
 }
 
-/// A dart: from loop point `at` (0-based) through `points`, the last one being the tip.
-#[derive(Debug, Clone, PartialEq)]
+/// A dart: from point `at` of loop `looop` (both 0-based) through `points`, the last one being
+/// the tip.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Dart {
+    pub looop: usize,
     pub at: usize,
     pub points: Vec<DVec3>,
-    /// Opening at the mouth, mm; `None`: 2 % of the dart's length.
+    /// Opening at the mouth, mm, used only when the coincident sides cannot be triangulated
+    /// (and for the hulls); `None`: 2 % of the dart's length.
     pub width: Option<f64>,
 }
 
-/// The boundary: closed loops (the first outer), darts and rulings on the first loop.
+/// The boundary: closed loops (the first outer), darts and rulings on any loop.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Input {
     pub loops: Vec<Vec<DVec3>>,
     pub darts: Vec<Dart>,
-    /// Pairs of 0-based point indices of the first loop (before darts are inserted).
-    pub rulings: Vec<[usize; 2]>,
+    /// Edges the result must contain: pairs of (loop, point), 0-based, points counted before
+    /// darts are inserted. Between two points of one loop a ruling splits the region; between
+    /// two loops it joins them.
+    pub rulings: Vec<[(usize, usize); 2]>,
 }
 
 /// Predictability then fairness; lower is better.
@@ -154,6 +200,10 @@ pub struct Figures {
     pub fairness: f64,
     pub iterations: usize,
     pub seconds: f64,
+    /// Hull charts that joined loops (§6).
+    pub connecting_charts: usize,
+    /// Edges that joined loops: rulings between loops and the shortest tree (§6).
+    pub joining_edges: usize,
 }
 
 impl Figures {
@@ -210,6 +260,10 @@ pub enum BoundaryError {
     Ruling { index: usize, message: String },
     #[error("dart {index}: {message}")]
     Dart { index: usize, message: String },
+    #[error("several loops: {0}")]
+    Loops(String),
+    #[error("no valid boundary triangulation found (a dart or a joining edge folds the surface onto itself); raise max_dihedral, lower min_chart_area, or add rulings")]
+    NoTriangulation,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -371,28 +425,47 @@ fn newell(p: &[DVec3]) -> DVec3 {
     n
 }
 
-/// Insert the darts into the first loop (see the module doc). Returns the new loop, the map
-/// from old point index to new, and the user label of each new point.
-#[allow(clippy::type_complexity)]
+/// One loop with its darts inserted (see the module doc).
+struct Darted {
+    /// The points; a dart's two copies coincide (or form the opened V with `open`).
+    pts: Vec<DVec3>,
+    /// The points for hulls and the crossing check: the copies always opened into a V.
+    hull: Vec<DVec3>,
+    /// For each point, the point it coincides with: the left copy for a right copy, else itself.
+    twin: Vec<usize>,
+    /// Old point index → new.
+    map: Vec<usize>,
+    /// The user's (loop, point) name of each new point, from 1.
+    labels: Vec<(usize, usize)>,
+}
+
+/// Insert the darts `(index, dart)` of loop `l` into its points (see the module doc).
 fn insert_darts(
     pts: &[DVec3],
-    darts: &[Dart],
-) -> Result<(Vec<DVec3>, Vec<usize>, Vec<(usize, usize)>), BoundaryError> {
+    l: usize,
+    darts: &[(usize, &Dart)],
+    open: bool,
+) -> Result<Darted, BoundaryError> {
     let n = pts.len();
     let mut by_at: Vec<Option<usize>> = vec![None; n];
-    for (k, d) in darts.iter().enumerate() {
+    for (di, &(k, d)) in darts.iter().enumerate() {
         let err = |message: String| BoundaryError::Dart {
             index: k + 1,
             message,
         };
         if d.at >= n {
             return Err(err(format!(
-                "starts at point {} but the loop has {n} points",
-                d.at + 1
+                "starts at point {} but loop {} has {n} points",
+                d.at + 1,
+                l + 1
             )));
         }
         if by_at[d.at].is_some() {
-            return Err(err(format!("point {} already starts a dart", d.at + 1)));
+            return Err(err(format!(
+                "point {} of loop {} already starts a dart",
+                d.at + 1,
+                l + 1
+            )));
         }
         if d.points.is_empty() {
             return Err(err("needs at least one point (the tip)".into()));
@@ -414,19 +487,25 @@ fn insert_darts(
                 )));
             }
         }
-        by_at[d.at] = Some(k);
+        by_at[d.at] = Some(di);
     }
-    let mut out = Vec::new();
-    let mut labels = Vec::new();
-    let mut map = vec![0; n];
+    let mut out = Darted {
+        pts: Vec::new(),
+        hull: Vec::new(),
+        twin: Vec::new(),
+        map: vec![0; n],
+        labels: Vec::new(),
+    };
     for i in 0..n {
-        let Some(k) = by_at[i] else {
-            map[i] = out.len();
-            out.push(pts[i]);
-            labels.push((1, i + 1));
+        let Some(di) = by_at[i] else {
+            out.map[i] = out.pts.len();
+            out.twin.push(out.pts.len());
+            out.pts.push(pts[i]);
+            out.hull.push(pts[i]);
+            out.labels.push((l + 1, i + 1));
             continue;
         };
-        let d = &darts[k];
+        let d = darts[di].1;
         let a = pts[i];
         let t = (pts[(i + 1) % n] - pts[(i + n - 1) % n]).normalize_or_zero();
         let mut chain = vec![a];
@@ -439,73 +518,134 @@ fn insert_darts(
         let half = 0.5 * d.width.unwrap_or(0.02 * len);
         let m = chain.len();
         // Left copy (mouth to tip, on the side of the previous point), tip, right copy back.
-        map[i] = out.len();
+        out.map[i] = out.pts.len();
+        let left = out.pts.len();
         for j in 0..m - 1 {
-            out.push(chain[j] - t * half * (1.0 - cum[j] / len));
-            labels.push((1, i + 1));
+            let v = chain[j] - t * half * (1.0 - cum[j] / len);
+            out.twin.push(out.pts.len());
+            out.pts.push(if open { v } else { chain[j] });
+            out.hull.push(v);
+            out.labels.push((l + 1, i + 1));
         }
-        out.push(chain[m - 1]);
-        labels.push((1, i + 1));
+        out.twin.push(out.pts.len());
+        out.pts.push(chain[m - 1]);
+        out.hull.push(chain[m - 1]);
+        out.labels.push((l + 1, i + 1));
         for j in (0..m - 1).rev() {
-            out.push(chain[j] + t * half * (1.0 - cum[j] / len));
-            labels.push((1, i + 1));
+            let v = chain[j] + t * half * (1.0 - cum[j] / len);
+            out.twin.push(if open { out.pts.len() } else { left + j });
+            out.pts.push(if open { v } else { chain[j] });
+            out.hull.push(v);
+            out.labels.push((l + 1, i + 1));
         }
     }
-    Ok((out, map, labels))
+    Ok(out)
 }
 
 // ---------------------------------------------------------------------------------------------
-// The whole boundary: regions split by rulings and hole bridges, each searched on its own
+// The whole boundary: loops joined by connecting charts and the shortest tree, regions split by
+// rulings, each searched on its own
 // ---------------------------------------------------------------------------------------------
 
-/// The boundary ready to search: all vertices, the loops as vertex ids (holes reversed when
-/// needed), the input's directed edges and the regions split by rulings and hole bridges.
+/// The boundary ready to search.
 struct Prepared {
+    /// All vertices (dart copies coincide unless opened).
     verts: Vec<DVec3>,
+    /// The vertices for hulls (dart copies opened into a V).
+    hverts: Vec<DVec3>,
+    /// Site of each vertex: the vertex it coincides with (a dart's left copy), else itself.
+    site: Vec<usize>,
+    /// The loops as vertex ids, holes reversed when needed.
     loop_ids: Vec<Vec<usize>>,
+    /// The input's directed edges.
     input_edges: HashSet<(usize, usize)>,
+    /// Triangles of the charts that connect loops, wound like the loops.
+    fixed: Vec<[usize; 3]>,
+    /// Loops joining edges (user rulings between loops and the shortest tree), undirected.
+    joins: HashSet<(usize, usize)>,
+    /// The simple-or-seamed loops left to search (a join's ends appear twice).
     regions: Vec<Vec<usize>>,
+    connecting_charts: usize,
 }
 
 /// Check a boundary without searching: loops, darts, crossings, rulings.
 pub fn check(input: &Input) -> Result<(), BoundaryError> {
-    prepare(input).map(|_| ())
+    prepare(input, &Options::default(), false).map(|_| ())
 }
 
 /// Triangulate a boundary (see the module doc).
 pub fn triangulate(input: &Input, opts: &Options) -> Result<Output, BoundaryError> {
     let t0 = Instant::now();
-    let Prepared {
-        verts,
-        loop_ids,
-        input_edges,
-        regions,
-    } = prepare(input)?;
-    search(verts, loop_ids, input_edges, regions, opts, t0)
+    let prep = prepare(input, opts, false)?;
+    let relaxed = |o: &Output| o.warnings.iter().any(|w| w.starts_with(RELAXED));
+    let (out, ok) = search(prep, opts, t0);
+    if ok && (input.darts.is_empty() || !relaxed(&out)) {
+        return Ok(out);
+    }
+    if !input.darts.is_empty() {
+        // The fallback: darts opened into a narrow V, when the coincident sides gave no valid
+        // triangulation or only one over the limits and the V gives one within them.
+        let prep = prepare(input, opts, true)?;
+        let (mut open, open_ok) = search(prep, opts, t0);
+        if open_ok && (!ok || !relaxed(&open)) {
+            open.warnings.insert(
+                0,
+                "the darts could not be triangulated within the limits with their two sides coinciding: they were opened into a narrow V (`width`, default 2 % of the dart's length)".into(),
+            );
+            open.figures.seconds = t0.elapsed().as_secs_f64();
+            return Ok(open);
+        }
+    }
+    if ok {
+        return Ok(out);
+    }
+    Err(BoundaryError::NoTriangulation)
 }
 
-fn prepare(input: &Input) -> Result<Prepared, BoundaryError> {
+/// How the warning that the limits were relaxed starts.
+const RELAXED: &str = "no triangulation with every dihedral angle under";
+
+fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepared, BoundaryError> {
     check_loops(&input.loops)?;
-    let (first, map, first_labels) = insert_darts(&input.loops[0], &input.darts)?;
-    let mut loops = vec![first];
-    let mut labels = vec![first_labels];
-    for (l, p) in input.loops.iter().enumerate().skip(1) {
-        loops.push(p.clone());
-        labels.push((0..p.len()).map(|i| (l + 1, i + 1)).collect());
+    let nl = input.loops.len();
+    for (k, d) in input.darts.iter().enumerate() {
+        if d.looop >= nl {
+            return Err(BoundaryError::Dart {
+                index: k + 1,
+                message: format!("is on loop {} but there are {nl} loops", d.looop + 1),
+            });
+        }
     }
-    check_crossings(&loops, &labels)?;
+    let mut darted = Vec::new();
+    for (l, p) in input.loops.iter().enumerate() {
+        let mine: Vec<(usize, &Dart)> = input
+            .darts
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.looop == l)
+            .collect();
+        darted.push(insert_darts(p, l, &mine, open)?);
+    }
+    let hull_loops: Vec<Vec<DVec3>> = darted.iter().map(|d| d.hull.clone()).collect();
+    let labels: Vec<Vec<(usize, usize)>> = darted.iter().map(|d| d.labels.clone()).collect();
+    check_crossings(&hull_loops, &labels)?;
     // Global vertices and the input's directed edges.
     let mut verts: Vec<DVec3> = Vec::new();
+    let mut hverts: Vec<DVec3> = Vec::new();
+    let mut site: Vec<usize> = Vec::new();
     let mut starts = Vec::new();
-    for p in &loops {
-        starts.push(verts.len());
-        verts.extend_from_slice(p);
+    for d in &darted {
+        let s = verts.len();
+        starts.push(s);
+        verts.extend_from_slice(&d.pts);
+        hverts.extend_from_slice(&d.hull);
+        site.extend(d.twin.iter().map(|t| s + t));
     }
-    let outer_normal = newell(&loops[0]);
+    let outer_normal = newell(&darted[0].hull);
     let mut loop_ids: Vec<Vec<usize>> = Vec::new();
-    for (l, p) in loops.iter().enumerate() {
-        let mut ids: Vec<usize> = (starts[l]..starts[l] + p.len()).collect();
-        if l > 0 && newell(p).dot(outer_normal) > 0.0 {
+    for (l, d) in darted.iter().enumerate() {
+        let mut ids: Vec<usize> = (starts[l]..starts[l] + d.pts.len()).collect();
+        if l > 0 && newell(&d.hull).dot(outer_normal) > 0.0 {
             ids.reverse();
         }
         loop_ids.push(ids);
@@ -516,22 +656,155 @@ fn prepare(input: &Input) -> Result<Prepared, BoundaryError> {
             input_edges.insert((ids[k], ids[(k + 1) % ids.len()]));
         }
     }
-    // Regions: the outer loop, split by rulings, then holes bridged in.
-    let mut regions: Vec<Vec<usize>> = vec![loop_ids[0].clone()];
-    let n0 = input.loops[0].len();
+    // Rulings as global vertex pairs.
+    let mut rulings: Vec<(usize, [usize; 2])> = Vec::new();
     for (r, ru) in input.rulings.iter().enumerate() {
         let err = |message: String| BoundaryError::Ruling {
             index: r + 1,
             message,
         };
-        if ru[0] >= n0 || ru[1] >= n0 {
-            return Err(err(format!(
-                "points {} and {}: the loop has {n0} points",
-                ru[0] + 1,
-                ru[1] + 1
-            )));
+        let mut ends = [0; 2];
+        for (e, &(l, i)) in ru.iter().enumerate() {
+            if l >= nl {
+                return Err(err(format!(
+                    "names loop {} but there are {nl} loops",
+                    l + 1
+                )));
+            }
+            let n = input.loops[l].len();
+            if i >= n {
+                return Err(err(format!(
+                    "point {} of loop {}: the loop has {n} points",
+                    i + 1,
+                    l + 1
+                )));
+            }
+            ends[e] = starts[l] + darted[l].map[i];
         }
-        let (a, b) = (map[ru[0]], map[ru[1]]);
+        if ends[0] == ends[1] {
+            return Err(err("joins a point to itself".into()));
+        }
+        rulings.push((r, ends));
+    }
+    // §6: charts connecting loops first.
+    let mut cycles = loop_ids.clone();
+    let mut fixed: Vec<[usize; 3]> = Vec::new();
+    let mut pending = rulings.clone();
+    let mut connecting_charts = 0;
+    while cycles.len() > 1 {
+        let Some((tris, next)) = connecting_chart(
+            &verts,
+            &hverts,
+            &site,
+            &cycles,
+            &input_edges,
+            &pending,
+            opts,
+        ) else {
+            break;
+        };
+        pending.retain(|(_, [a, b])| !tris.iter().any(|t| t.contains(a) && t.contains(b)));
+        fixed.extend(tris);
+        cycles = next;
+        connecting_charts += 1;
+    }
+    // Then the user's rulings between loops, then the shortest tree of connecting edges.
+    let cycle_of = |cycles: &[Vec<usize>], v: usize| cycles.iter().position(|c| c.contains(&v));
+    let mut joins: HashSet<(usize, usize)> = HashSet::new();
+    let mut used: HashSet<usize> = HashSet::new();
+    let mut chords: Vec<(usize, [usize; 2])> = Vec::new();
+    for &(r, [a, b]) in &pending {
+        let err = |message: String| BoundaryError::Ruling {
+            index: r + 1,
+            message,
+        };
+        match (cycle_of(&cycles, a), cycle_of(&cycles, b)) {
+            (Some(x), Some(y)) if x != y => {
+                if used.contains(&a) || used.contains(&b) {
+                    return Err(err(
+                        "an end already joins two loops (rulings between loops must not share points)".into(),
+                    ));
+                }
+                join(&mut cycles, x, a, y, b);
+                used.extend([a, b]);
+                joins.insert((a.min(b), a.max(b)));
+            }
+            (Some(_), Some(_)) => chords.push((r, [a, b])),
+            _ => {
+                return Err(err(
+                    "an end lies inside a chart that connects the loops; choose other points"
+                        .into(),
+                ))
+            }
+        }
+    }
+    if cycles.len() > 1 {
+        let avoid: HashSet<usize> = chords.iter().flat_map(|(_, e)| *e).collect();
+        let mut cand: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, ci) in cycles.iter().enumerate() {
+            for cj in &cycles[i + 1..] {
+                for &a in ci {
+                    for &b in cj {
+                        if !used.contains(&a)
+                            && !used.contains(&b)
+                            && !avoid.contains(&a)
+                            && !avoid.contains(&b)
+                        {
+                            cand.push((verts[a].distance(verts[b]), a.min(b), a.max(b)));
+                        }
+                    }
+                }
+            }
+        }
+        cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+        let tol = 1e-9 * size(&verts);
+        for (_, a, b) in cand {
+            if cycles.len() == 1 {
+                break;
+            }
+            let (Some(x), Some(y)) = (cycle_of(&cycles, a), cycle_of(&cycles, b)) else {
+                continue;
+            };
+            if x == y || used.contains(&a) || used.contains(&b) {
+                continue;
+            }
+            // No crossing with the loops, the charts, the rulings or the tree so far.
+            let mut segs: Vec<(usize, usize)> = Vec::new();
+            for c in &cycles {
+                segs.extend((0..c.len()).map(|k| (c[k], c[(k + 1) % c.len()])));
+            }
+            for t in &fixed {
+                segs.extend((0..3).map(|k| (t[k], t[(k + 1) % 3])));
+            }
+            segs.extend(chords.iter().map(|(_, e)| (e[0], e[1])));
+            segs.extend(joins.iter().copied());
+            let crosses = segs.iter().any(|&(p, q)| {
+                if p == a || p == b || q == a || q == b {
+                    return false;
+                }
+                segment_distance(verts[a], verts[b], verts[p], verts[q]).0 <= tol
+            });
+            if crosses {
+                continue;
+            }
+            join(&mut cycles, x, a, y, b);
+            used.extend([a, b]);
+            joins.insert((a, b));
+        }
+        if cycles.len() > 1 {
+            return Err(BoundaryError::Loops(
+                "the loops cannot be joined by edges that cross neither the loops nor each other"
+                    .into(),
+            ));
+        }
+    }
+    // Rulings within a loop split the region.
+    let mut regions: Vec<Vec<usize>> = cycles;
+    for (r, [a, b]) in chords {
+        let err = |message: String| BoundaryError::Ruling {
+            index: r + 1,
+            message,
+        };
         let found = regions.iter().position(|g| {
             let pa = g.iter().position(|&v| v == a);
             let pb = g.iter().position(|&v| v == b);
@@ -544,86 +817,325 @@ fn prepare(input: &Input) -> Result<Prepared, BoundaryError> {
             }
         });
         let Some(gi) = found else {
-            return Err(err(format!(
-                "points {} and {} are neighbours, the same point, or on different sides of another ruling (rulings must not cross)",
-                ru[0] + 1,
-                ru[1] + 1
-            )));
+            return Err(err(
+                "its points are neighbours, or on different sides of another ruling (rulings must not cross)".into(),
+            ));
         };
+        if regions[gi].iter().filter(|&&v| v == a || v == b).count() > 2 {
+            return Err(err(
+                "an end is also the end of a ruling between loops; choose other points".into(),
+            ));
+        }
         let g = regions.swap_remove(gi);
         let (x, y) = split_at(&g, a, b);
         regions.push(x);
         regions.push(y);
     }
-    for ids in loop_ids.iter().skip(1) {
-        // The region and vertex nearest to the hole.
-        let mut best = (f64::INFINITY, 0, 0, 0);
-        for (gi, g) in regions.iter().enumerate() {
-            for (k, &v) in g.iter().enumerate() {
-                for (h, &w) in ids.iter().enumerate() {
-                    let d = verts[v].distance_squared(verts[w]);
-                    if d < best.0 {
-                        best = (d, gi, k, h);
-                    }
-                }
-            }
-        }
-        let (_, gi, k1, h1) = best;
-        let g = regions.swap_remove(gi);
-        let k2 = (k1 + g.len() / 2) % g.len();
-        let mut h2 = (h1 + ids.len() / 2) % ids.len();
-        let mut dh = f64::INFINITY;
-        for (h, &w) in ids.iter().enumerate() {
-            let d = verts[g[k2]].distance_squared(verts[w]);
-            if h != h1 && d < dh {
-                dh = d;
-                h2 = h;
-            }
-        }
-        // Region 1: g[k1..=k2], hole h2..=h1; region 2: g[k2..=k1], hole h1..=h2.
-        let arc = |v: &[usize], from: usize, to: usize| -> Vec<usize> {
-            let mut out = vec![v[from]];
-            let mut i = from;
-            while i != to {
-                i = (i + 1) % v.len();
-                out.push(v[i]);
-            }
-            out
-        };
-        let mut r1 = arc(&g, k1, k2);
-        r1.extend(arc(ids, h2, h1));
-        let mut r2 = arc(&g, k2, k1);
-        r2.extend(arc(ids, h1, h2));
-        regions.push(r1);
-        regions.push(r2);
-    }
     Ok(Prepared {
         verts,
+        hverts,
+        site,
         loop_ids,
         input_edges,
+        fixed,
+        joins,
         regions,
+        connecting_charts,
     })
 }
 
-fn search(
-    verts: Vec<DVec3>,
-    loop_ids: Vec<Vec<usize>>,
-    input_edges: HashSet<(usize, usize)>,
-    regions: Vec<Vec<usize>>,
+/// Join cycle `y` into cycle `x` by the edge `a b` (`a` on `x`, `b` on `y`), walked both
+/// ways: … a, b, (y around), b, a, … .
+fn join(cycles: &mut Vec<Vec<usize>>, x: usize, a: usize, y: usize, b: usize) {
+    let cx = &cycles[x];
+    let cy = &cycles[y];
+    let i = cx.iter().position(|&v| v == a).unwrap_or(0);
+    let j = cy.iter().position(|&v| v == b).unwrap_or(0);
+    let mut merged: Vec<usize> = cx[..=i].to_vec();
+    merged.extend_from_slice(&cy[j..]);
+    merged.extend_from_slice(&cy[..=j]);
+    merged.extend_from_slice(&cx[i..]);
+    cycles[x] = merged;
+    cycles.remove(y);
+}
+
+/// §6 "charts which connect separate loops": on the hull of all the loops' points (the §7
+/// radial offset applied), charts as in §3 — hull triangles joined across edges that are not
+/// loop edges, each with an input edge, all wound like the loops — that touch two loops or
+/// more, smooth inside and against the neighbouring interior hull triangles, at least
+/// `min_chart_area` of the hull, whose subtraction leaves simple loops (each touched loop
+/// entered once, so they merge into one, or none when the chart covers them) and keeps every
+/// pending ruling possible. The largest such chart, wound like the loops, and the loops left.
+#[allow(clippy::type_complexity)]
+fn connecting_chart(
+    verts: &[DVec3],
+    hverts: &[DVec3],
+    site: &[usize],
+    cycles: &[Vec<usize>],
+    input_edges: &HashSet<(usize, usize)>,
+    pending: &[(usize, [usize; 2])],
     opts: &Options,
-    t0: Instant,
-) -> Result<Output, BoundaryError> {
-    // Search each region.
-    let mut best: Vec<Vec<[usize; 3]>> = Vec::new();
+) -> Option<(Vec<[usize; 3]>, Vec<Vec<usize>>)> {
+    let ids: Vec<usize> = cycles.iter().flatten().copied().collect();
+    let m = ids.len();
+    let c = ids.iter().map(|&v| hverts[v]).sum::<DVec3>() / m as f64;
+    let mean = ids.iter().map(|&v| hverts[v].distance(c)).sum::<f64>() / m as f64;
+    let hp: Vec<DVec3> = ids
+        .iter()
+        .map(|&v| hverts[v] + (hverts[v] - c).normalize_or_zero() * opts.offset * mean)
+        .collect();
+    let hull = hull::hull(&hp)?;
+    if hull.planar.is_some() {
+        return None;
+    }
+    let mut edge_cycle: HashMap<(usize, usize), usize> = HashMap::new();
+    for (ci, cy) in cycles.iter().enumerate() {
+        for k in 0..cy.len() {
+            edge_cycle.insert((cy[k], cy[(k + 1) % cy.len()]), ci);
+        }
+    }
+    let nf = hull.faces.len();
+    let face = |f: usize| hull.faces[f].map(|x| ids[x]);
+    let on_loop =
+        |a: usize, b: usize| edge_cycle.contains_key(&(a, b)) || edge_cycle.contains_key(&(b, a));
+    let mut sense: Vec<Option<bool>> = vec![None; nf];
+    let mut has_edge = vec![false; nf];
+    for f in 0..nf {
+        let t = face(f);
+        let mut vote: Option<bool> = None;
+        let mut mixed = false;
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let v = if edge_cycle.contains_key(&(a, b)) {
+                has_edge[f] = true;
+                input_edges.contains(&(a, b)).then_some(true)
+            } else if edge_cycle.contains_key(&(b, a)) {
+                has_edge[f] = true;
+                input_edges.contains(&(b, a)).then_some(false)
+            } else {
+                None
+            };
+            if let Some(v) = v {
+                mixed |= vote.is_some_and(|w| w != v);
+                vote = Some(v);
+            }
+        }
+        let wound = if vote == Some(false) {
+            [t[0], t[2], t[1]]
+        } else {
+            t
+        };
+        if !mixed && sites_valid(verts, site, &[wound]) {
+            sense[f] = vote;
+        }
+    }
+    let thr = opts.max_dihedral_deg.to_radians();
+    let hull_area = hull.area(&hp);
+    let mut comp = vec![usize::MAX; nf];
+    let mut best: Option<(f64, Vec<[usize; 3]>, Vec<Vec<usize>>)> = None;
+    for f0 in 0..nf {
+        let Some(s0) = sense[f0] else { continue };
+        if comp[f0] != usize::MAX {
+            continue;
+        }
+        comp[f0] = f0;
+        let mut part = vec![f0];
+        let mut k = 0;
+        while k < part.len() {
+            let f = part[k];
+            k += 1;
+            let t = face(f);
+            for e in 0..3 {
+                let g = hull.neighbours[f][e];
+                if g == usize::MAX
+                    || comp[g] != usize::MAX
+                    || sense[g] != Some(s0)
+                    || on_loop(t[e], t[(e + 1) % 3])
+                {
+                    continue;
+                }
+                comp[g] = f0;
+                part.push(g);
+            }
+        }
+        let tris: Vec<[usize; 3]> = part
+            .iter()
+            .map(|&f| {
+                let t = face(f);
+                if s0 {
+                    t
+                } else {
+                    [t[0], t[2], t[1]]
+                }
+            })
+            .collect();
+        let mut touched: BTreeSet<usize> = BTreeSet::new();
+        for t in &tris {
+            for k in 0..3 {
+                if let Some(&ci) = edge_cycle.get(&(t[k], t[(k + 1) % 3])) {
+                    touched.insert(ci);
+                }
+            }
+        }
+        if touched.len() < 2 {
+            continue;
+        }
+        let area: f64 = part
+            .iter()
+            .map(|&f| {
+                let t = hull.faces[f];
+                0.5 * (hp[t[1]] - hp[t[0]]).cross(hp[t[2]] - hp[t[0]]).length()
+            })
+            .sum();
+        if area < opts.min_chart_area * hull_area || best.as_ref().is_some_and(|b| b.0 >= area) {
+            continue;
+        }
+        let smooth = part.iter().all(|&f| {
+            (0..3).all(|e| {
+                let g = hull.neighbours[f][e];
+                g == usize::MAX
+                    || (comp[g] != f0 && has_edge[g])
+                    || angle(unit_normal(verts, face(f)), unit_normal(verts, face(g))) < thr
+            })
+        });
+        if !smooth || !sites_valid(verts, site, &tris) {
+            continue;
+        }
+        // Subtract: the loops' edges, less the chart's, plus the chart's rim reversed.
+        let mut rem: BTreeSet<(usize, usize)> = edge_cycle.keys().copied().collect();
+        let mut ok = true;
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if !rem.remove(&(a, b)) {
+                    ok &= rem.insert((b, a));
+                }
+            }
+        }
+        let mut next: BTreeMap<usize, usize> = BTreeMap::new();
+        let mut into: HashSet<usize> = HashSet::new();
+        for &(a, b) in &rem {
+            ok &= next.insert(a, b).is_none() && into.insert(b);
+        }
+        if !ok {
+            continue;
+        }
+        let mut left: Vec<Vec<usize>> = Vec::new();
+        let mut seen: HashSet<usize> = HashSet::new();
+        for &start in next.keys() {
+            if seen.contains(&start) {
+                continue;
+            }
+            let mut cy = vec![start];
+            seen.insert(start);
+            let mut v = next[&start];
+            while v != start && ok {
+                ok = seen.insert(v);
+                cy.push(v);
+                v = next.get(&v).copied().unwrap_or(start);
+            }
+            ok &= cy.len() >= 3;
+            left.push(cy);
+        }
+        let merged = cycles.len() + 1 - touched.len();
+        if !ok || !(left.len() == merged || left.len() + 1 == merged) {
+            continue;
+        }
+        let feasible = pending.iter().all(|(_, [a, b])| {
+            tris.iter().any(|t| t.contains(a) && t.contains(b))
+                || (left.iter().any(|c| c.contains(a)) && left.iter().any(|c| c.contains(b)))
+        });
+        if feasible {
+            best = Some((area, tris, left));
+        }
+    }
+    best.map(|(_, t, l)| (t, l))
+}
+
+/// Whether triangles over vertices with sites are valid pieces of a boundary triangulation:
+/// no triangle with two vertices at one site or with no area, no site pair (edge in space) in
+/// more than two triangles.
+fn sites_valid(p: &[DVec3], site: &[usize], tris: &[[usize; 3]]) -> bool {
+    let mut count: HashMap<(usize, usize), u8> = HashMap::new();
+    for t in tris {
+        let s = t.map(|x| site[x]);
+        if s[0] == s[1] || s[1] == s[2] || s[0] == s[2] {
+            return false;
+        }
+        let (a, b, c) = (p[t[0]], p[t[1]], p[t[2]]);
+        let longest = a
+            .distance_squared(b)
+            .max(b.distance_squared(c))
+            .max(c.distance_squared(a));
+        if (b - a).cross(c - a).length() <= 1e-9 * longest {
+            return false;
+        }
+        for k in 0..3 {
+            let (x, y) = (s[k], s[(k + 1) % 3]);
+            let n = count.entry((x.min(y), x.max(y))).or_default();
+            *n += 1;
+            if *n > 2 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Search every region; `false` when a region with copies got no valid triangulation.
+fn search(prep: Prepared, opts: &Options, t0: Instant) -> (Output, bool) {
+    let Prepared {
+        verts,
+        hverts,
+        site,
+        loop_ids,
+        input_edges,
+        fixed,
+        joins,
+        regions,
+        connecting_charts,
+    } = prep;
+    let mut best: Vec<Vec<[usize; 3]>> = vec![fixed.clone()];
     let mut warnings = Vec::new();
     let mut iterations = 0;
-    let mut alts: Vec<Vec<Vec<[usize; 3]>>> = Vec::new();
+    let mut alts: Vec<Vec<Vec<[usize; 3]>>> = vec![Vec::new()];
+    let mut all_ok = true;
     for g in &regions {
+        let q = g.len();
         let pts: Vec<DVec3> = g.iter().map(|&v| verts[v]).collect();
-        let orig: Vec<bool> = (0..g.len())
-            .map(|k| input_edges.contains(&(g[k], g[(k + 1) % g.len()])))
+        // Hull points: a join's two copies of an end are nudged apart, each along its loop
+        // edge (1 % of the shorter of that edge and the join), for the hulls only.
+        let mut times: HashMap<usize, usize> = HashMap::new();
+        for &v in g {
+            *times.entry(v).or_default() += 1;
+        }
+        let hp: Vec<DVec3> = (0..q)
+            .map(|k| {
+                let v = g[k];
+                if times[&v] < 2 {
+                    return hverts[v];
+                }
+                let (a, b) = (g[(k + q - 1) % q], g[(k + 1) % q]);
+                let (nb, partner) = if joins.contains(&(v.min(b), v.max(b))) {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
+                let d = verts[nb] - verts[v];
+                let eps = 0.01 * d.length().min(verts[partner].distance(verts[v]));
+                hverts[v] + d.normalize_or_zero() * eps
+            })
             .collect();
-        let res = solve(&pts, &orig, opts, &mut warnings);
+        let lsite: Vec<usize> = g.iter().map(|&v| site[v]).collect();
+        let mut sorted = lsite.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        let copies = sorted.len() < q;
+        let orig: Vec<bool> = (0..q)
+            .map(|k| input_edges.contains(&(g[k], g[(k + 1) % q])))
+            .collect();
+        let res = solve(&pts, &hp, &orig, &lsite, copies, opts, &mut warnings);
+        all_ok &= res.valid;
         iterations += res.iterations;
         let to_global = |t: &Vec<[usize; 3]>| -> Vec<[usize; 3]> {
             t.iter().map(|f| f.map(|x| g[x])).collect()
@@ -632,10 +1144,13 @@ fn search(
         alts.push(res.alternatives.iter().map(to_global).collect());
     }
     let faces: Vec<[usize; 3]> = best.iter().flatten().copied().collect();
+    all_ok &= sites_valid(&verts, &site, &faces);
     let mesh = to_mesh(&verts, &faces);
     let mut figures = figures(&verts, &faces, &input_edges, &loop_ids);
     figures.iterations = iterations;
     figures.seconds = t0.elapsed().as_secs_f64();
+    figures.connecting_charts = connecting_charts;
+    figures.joining_edges = joins.len();
     // Alternatives: one region's next best with the other regions' best, region by region.
     let mut alternatives = Vec::new();
     'regions: for (r, list) in alts.iter().enumerate() {
@@ -650,12 +1165,15 @@ fn search(
             alternatives.push(to_mesh(&verts, &all));
         }
     }
-    Ok(Output {
-        mesh,
-        figures,
-        alternatives,
-        warnings,
-    })
+    (
+        Output {
+            mesh,
+            figures,
+            alternatives,
+            warnings,
+        },
+        all_ok,
+    )
 }
 
 /// Split loop `g` along the chord `a b`: (a … b) and (b … a).
@@ -768,41 +1286,64 @@ struct Solved {
     best: Vec<[usize; 3]>,
     alternatives: Vec<Vec<[usize; 3]>>,
     iterations: usize,
+    /// False when the loop has copies (darts, joins) and no valid triangulation was found.
+    valid: bool,
 }
 
-fn solve(pts: &[DVec3], orig: &[bool], opts: &Options, warnings: &mut Vec<String>) -> Solved {
+/// `pts` the points, `base` the points for hulls (copies moved apart), `site` which points
+/// coincide, `copies` whether any do.
+fn solve(
+    pts: &[DVec3],
+    base: &[DVec3],
+    orig: &[bool],
+    site: &[usize],
+    copies: bool,
+    opts: &Options,
+    warnings: &mut Vec<String>,
+) -> Solved {
     let m = pts.len();
     if m == 3 {
         return Solved {
             best: vec![[0, 1, 2]],
             alternatives: vec![],
             iterations: 0,
+            valid: !copies || sites_valid(pts, site, &[[0, 1, 2]]),
         };
     }
     // §7 radial offset for the hulls, unless it takes more loop edges off the hull than the
     // points as given (a scalloped edge near the centre of mass can sink inside).
-    let c = pts.iter().copied().sum::<DVec3>() / m as f64;
-    let mean = pts.iter().map(|p| p.distance(c)).sum::<f64>() / m as f64;
-    let mut hpts: Vec<DVec3> = pts
+    let c = base.iter().copied().sum::<DVec3>() / m as f64;
+    let mean = base.iter().map(|p| p.distance(c)).sum::<f64>() / m as f64;
+    let mut hpts: Vec<DVec3> = base
         .iter()
         .map(|p| *p + (*p - c).normalize_or_zero() * opts.offset * mean)
         .collect();
-    if opts.offset != 0.0 && loop_edges_on_hull(pts) > loop_edges_on_hull(&hpts) {
-        hpts = pts.to_vec();
+    if opts.offset != 0.0 && loop_edges_on_hull(base) > loop_edges_on_hull(&hpts) {
+        hpts = base.to_vec();
     }
     let mut s = Search::new(
         pts,
         hpts,
         orig,
+        (site, copies),
         opts.max_dihedral_deg.to_radians(),
         opts.min_chart_area,
     );
+    s.base = base.to_vec();
     let mut r = s.run(opts);
-    let mut relaxed = Search::new(pts, s.h.clone(), orig, std::f64::consts::PI, 0.0);
+    let mut relaxed = Search::new(
+        pts,
+        s.h.clone(),
+        orig,
+        (site, copies),
+        std::f64::consts::PI,
+        0.0,
+    );
+    relaxed.base = base.to_vec();
     if r.best.is_none() {
         let r2 = relaxed.run(opts);
         warnings.push(format!(
-            "no triangulation with every dihedral angle under {}° and charts over {} % of their hull: the limits were relaxed",
+            "{RELAXED} {}° and charts over {} % of their hull: the limits were relaxed",
             opts.max_dihedral_deg,
             100.0 * opts.min_chart_area
         ));
@@ -839,6 +1380,7 @@ fn solve(pts: &[DVec3], orig: &[bool], opts: &Options, warnings: &mut Vec<String
             .map(|(t, _)| t)
             .filter(|t| *t != best)
             .collect(),
+        valid: !copies || sites_valid(pts, site, &best),
         best,
         iterations: r.iterations,
     }
@@ -909,9 +1451,14 @@ struct Search<'a> {
     p: &'a [DVec3],
     h: Vec<DVec3>,
     orig: &'a [bool],
+    /// Which points coincide (dart sides, join ends), and whether any do.
+    site: &'a [usize],
+    copies: bool,
     m: usize,
     thr: f64,
     min_area: f64,
+    /// The hull points before the radial offset (tried for flat subloops).
+    base: Vec<DVec3>,
     charts: Vec<Chart>,
     chart_ids: HashMap<Vec<[usize; 3]>, usize>,
     subs: HashMap<Vec<usize>, Rc<Sub>>,
@@ -921,18 +1468,34 @@ struct Search<'a> {
 type EdgeMap = BTreeMap<(usize, usize), Vec<usize>>;
 
 impl<'a> Search<'a> {
-    fn new(p: &'a [DVec3], h: Vec<DVec3>, orig: &'a [bool], thr: f64, min_area: f64) -> Self {
+    fn new(
+        p: &'a [DVec3],
+        h: Vec<DVec3>,
+        orig: &'a [bool],
+        (site, copies): (&'a [usize], bool),
+        thr: f64,
+        min_area: f64,
+    ) -> Self {
         Search {
             p,
             h,
             orig,
+            site,
+            copies,
             m: p.len(),
             thr,
             min_area,
+            base: Vec::new(),
             charts: Vec::new(),
             chart_ids: HashMap::new(),
             subs: HashMap::new(),
         }
+    }
+
+    /// Triangles that can be part of a boundary triangulation once coinciding points are
+    /// taken into account (always true without copies).
+    fn valid(&self, tris: &[[usize; 3]]) -> bool {
+        !self.copies || sites_valid(self.p, self.site, tris)
     }
 
     fn normal(&self, t: [usize; 3]) -> DVec3 {
@@ -1087,7 +1650,15 @@ impl<'a> Search<'a> {
             // A flat subloop: ear clipping in its plane, on the input points (the offset ones
             // if those fold over), one envelope since both sides are the same.
             let op: Vec<DVec3> = sub.iter().map(|&v| self.p[v]).collect();
-            for pts in [&op, &hp] {
+            let bp: Vec<DVec3> = sub
+                .iter()
+                .filter_map(|&v| self.base.get(v))
+                .copied()
+                .collect();
+            for pts in [&op, &bp, &hp] {
+                if pts.len() != q {
+                    continue;
+                }
                 let n = newell(pts).normalize_or_zero();
                 if n == DVec3::ZERO {
                     continue;
@@ -1100,7 +1671,7 @@ impl<'a> Search<'a> {
                         .into_iter()
                         .map(sorted)
                         .collect();
-                    if tris.len() == q - 2 && Self::non_crossing(&tris) {
+                    if tris.len() == q - 2 && Self::non_crossing(&tris) && self.valid(&tris) {
                         out.envelopes.push(tris);
                         break;
                     }
@@ -1132,7 +1703,7 @@ impl<'a> Search<'a> {
                 if is_sub_edge(x, y) {
                     has_edge[f] = true;
                     edge_seen += 1;
-                    if counts(x, y) {
+                    if counts(x, y) && self.valid(&[sorted(*t)]) {
                         eligible[f] = true;
                     }
                 }
@@ -1179,7 +1750,7 @@ impl<'a> Search<'a> {
                     if part.len() == q - 2 && part.iter().all(|&f| sense[f] == s0) {
                         let tris: Vec<[usize; 3]> =
                             part.iter().map(|&f| sorted(hull.faces[f])).collect();
-                        if Self::non_crossing(&tris) {
+                        if Self::non_crossing(&tris) && self.valid(&tris) {
                             out.envelopes.push(tris);
                         }
                     }
@@ -1199,7 +1770,8 @@ impl<'a> Search<'a> {
                         .length()
                 })
                 .sum();
-            if area < self.min_area * hull_area || !Self::non_crossing(&tris) {
+            if area < self.min_area * hull_area || !Self::non_crossing(&tris) || !self.valid(&tris)
+            {
                 continue;
             }
             let mut smooth = true;
@@ -1228,7 +1800,7 @@ impl<'a> Search<'a> {
             // The pathological hull: each triangle a chart.
             for f in 0..nf {
                 let t = sorted(hull.faces[f]);
-                if t[0] != t[1] && t[1] != t[2] {
+                if t[0] != t[1] && t[1] != t[2] && self.valid(&[t]) {
                     let id = self.chart_id(vec![t]);
                     out.charts.push(id);
                 }
@@ -1366,7 +1938,7 @@ impl<'a> Search<'a> {
                 all.extend_from_slice(pick);
             }
             all.sort_unstable();
-            return (all.len() == self.m - 2).then_some(all);
+            return (all.len() == self.m - 2 && self.valid(&all)).then_some(all);
         }
         None
     }
@@ -1431,7 +2003,7 @@ impl<'a> Search<'a> {
                     }
                 }
                 if let Some(q) = total {
-                    if all.len() == self.m - 2 {
+                    if all.len() == self.m - 2 && self.valid(&all) {
                         all.sort_unstable();
                         if seen_tri.insert(all.clone()) {
                             run.found.push((all.clone(), q));
@@ -1468,6 +2040,9 @@ impl<'a> Search<'a> {
                         continue;
                     }
                     let (nt, no) = self.cover_tris(&n);
+                    if !self.valid(&nt) {
+                        continue;
+                    }
                     let nq = self.bound(&nt, &no, &self.subtract(&nt));
                     if run.best.as_ref().is_some_and(|b| !nq.better(&b.1)) {
                         continue;
@@ -1516,7 +2091,8 @@ mod tests {
             })
             .collect();
         let orig = vec![true; 8];
-        let s = Search::new(&p, p.clone(), &orig, 3.0, 0.0);
+        let site: Vec<usize> = (0..8).collect();
+        let s = Search::new(&p, p.clone(), &orig, (&site, false), 3.0, 0.0);
         // Triangle 1-2-5 leaves 0,1,5,6,7 and 2,3,4,5.
         let subs = s.subtract(&[[1, 2, 5]]);
         assert_eq!(subs, vec![vec![0, 1, 5, 6, 7], vec![2, 3, 4, 5]]);
