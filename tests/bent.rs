@@ -39,9 +39,23 @@ fn area_perimeter(pts: &[DVec2]) -> (f64, f64) {
     (0.5 * area.abs(), per)
 }
 
+/// The first surface of a spec file, which must be a bent sheet.
+fn bent_spec(path: &std::path::Path) -> BentSpec {
+    let spec = flatcut::spec::load(path).expect("spec loads");
+    spec.surfaces[0].bent.clone().expect("a bent sheet")
+}
+
+/// The arc length `s = … mm` an error message gives.
+fn arc_length_in(err: &str) -> f64 {
+    err.split("s = ")
+        .nth(1)
+        .and_then(|t| t.split(" mm").next())
+        .and_then(|t| t.parse().ok())
+        .expect("arc length in the message")
+}
+
 fn bent_of(path: &str) -> (BentSpec, geodesic::Bent) {
-    let spec = flatcut::spec::load(&manifest(path)).expect("spec loads");
-    let b = spec.surfaces[0].bent.clone().expect("a bent sheet");
+    let b = bent_spec(&manifest(path));
     let bent = geodesic::bend(&b).expect("bends");
     (b, bent)
 }
@@ -368,23 +382,13 @@ control_points = { kind = "bspline", degree = 3, control = [[0, 27.5, 0], [20, 2
     assert!(err.contains("twist.toml:6"), "{err}");
     assert!(err.contains("curve of regression"), "{err}");
     // The position: arc length along the line in mm, distance and depth in mm.
-    let s: f64 = err
-        .split("s = ")
-        .nth(1)
-        .and_then(|t| t.split(" mm").next())
-        .and_then(|t| t.parse().ok())
-        .expect("arc length in the message");
+    let s = arc_length_in(&err);
     assert!(s > 0.0 && s < 85.0, "{s}");
     assert!(err.contains("inside the sheet's edge"), "{err}");
     assert!(!dir.join("twisted.plt").exists());
 
     // The same through the library: the error carries the figures.
-    let b = flatcut::spec::load(std::path::Path::new(&spec))
-        .unwrap()
-        .surfaces[0]
-        .bent
-        .clone()
-        .unwrap();
+    let b = bent_spec(std::path::Path::new(&spec));
     match geodesic::bend(&b) {
         Err(GeodesicError::Regression {
             s: s2, dist, depth, ..
@@ -1035,24 +1039,14 @@ control_points = [[0, 0, 0], [40, 0, 40], [80, 0, 0], [120, 0, 40]]
         err.contains("bends less than the curve drawn on the sheet"),
         "{err}"
     );
-    let s: f64 = err
-        .split("s = ")
-        .nth(1)
-        .and_then(|t| t.split(" mm").next())
-        .and_then(|t| t.parse().ok())
-        .expect("arc length in the message");
+    let s = arc_length_in(&err);
     // The S-shaped control curve is straight at its inflection, half way along.
     let len = 50.0 * 120f64.to_radians();
     assert!((s - 0.5 * len).abs() < 1.0, "{s} of {len}");
     assert!(err.contains("short by"), "{err}");
     assert!(!dir.join("band.plt").exists());
     // The library's figures: the shortfall is the flat curvature minus the curve's.
-    let b = flatcut::spec::load(std::path::Path::new(&spec))
-        .unwrap()
-        .surfaces[0]
-        .bent
-        .clone()
-        .unwrap();
+    let b = bent_spec(std::path::Path::new(&spec));
     match geodesic::bend(&b) {
         Err(GeodesicError::Curvature {
             s: s2,
@@ -1150,12 +1144,7 @@ control_points = [[0, 0, 0], [40, 0, 40], [120, 0, 40], [160, 0, 0]]
 tolerance = 0.05
 "#,
     );
-    let b = flatcut::spec::load(std::path::Path::new(&path))
-        .unwrap()
-        .surfaces[0]
-        .bent
-        .clone()
-        .unwrap();
+    let b = bent_spec(std::path::Path::new(&path));
     assert!(matches!(b.pieces[0].path, FlatPath::Curve(_)));
     let bent = geodesic::bend(&b).unwrap();
     let worst = worst_edge_error(&bent);
