@@ -897,6 +897,20 @@ impl Ctx<'_> {
         }
     }
 
+    /// The first of `keys` that is given is an error, `{key}.{k}` with `why`: keys meant for
+    /// another kind of surface, or for another place in the file.
+    fn refuse(
+        &self,
+        key: &str,
+        keys: &[(&str, Option<Range<usize>>)],
+        why: &str,
+    ) -> Result<(), SpecError> {
+        match keys.iter().find_map(|(k, sp)| sp.clone().map(|sp| (k, sp))) {
+            Some((k, sp)) => Err(self.invalid(self.line(sp), &format!("{key}.{k}"), why.into())),
+            None => Ok(()),
+        }
+    }
+
     fn invalid(&self, line: usize, key: &str, message: String) -> SpecError {
         SpecError::Invalid {
             path: self.path.to_path_buf(),
@@ -1458,29 +1472,19 @@ impl Ctx<'_> {
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
         use crate::surface::strip::Method;
-        for (k, v) in [
-            ("path", &s.path),
-            ("scale", &s.scale),
-            ("units", &s.units),
-            ("segment", &s.segment),
-            ("charts", &s.charts),
-            ("f_max", &s.f_max),
-        ] {
-            if let Some(v) = v {
-                return Err(self.invalid(
-                    self.line(v.span()),
-                    &format!("{key}.{k}"),
-                    "is for mesh surfaces; a strip takes the curves `p` and `q`".to_string(),
-                ));
-            }
-        }
-        if let Some(v) = &s.approximate {
-            return Err(self.invalid(
-                self.line(v.span()),
-                &format!("{key}.approximate"),
-                "is for mesh surfaces; a strip takes the curves `p` and `q`".to_string(),
-            ));
-        }
+        self.refuse(
+            key,
+            &[
+                ("path", span(&s.path)),
+                ("scale", span(&s.scale)),
+                ("units", span(&s.units)),
+                ("segment", span(&s.segment)),
+                ("charts", span(&s.charts)),
+                ("f_max", span(&s.f_max)),
+                ("approximate", span(&s.approximate)),
+            ],
+            "is for mesh surfaces; a strip takes the curves `p` and `q`",
+        )?;
         let tolerance = self
             .number(
                 &s.tolerance,
@@ -1811,28 +1815,29 @@ impl Ctx<'_> {
 // pieces = [{ line = ..., control_points = ... }, ...]   # several curved pieces instead
 // ```
 
+/// Where a key stands in the file, if it is given.
+fn span<T>(v: &Option<Spanned<T>>) -> Option<Range<usize>> {
+    v.as_ref().map(|v| v.span())
+}
+
 impl Ctx<'_> {
     /// Keys only a bent sheet takes are errors on other kinds.
     fn no_bent_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
-        for (k, v) in [
-            ("outline", &s.outline),
-            ("holes", &s.holes),
-            ("line", &s.line),
-            ("arc", &s.arc),
-            ("flat_curve", &s.flat_curve),
-            ("control_points", &s.control_points),
-            ("handles", &s.handles),
-            ("length_fit", &s.length_fit),
-            ("pieces", &s.pieces),
-        ] {
-            if let Some(v) = v {
-                return Err(self.invalid(
-                    self.line(v.span()),
-                    &format!("{key}.{k}"),
-                    "is for bent sheets (kind = \"bent-sheet\")".to_string(),
-                ));
-            }
-        }
+        self.refuse(
+            key,
+            &[
+                ("outline", span(&s.outline)),
+                ("holes", span(&s.holes)),
+                ("line", span(&s.line)),
+                ("arc", span(&s.arc)),
+                ("flat_curve", span(&s.flat_curve)),
+                ("control_points", span(&s.control_points)),
+                ("handles", span(&s.handles)),
+                ("length_fit", span(&s.length_fit)),
+                ("pieces", span(&s.pieces)),
+            ],
+            "is for bent sheets (kind = \"bent-sheet\")",
+        )?;
         Ok(())
     }
 
@@ -2077,32 +2082,21 @@ impl Ctx<'_> {
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
         use crate::surface::geodesic::{Control, FlatPath, LengthFit, PieceSpec};
-        for (k, v) in [("path", &s.path), ("scale", &s.scale), ("units", &s.units)] {
-            if let Some(v) = v {
-                return Err(self.invalid(
-                    self.line(v.span()),
-                    &format!("{key}.{k}"),
-                    "is for mesh surfaces; a bent sheet takes `outline`, `line` (or `arc`, `flat_curve`) and `control_points` or `handles`".to_string(),
-                ));
-            }
-        }
-        for (k, v) in [("p", &s.p), ("q", &s.q)] {
-            if let Some(v) = v {
-                return Err(self.invalid(
-                    self.line(v.span()),
-                    &format!("{key}.{k}"),
-                    "is for strips; a bent sheet takes `line` (or `arc`, `flat_curve`) and `control_points` or `handles`"
-                        .to_string(),
-                ));
-            }
-        }
-        if let Some(v) = &s.method {
-            return Err(self.invalid(
-                self.line(v.span()),
-                &format!("{key}.method"),
-                "is for strips".to_string(),
-            ));
-        }
+        self.refuse(
+            key,
+            &[
+                ("path", span(&s.path)),
+                ("scale", span(&s.scale)),
+                ("units", span(&s.units)),
+            ],
+            "is for mesh surfaces; a bent sheet takes `outline`, `line` (or `arc`, `flat_curve`) and `control_points` or `handles`",
+        )?;
+        self.refuse(
+            key,
+            &[("p", span(&s.p)), ("q", span(&s.q))],
+            "is for strips; a bent sheet takes `line` (or `arc`, `flat_curve`) and `control_points` or `handles`",
+        )?;
+        self.refuse(key, &[("method", span(&s.method))], "is for strips")?;
         let tolerance = self
             .number(
                 &s.tolerance,
@@ -2266,22 +2260,18 @@ impl Ctx<'_> {
         if let Some(pv) = &s.pieces {
             let pl = self.line(pv.span());
             line_no = pl;
-            for (k, v) in [
-                ("line", &s.line),
-                ("arc", &s.arc),
-                ("flat_curve", &s.flat_curve),
-                ("control_points", &s.control_points),
-                ("handles", &s.handles),
-                ("length_fit", &s.length_fit),
-            ] {
-                if let Some(v) = v {
-                    return Err(self.invalid(
-                        self.line(v.span()),
-                        &format!("{key}.{k}"),
-                        "goes into each entry of `pieces` when `pieces` is given".to_string(),
-                    ));
-                }
-            }
+            self.refuse(
+                key,
+                &[
+                    ("line", span(&s.line)),
+                    ("arc", span(&s.arc)),
+                    ("flat_curve", span(&s.flat_curve)),
+                    ("control_points", span(&s.control_points)),
+                    ("handles", span(&s.handles)),
+                    ("length_fit", span(&s.length_fit)),
+                ],
+                "goes into each entry of `pieces` when `pieces` is given",
+            )?;
             let items = match pv.get_ref() {
                 toml::Value::Array(items) if !items.is_empty() => items,
                 v => {
@@ -2683,35 +2673,23 @@ impl Ctx<'_> {
 
     /// Boundary keys on another kind of surface are mistakes, not silently ignored.
     fn no_boundary_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
-        let spans = [
-            ("loop", s.loop_.as_ref().map(|v| v.span())),
-            ("loop_csv", s.loop_csv.as_ref().map(|v| v.span())),
-            ("loops", s.loops.as_ref().map(|v| v.span())),
-            ("darts", s.darts.as_ref().map(|v| v.span())),
-            ("rulings", s.rulings.as_ref().map(|v| v.span())),
-            ("max_dihedral", s.max_dihedral.as_ref().map(|v| v.span())),
-            (
-                "min_chart_area",
-                s.min_chart_area.as_ref().map(|v| v.span()),
-            ),
-            (
-                "max_iterations",
-                s.max_iterations.as_ref().map(|v| v.span()),
-            ),
-            ("smooth", s.smooth.as_ref().map(|v| v.span())),
-            ("good_interior", s.good_interior.as_ref().map(|v| v.span())),
-            ("good_fairness", s.good_fairness.as_ref().map(|v| v.span())),
-        ];
-        for (k, span) in spans {
-            if let Some(span) = span {
-                return Err(self.invalid(
-                    self.line(span),
-                    &format!("{key}.{k}"),
-                    "is for boundary surfaces (kind = \"boundary\")".to_string(),
-                ));
-            }
-        }
-        Ok(())
+        self.refuse(
+            key,
+            &[
+                ("loop", span(&s.loop_)),
+                ("loop_csv", span(&s.loop_csv)),
+                ("loops", span(&s.loops)),
+                ("darts", span(&s.darts)),
+                ("rulings", span(&s.rulings)),
+                ("max_dihedral", span(&s.max_dihedral)),
+                ("min_chart_area", span(&s.min_chart_area)),
+                ("max_iterations", span(&s.max_iterations)),
+                ("smooth", span(&s.smooth)),
+                ("good_interior", span(&s.good_interior)),
+                ("good_fairness", span(&s.good_fairness)),
+            ],
+            "is for boundary surfaces (kind = \"boundary\")",
+        )
     }
 
     /// One boundary loop: an inline list of points (closed; a last point equal to the first is
