@@ -31,9 +31,15 @@
 //! floor — makes many shallow overlaps cost more than one deeper one, which keeps the
 //! separator from scattering overlaps. Choices where the paper is silent: at most 12 poles
 //! per item, poles smaller than 8 % of the first are dropped, the poles are found on a grid of
-//! about 4000 points refined by pattern search, and pole pairs that cannot meet (a pole
-//! farther from the other shape's bounding box than the two largest radii plus the spacing)
-//! are skipped.
+//! about 4000 points refined by pattern search. Sparrow sums over all pole pairs; here only
+//! pairs that are near count: a pole farther from the other shape's bounding box than the
+//! two largest radii plus the spacing is skipped, and so is a pair whose gap exceeds the sum
+//! of its radii (`pd < −(r₁ + r₂)`). Far pairs add a long-range push that, summed over many
+//! pairs, outweighs the `ε²` floor and spreads the layout: on albano at 60 s (three seeds)
+//! all pairs gave 86.7–87.5 %, the bounding-box filter alone 88.3–88.5 %, both filters
+//! 88.7–89.2 % (a gap bound of 0.25, 0.5 or 2 sums of radii: 87.7–88.9 %). The pole pairs are
+//! evaluated a row at a time, branch-free over fixed-size lanes, so that the compiler
+//! vectorises them (AVX2 when the CPU has it, with bit-identical results).
 //!
 //! Why not jagua-rs: it computes in `f32` and takes no holes; this engine is exact in `f64`
 //! (so a feasible layout needs no safety margin and no separate verification pass), handles
@@ -89,6 +95,9 @@ pub struct Shape {
     /// Edge midpoints (probes for the zero-spacing containment test).
     pub mids: Vec<DVec2>,
     pub poles: Vec<(DVec2, f64)>,
+    /// The poles again, one array per coordinate, padded with empty circles far away, for
+    /// the vectorised [`overlap_proxy`].
+    pub lanes: PoleLanes,
     pub size: DVec2,
     /// Area of the material.
     pub area: f64,
@@ -133,10 +142,11 @@ impl Shape {
                 mids.push((a + b) * 0.5);
             }
         }
-        let poles = poles
+        let poles: Vec<(DVec2, f64)> = poles
             .iter()
             .map(|(c, r)| (orient.apply(*c) + shift, *r))
             .collect();
+        let lanes = PoleLanes::new(&poles);
         let area = turned
             .iter()
             .map(|r| crate::geom::polygon::signed_area(r))
@@ -147,6 +157,7 @@ impl Shape {
             segs,
             mids,
             poles,
+            lanes,
             size: hi - lo,
             area,
             shift,
@@ -315,51 +326,105 @@ pub fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u6
             .any(|p| deep(&a.rings, &a.segs, p + d))
 }
 
+/// Poles in lanes (see [`Shape::lanes`]): at most [`POLE_LANES`], the rest padded with
+/// radius-0 circles far away, which add exactly 0 to the proxy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoleLanes {
+    pub x: [f64; POLE_LANES],
+    pub y: [f64; POLE_LANES],
+    pub r: [f64; POLE_LANES],
+}
+
+/// Lanes of [`PoleLanes`]: the most poles an item keeps ([`poles`]).
+pub const POLE_LANES: usize = 12;
+
+impl PoleLanes {
+    fn new(poles: &[(DVec2, f64)]) -> PoleLanes {
+        let mut l = PoleLanes {
+            x: [1e12; POLE_LANES],
+            y: [1e12; POLE_LANES],
+            r: [0.0; POLE_LANES],
+        };
+        for (k, (c, r)) in poles.iter().take(POLE_LANES).enumerate() {
+            l.x[k] = c.x;
+            l.y[k] = c.y;
+            l.r[k] = *r;
+        }
+        l
+    }
+}
+
 /// Overlap proxy of two shapes known to collide (see the module docs); always > 0.
+///
+/// Each pole of `a` near `b`'s bounding box meets every lane of `b` at once, branch-free, so
+/// that the compiler vectorises it; with AVX2 where the CPU has it (checked at run time). The
+/// compiler never fuses a multiply and an add on its own, so both give bit-identical values.
 pub fn overlap_proxy(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u64) -> f64 {
     *work += (a.poles.len() * b.poles.len()) as u64 / 16 + 2;
     if a.poles.is_empty() || b.poles.is_empty() {
         return 1e-6;
     }
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2, checked just above.
+        return unsafe { overlap_proxy_avx2(a, pa, b, pb, s) };
+    }
+    overlap_proxy_lanes(a, pa, b, pb, s)
+}
+
+/// [`overlap_proxy_lanes`] with AVX2 instructions.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn overlap_proxy_avx2(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64) -> f64 {
+    overlap_proxy_lanes(a, pa, b, pb, s)
+}
+
+#[inline(always)]
+fn overlap_proxy_lanes(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64) -> f64 {
     let eps = 0.01 * a.size.max_element().max(b.size.max_element());
+    let (eps2, two_eps) = (eps * eps, 2.0 * eps);
     let d = pb - pa;
-    let f = |pd: f64| {
-        if pd >= eps {
-            pd
-        } else {
-            eps * eps / (2.0 * eps - pd)
-        }
-    };
-    let mut sum = 0.0;
-    // Poles far from the other shape's bounding box add (almost) nothing: skipped.
-    let box_dist = |c: DVec2, lo: DVec2, hi: DVec2| c.clamp(lo, hi).distance_squared(c);
-    let (ra_max, rb_max) = (a.poles[0].1, b.poles[0].1);
-    let mut near_b: [(DVec2, f64); 16] = [(DVec2::ZERO, 0.0); 16];
-    let mut nb = 0;
-    for (cb, rb) in b.poles.iter().take(16) {
-        let reach = rb + s + ra_max;
-        if box_dist(*cb + d, DVec2::ZERO, a.size) < reach * reach {
-            near_b[nb] = (*cb, *rb);
-            nb += 1;
+    let l = &b.lanes;
+    let (ra_max, rb_max) = (a.poles[0].1, l.r[0]);
+    // Poles far from the other shape's bounding box add (almost) nothing: skipped, on `b`'s
+    // side by a radius of 0 in the min-radius weight.
+    let mut rw = l.r;
+    for (j, w) in rw.iter_mut().enumerate() {
+        let c = DVec2::new(l.x[j], l.y[j]) + d;
+        let reach = *w + s + ra_max;
+        if c.clamp(DVec2::ZERO, a.size).distance_squared(c) >= reach * reach {
+            *w = 0.0;
         }
     }
+    let mut acc = [0.0f64; POLE_LANES];
     for (ca, ra) in &a.poles {
         let ca = *ca - d;
         let reach = ra + s + rb_max;
-        if box_dist(ca, DVec2::ZERO, b.size) >= reach * reach {
+        if ca.clamp(DVec2::ZERO, b.size).distance_squared(ca) >= reach * reach {
             continue;
         }
-        for (cb, rb) in &near_b[..nb] {
-            sum += f(ra + rb + s - ca.distance(*cb)) * ra.min(*rb);
+        let base = ra + s;
+        for j in 0..POLE_LANES {
+            let (dx, dy) = (ca.x - l.x[j], ca.y - l.y[j]);
+            let pd = base + l.r[j] - (dx * dx + dy * dy).sqrt();
+            let decay = eps2 / (two_eps - pd);
+            let v = if pd >= eps { pd } else { decay };
+            // Pairs farther apart than their radii sum count for nothing (module docs).
+            let v = if pd > -(ra + l.r[j]) { v } else { 0.0 };
+            acc[j] += v * ra.min(rw[j]);
         }
     }
-    (sum + eps * eps).sqrt() * (a.area.abs() * b.area.abs()).sqrt().sqrt()
+    let sum: f64 = acc.iter().sum();
+    (sum + eps2).sqrt() * (a.area.abs() * b.area.abs()).sqrt().sqrt()
 }
 
 /// Poles of inaccessibility of a polygon with holes: disjoint inscribed circles, largest
 /// first (see the module docs).
 pub fn poles(rings: &[Vec<DVec2>]) -> Vec<(DVec2, f64)> {
-    const MAX_POLES: usize = 12;
+    const MAX_POLES: usize = POLE_LANES;
     let Some(outer) = rings.first() else {
         return vec![];
     };

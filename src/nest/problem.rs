@@ -17,7 +17,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Work units per second of the time limit (see the module docs).
-pub const WORK_PER_SECOND: f64 = 3.5e7;
+pub const WORK_PER_SECOND: f64 = 5.0e7;
 
 /// Allowed orientations of an item.
 #[derive(Debug, Clone, PartialEq)]
