@@ -938,14 +938,9 @@ fn torus_is_cut_open_along_two_loops() {
         seg.merged
     );
     assert_eq!(seg.split, 0);
-    // As one chart, laid flat with a generous tolerance (a torus is not developable): one
-    // piece, no flip, no NaN, both sides of every seam on that piece.
-    let o = FlattenOptions {
-        tolerance: 2.0,
-        darts: 0,
-        max_splits: 0,
-        ..FlattenOptions::default()
-    };
+    // As one chart, laid flat for fabric (L2 up to 1.03; a torus is not developable, this
+    // one stretches by 1.027): one piece, no flip, no NaN, both sides of every seam on it.
+    let o = FlattenOptions::for_material(flatcut::spec::MaterialKind::Fabric);
     let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
     check_flat(&flat);
     let (_, s) = fcharts::stretch(&flat);
@@ -964,7 +959,8 @@ fn torus_is_cut_open_along_two_loops() {
     assert_eq!(p.len(), 1);
     assert_eq!(p[0].border.len(), 1, "one outline: the torus is a disk now");
     assert_eq!(s.flipped, 0);
-    assert!(s.l2.is_finite() && s.l2 > 1.0 && s.l2 < 2.0);
+    assert!(s.l2.is_finite() && s.l2 > 1.0 && s.l2 <= o.tolerance);
+    assert!(flat.surface.warnings.is_empty());
     assert_eq!(flat.surface.cuts.len(), cuts.len());
     // Both sides of the cut are seams of this piece; their 3D length is the cuts' length.
     assert!((len3 - len).abs() < 1e-6 * len);
@@ -1093,7 +1089,7 @@ fn gussets_fill_the_slits_of_a_saddle() {
     // A saddle has negative angle defect: a slit toward its most negative point overlaps
     // instead of opening (§5.2.3). The overlapping region is cut off and laid flat on its
     // own: a gusset, a separate piece sewn into the slit (§5.3).
-    let mesh = saddle(50.0, 60.0, 24);
+    let mesh = saddle(50.0, 30.0, 24);
     let n = mesh.faces.len();
     let lay = |gussets: usize| {
         let o = FlattenOptions {
@@ -1125,7 +1121,7 @@ fn gussets_fill_the_slits_of_a_saddle() {
         }
     }
     println!(
-        "saddle 100 mm, c 60: whole L2 {:.5} Linf {:.4}; with gussets {} pieces L2 {:.5} Linf {:.4}, pieces' L2 {:?}; {} seams between pieces, sides differ by at most {:.3} %",
+        "saddle 100 mm, c 30: whole L2 {:.5} Linf {:.4}; with gussets {} pieces L2 {:.5} Linf {:.4}, pieces' L2 {:?}; {} seams between pieces, sides differ by at most {:.3} %",
         s0.l2,
         s0.linf,
         gus.islands.len(),
@@ -1151,8 +1147,10 @@ fn gussets_fill_the_slits_of_a_saddle() {
         }
     }
     assert!(s1.l2 < s0.l2 && s1.linf < s0.linf, "{s1:?} vs {s0:?}");
-    // Every gusset shares seams with the chart it was cut from.
-    assert!(seams >= 2 * (gus.islands.len() - 1), "{seams}");
+    // Every gusset shares a seam with the chart it was cut from (the slit's side and the
+    // edge it was cut along make one chain); laid flat its two sides differ by the stretch.
+    assert!(seams >= gus.islands.len() - 1, "{seams}");
+    assert!(worst < s1.linf - 1.0, "{worst}");
     // Same input, same output.
     let (again, _, _) = lay(2);
     assert_eq!(again.face_2d, gus.face_2d);

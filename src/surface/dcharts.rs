@@ -31,7 +31,14 @@
 //! - **Merging** (§5.2.3): two adjacent charts merge when the faces within
 //!   [`DChartsOptions::merge_rings`] rings of their common boundary fit a cylinder
 //!   (`θ = π/2`) with mean error below `η` ([`DChartsOptions::eta`]), best pair first, and
-//!   only when the merged chart can be cut into a disk ([`disk_cuts`]: no handle).
+//!   only when the merged chart can be cut into a disk ([`disk_cuts`]). A merge that makes a
+//!   handle (two charts meeting along two separate boundary segments, closing a ring) is
+//!   allowed now that handles are cut open: the thesis' criterion is about developability
+//!   alone, and the merged region fits a cylinder near the common boundary by `η`. Whether it
+//!   flattens within the material's tolerance is the flatten stage's question (it knows the
+//!   material): it adds darts and gussets, and splits or reports a piece that stays over
+//!   ([`crate::flatten::charts`]). Checking it here would need the parameteriser inside the
+//!   surface stage; on the acceptance meshes no merge made a handle (same figures).
 //! - **Cuts** (§5.2.3 "cuts connecting the boundary loops"): a chart that is not a disk gets
 //!   seams inside it ([`disk_cuts`], [`Segmentation::cuts`], carried by
 //!   [`super::Surface::cuts`]): a tube the shortest path between its two rims, a sphere with
@@ -57,8 +64,7 @@
 //! reaches unreached components first). The result is deterministic: ties break on face
 //! index, charts are numbered by their smallest face.
 //!
-//! Not done: cutting handles open (a chart with a handle is split instead), the min-cut
-//! straightening of closed boundary loops, gussets (a cut that would overlap is not made).
+//! Not done: the min-cut straightening of closed boundary loops.
 
 use super::dcs::{self, Moments, Proxy};
 use crate::geom::mesh::{Mesh, Topology};
