@@ -1393,9 +1393,8 @@ pub fn disk_cuts(
             loop_of[v] = loop_of[v].min(r);
         }
     }
-    if op.loops == 0 && twice_genus > 0 {
-        // A closed surface with handles: the generators alone open it (below).
-    } else if op.loops == 0 {
+    // A closed surface with handles: the generators alone open it (below).
+    if op.loops == 0 && twice_genus == 0 {
         let &low = faces
             .iter()
             .flat_map(|&f| mesh.faces[f].verts.iter())
@@ -1412,7 +1411,7 @@ pub fn disk_cuts(
         let (da, via, _) = vertex_paths(&adj, &w, &[a], &never);
         let b = far(&da);
         added = trace(topo, &via, b);
-    } else {
+    } else if op.loops > 0 {
         // Root: the loop through the lowest boundary vertex; the others joined one by one.
         let mut reached = vec![false; nv];
         let mut loop_reached: std::collections::BTreeSet<usize> = Default::default();
@@ -1514,15 +1513,13 @@ fn handle_cuts(
     let mut d = vec![f64::INFINITY; nl];
     let mut via = vec![(NONE, NONE); nl]; // (edge, previous local vertex)
     let mut heap = BinaryHeap::new();
-    for l in 0..nl {
-        if root[l] {
-            d[l] = 0.0;
-            heap.push(Entry {
-                key: 0.0,
-                face: l,
-                d: 0.0,
-            });
-        }
+    for (l, _) in root.iter().enumerate().filter(|&(_, &r)| r) {
+        d[l] = 0.0;
+        heap.push(Entry {
+            key: 0.0,
+            face: l,
+            d: 0.0,
+        });
     }
     while let Some(Entry { key, face: v, .. }) = heap.pop() {
         if key > d[v] {
