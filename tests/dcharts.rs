@@ -739,3 +739,419 @@ fn darts_lower_stretch_without_splitting() {
     assert_eq!(again.face_2d, darted.face_2d);
     assert_eq!(again.surface.cuts, darted.surface.cuts);
 }
+
+/// A torus of radii `big` (to the tube's centre) and `small` (the tube's), `n` × `m` quads
+/// each split in two triangles.
+fn torus(big: f64, small: f64, n: usize, m: usize) -> Mesh {
+    let mut vertices = Vec::new();
+    for i in 0..n {
+        let u = i as f64 / n as f64 * 2.0 * PI;
+        for j in 0..m {
+            let v = j as f64 / m as f64 * 2.0 * PI;
+            let r = big + small * v.cos();
+            vertices.push(DVec3::new(r * u.cos(), r * u.sin(), small * v.sin()));
+        }
+    }
+    let id = |i: usize, j: usize| (i % n) * m + j % m;
+    let mut faces = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            faces.push(Face {
+                verts: vec![a, b, c],
+                line: None,
+            });
+            faces.push(Face {
+                verts: vec![a, c, d],
+                line: None,
+            });
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+/// A closed genus-2 surface: the outside of a 5 × 3 slab of `cell` mm cubes, one cube thick,
+/// with the cubes (1, 1) and (3, 1) taken out (two holes), each cube face split in two
+/// triangles.
+fn genus_two(cell: f64) -> Mesh {
+    let (nx, ny) = (5i64, 3i64);
+    let solid = |x: i64, y: i64, z: i64| {
+        (0..nx).contains(&x) && (0..ny).contains(&y) && z == 0 && !(y == 1 && (x == 1 || x == 3))
+    };
+    let mut index: std::collections::BTreeMap<[i64; 3], usize> = Default::default();
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    let mut vid = |p: [i64; 3], vertices: &mut Vec<DVec3>| {
+        *index.entry(p).or_insert_with(|| {
+            vertices.push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * cell);
+            vertices.len() - 1
+        })
+    };
+    for x in 0..nx {
+        for y in 0..ny {
+            if !solid(x, y, 0) {
+                continue;
+            }
+            // The six faces, counter-clockwise seen from outside.
+            let quads: [([i64; 3], [[i64; 3]; 4]); 6] = [
+                ([1, 0, 0], [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]]),
+                ([-1, 0, 0], [[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0]]),
+                ([0, 1, 0], [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]]),
+                ([0, -1, 0], [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]]),
+                ([0, 0, 1], [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]),
+                ([0, 0, -1], [[0, 0, 0], [0, 1, 0], [1, 1, 0], [1, 0, 0]]),
+            ];
+            for (dir, q) in quads {
+                if solid(x + dir[0], y + dir[1], dir[2]) {
+                    continue;
+                }
+                let v: Vec<usize> = q
+                    .iter()
+                    .map(|c| vid([x + c[0], y + c[1], c[2]], &mut vertices))
+                    .collect();
+                faces.push(Face {
+                    verts: vec![v[0], v[1], v[2]],
+                    line: None,
+                });
+                faces.push(Face {
+                    verts: vec![v[0], v[2], v[3]],
+                    line: None,
+                });
+            }
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+/// Edge ids of cut vertex pairs.
+fn cut_ids(mesh: &Mesh, cuts: &[[usize; 2]]) -> Vec<usize> {
+    let topo = mesh.topology();
+    let mut ids: Vec<usize> = topo
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| {
+            let [a, b] = e.verts;
+            cuts.contains(&[a.min(b), a.max(b)])
+        })
+        .map(|(k, _)| k)
+        .collect();
+    ids.sort_unstable();
+    ids
+}
+
+/// Every chart of `chart`, opened along `cuts`, is a disk: connected, V − E + F = 1, one
+/// boundary loop.
+fn assert_disks(mesh: &Mesh, chart: &[usize], cuts: &[[usize; 2]]) {
+    let topo = mesh.topology();
+    let ids = cut_ids(mesh, cuts);
+    assert_eq!(ids.len(), cuts.len(), "every cut is an edge of the mesh");
+    let count = chart.iter().max().map_or(0, |m| m + 1);
+    for c in 0..count {
+        let faces: Vec<usize> = (0..chart.len()).filter(|&f| chart[f] == c).collect();
+        let op = dcharts::open(mesh, &topo, &faces, &|e| ids.binary_search(&e).is_ok());
+        assert!(op.connected && !op.nonmanifold, "chart {c}");
+        assert_eq!((op.euler, op.loops), (1, 1), "chart {c} opened");
+    }
+}
+
+/// The seams a piece shares with itself (cuts inside it): their two sides as laid flat, and
+/// the 3D length of all its cut edges. Returns (sum of side A, sum of side B, 3D length,
+/// largest relative difference between the two sides of one seam).
+fn self_seams(mesh: &Mesh, flat: &Flat, piece: &flatcut::pattern::Piece) -> (f64, f64, f64, f64) {
+    let cuts = cut_ids(mesh, &flat.surface.cuts);
+    let faces: std::collections::BTreeSet<usize> = piece.faces.iter().copied().collect();
+    let len3: f64 = cuts
+        .iter()
+        .filter(|&&e| {
+            flat.topology.edges[e]
+                .uses
+                .iter()
+                .all(|u| faces.contains(&u.0))
+        })
+        .map(|&e| {
+            let [a, b] = flat.topology.edges[e].verts;
+            mesh.vertices[a].distance(mesh.vertices[b])
+        })
+        .sum();
+    let mut a = 0.0;
+    let mut b = 0.0;
+    let mut worst: f64 = 0.0;
+    for s in piece.seams.iter().filter(|s| s.partner == piece.id) {
+        if s.is_a {
+            a += s.length;
+            let other = piece
+                .seams
+                .iter()
+                .find(|t| t.id == s.id && !t.is_a)
+                .map_or(f64::NAN, |t| t.length);
+            worst = worst.max((s.length - other).abs() / s.length);
+        } else {
+            b += s.length;
+        }
+    }
+    (a, b, len3, worst)
+}
+
+#[test]
+fn torus_is_cut_open_along_two_loops() {
+    // A torus is genus 1: one loop around the tube and one around the hole make it a disk
+    // (tree–cotree; no bisecting).
+    let mesh = torus(60.0, 20.0, 48, 24);
+    let n = mesh.faces.len();
+    let topo = mesh.topology();
+    let g = dcharts::Graph::new(&mesh, &topo);
+    let all: Vec<usize> = (0..n).collect();
+    let cuts = dcharts::disk_cuts(&mesh, &topo, &g, &all, &|_| false).expect("a torus opens");
+    let pairs: Vec<[usize; 2]> = cuts
+        .iter()
+        .map(|&e| {
+            let [a, b] = topo.edges[e].verts;
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    assert_disks(&mesh, &vec![0; n], &pairs);
+    let len: f64 = cuts
+        .iter()
+        .map(|&e| {
+            let [a, b] = topo.edges[e].verts;
+            mesh.vertices[a].distance(mesh.vertices[b])
+        })
+        .sum();
+    // The shortest loops: around the tube on the inside (2π · 20 as a 24-gon) and around the
+    // hole on the top, both through the root; no longer than the two circles on the outside.
+    let tube = 24.0 * 2.0 * 20.0 * (PI / 24.0).sin();
+    let around = 48.0 * 2.0 * 80.0 * (PI / 48.0).sin();
+    println!(
+        "torus 60/20 48x24: {} cut edges, {len:.2} mm (tube circle {tube:.2}, outer circle {around:.2})",
+        cuts.len()
+    );
+    assert!(len <= tube + around + 1e-6, "{len}");
+    // Segmented: every chart is a disk after its cuts, and none was bisected.
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    assert_disks(&mesh, &seg.chart, &seg.cuts);
+    println!(
+        "torus segmented: {} charts, {} cut edges, {} splits, {} merges",
+        seg.count,
+        seg.cuts.len(),
+        seg.split,
+        seg.merged
+    );
+    assert_eq!(seg.split, 0);
+    // As one chart, laid flat for fabric (L2 up to 1.03; a torus is not developable, this
+    // one stretches by 1.027): one piece, no flip, no NaN, both sides of every seam on it.
+    let o = FlattenOptions::for_material(flatcut::spec::MaterialKind::Fabric);
+    let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
+    check_flat(&flat);
+    let (_, s) = fcharts::stretch(&flat);
+    let p = pieces(&flat);
+    let (a, b, len3, worst) = self_seams(&mesh, &flat, &p[0]);
+    println!(
+        "torus as one chart: {} pieces, {} cut edges, L2 {:.5} Linf {:.4}, flipped {}; seam sides {a:.3} / {b:.3} mm laid flat, {len3:.3} mm in 3D, worst seam sides differ by {:.2} %",
+        flat.islands.len(),
+        flat.surface.cuts.len(),
+        s.l2,
+        s.linf,
+        s.flipped,
+        worst * 100.0
+    );
+    assert_eq!(flat.islands.len(), 1);
+    assert_eq!(p.len(), 1);
+    assert_eq!(p[0].border.len(), 1, "one outline: the torus is a disk now");
+    assert_eq!(s.flipped, 0);
+    assert!(s.l2.is_finite() && s.l2 > 1.0 && s.l2 <= o.tolerance);
+    assert!(flat.surface.warnings.is_empty());
+    assert_eq!(flat.surface.cuts.len(), cuts.len());
+    // Both sides of the cut are seams of this piece; their 3D length is the cuts' length.
+    assert!((len3 - len).abs() < 1e-6 * len);
+    assert!(a > 0.0 && b > 0.0);
+    // Same input, same output.
+    let again = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
+    assert_eq!(again.face_2d, flat.face_2d);
+}
+
+#[test]
+fn torus_with_a_hole_and_genus_two_are_cut_into_disks() {
+    // A torus with a hole (genus 1, one boundary loop): generators from the boundary.
+    let mut holed = torus(60.0, 20.0, 48, 24);
+    holed.faces.drain(100..104);
+    let n = holed.faces.len();
+    let topo = holed.topology();
+    let g = dcharts::Graph::new(&holed, &topo);
+    let all: Vec<usize> = (0..n).collect();
+    let cuts = dcharts::disk_cuts(&holed, &topo, &g, &all, &|_| false).expect("opens");
+    let pairs: Vec<[usize; 2]> = cuts
+        .iter()
+        .map(|&e| {
+            let [a, b] = topo.edges[e].verts;
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    assert_disks(&holed, &vec![0; n], &pairs);
+    // Genus 2, closed: four generators.
+    let mesh = genus_two(20.0);
+    let n2 = mesh.faces.len();
+    let topo2 = mesh.topology();
+    assert!(topo2.edges.iter().all(|e| e.uses.len() == 2));
+    let chi = mesh.vertices.len() as i64 - topo2.edges.len() as i64 + n2 as i64;
+    assert_eq!(chi, -2, "genus 2");
+    let g2 = dcharts::Graph::new(&mesh, &topo2);
+    let all2: Vec<usize> = (0..n2).collect();
+    let cuts2 = dcharts::disk_cuts(&mesh, &topo2, &g2, &all2, &|_| false).expect("opens");
+    let pairs2: Vec<[usize; 2]> = cuts2
+        .iter()
+        .map(|&e| {
+            let [a, b] = topo2.edges[e].verts;
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    assert_disks(&mesh, &vec![0; n2], &pairs2);
+    // Laid flat as one chart (paper): cut, then split where it overlaps or stretches; never
+    // an error or a NaN; every piece a disk.
+    let flat = fcharts::charts(
+        surface(mesh.clone(), Some(vec![0; n2])),
+        &FlattenOptions::default(),
+    )
+    .unwrap();
+    check_flat(&flat);
+    let (_, s) = fcharts::stretch(&flat);
+    assert_eq!(s.flipped, 0);
+    assert_disks(
+        &mesh,
+        flat.surface.charts.as_ref().unwrap(),
+        &flat.surface.cuts,
+    );
+    let seg = dcharts::segment(&mesh, &DChartsOptions::default()).unwrap();
+    assert_disks(&mesh, &seg.chart, &seg.cuts);
+    println!(
+        "torus with a hole: {} cut edges; genus 2 ({} faces): {} cut edges as one chart, laid flat in {} pieces L2 {:.5}; segmented {} charts, {} splits, {} cut edges",
+        cuts.len(),
+        n2,
+        cuts2.len(),
+        flat.islands.len(),
+        s.l2,
+        seg.count,
+        seg.split,
+        seg.cuts.len()
+    );
+    assert_eq!(seg.split, 0);
+}
+
+/// A hyperbolic paraboloid z = (x² − y²) / (2c) over a square of side `2 half`, `n` × `n`
+/// quads each split in two triangles: negative angle defect everywhere inside.
+fn saddle(half: f64, c: f64, n: usize) -> Mesh {
+    let mut vertices = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = -half + 2.0 * half * i as f64 / n as f64;
+            let y = -half + 2.0 * half * j as f64 / n as f64;
+            vertices.push(DVec3::new(x, y, (x * x - y * y) / (2.0 * c)));
+        }
+    }
+    let id = |i: usize, j: usize| i * (n + 1) + j;
+    let mut faces = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            faces.push(Face {
+                verts: vec![a, b, c],
+                line: None,
+            });
+            faces.push(Face {
+                verts: vec![a, c, d],
+                line: None,
+            });
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+/// Whether two faces of one island overlap in 2D (deeper than 1e-6 mm).
+fn island_overlaps(flat: &Flat) -> usize {
+    let mut n = 0;
+    for isl in &flat.islands {
+        for (k, &f) in isl.iter().enumerate() {
+            let a = &flat.face_2d[f];
+            let ta = [a[0], a[1], a[2]];
+            for &g in &isl[k + 1..] {
+                let b = &flat.face_2d[g];
+                if flatcut::geom::polygon::triangles_overlap(&ta, &[b[0], b[1], b[2]], 1e-6) {
+                    n += 1;
+                }
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn gussets_fill_the_slits_of_a_saddle() {
+    // A saddle has negative angle defect: a slit toward its most negative point overlaps
+    // instead of opening (§5.2.3). The overlapping region is cut off and laid flat on its
+    // own: a gusset, a separate piece sewn into the slit (§5.3).
+    let mesh = saddle(50.0, 30.0, 24);
+    let n = mesh.faces.len();
+    let lay = |gussets: usize| {
+        let o = FlattenOptions {
+            gussets,
+            max_splits: 0,
+            ..FlattenOptions::default()
+        };
+        let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
+        check_flat(&flat);
+        let (per, s) = fcharts::stretch(&flat);
+        (flat, per, s)
+    };
+    let (plain, _, s0) = lay(0);
+    let (gus, per, s1) = lay(2);
+    let tol = FlattenOptions::default().tolerance;
+    let p = pieces(&gus);
+    // Seams between two pieces: the two sides' lengths as laid flat.
+    let mut worst: f64 = 0.0;
+    let mut seams = 0;
+    for a in &p {
+        for sa in a.seams.iter().filter(|s| s.is_a && s.partner != a.id) {
+            let other = p
+                .iter()
+                .find(|q| q.id == sa.partner)
+                .and_then(|q| q.seams.iter().find(|t| t.id == sa.id && !t.is_a));
+            let Some(sb) = other else { continue };
+            seams += 1;
+            worst = worst.max((sa.length - sb.length).abs() / sa.length.max(sb.length));
+        }
+    }
+    println!(
+        "saddle 100 mm, c 30: whole L2 {:.5} Linf {:.4}; with gussets {} pieces L2 {:.5} Linf {:.4}, pieces' L2 {:?}; {} seams between pieces, sides differ by at most {:.3} %",
+        s0.l2,
+        s0.linf,
+        gus.islands.len(),
+        s1.l2,
+        s1.linf,
+        per.iter().map(|s| (s.l2 * 1e5).round() / 1e5).collect::<Vec<_>>(),
+        seams,
+        worst * 100.0
+    );
+    assert_eq!(plain.islands.len(), 1);
+    assert!(s0.l2 > tol);
+    assert!(gus.islands.len() >= 2, "a gusset was cut off");
+    assert_eq!(s1.flipped, 0);
+    assert!(s1.l2.is_finite() && s1.linf.is_finite());
+    assert_eq!(island_overlaps(&gus), 0, "no piece overlaps itself");
+    // The gussets (every piece but the largest) are within the tolerance.
+    let big = (0..gus.islands.len())
+        .max_by_key(|&k| (gus.islands[k].len(), usize::MAX - k))
+        .unwrap();
+    for (k, s) in per.iter().enumerate() {
+        if k != big {
+            assert!(s.l2 <= tol, "gusset {k}: L2 {}", s.l2);
+        }
+    }
+    assert!(s1.l2 < s0.l2 && s1.linf < s0.linf, "{s1:?} vs {s0:?}");
+    // Every gusset shares a seam with the chart it was cut from (the slit's side and the
+    // edge it was cut along make one chain); laid flat its two sides differ by the stretch.
+    assert!(seams >= gus.islands.len() - 1, "{seams}");
+    assert!(worst < s1.linf - 1.0, "{worst}");
+    // Same input, same output.
+    let (again, _, _) = lay(2);
+    assert_eq!(again.face_2d, gus.face_2d);
+}

@@ -7,7 +7,8 @@
 //! edges before it is parameterised: [`crate::surface::dcharts::open`] gives one vertex per
 //! wedge of faces around each mesh vertex, so the vertices along a seam are split, and the
 //! opened chart is laid flat as a mesh of its own. A chart that is still not a disk gets the
-//! cuts of [`crate::surface::dcharts::disk_cuts`] (a tube the shortest seam between its rims);
+//! cuts of [`crate::surface::dcharts::disk_cuts`] (a tube the shortest seam between its rims,
+//! a chart with handles its shortest system of loops as well);
 //! cuts a split leaves useless are dropped and found again. A cut edge is never `joined`, so
 //! the pattern stage draws it as a cut line with seam marks on both sides, like a seam
 //! between two pieces; [`Surface::cuts`] of the result lists the cuts that stayed inside a
@@ -20,15 +21,22 @@
 //!
 //! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
 //! material's tolerance"), a chart
-//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap, or a
-//!   gusset folding over) is split between the two overlapping faces
+//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap) has
+//!   the overlapping region cut off ([`cut_off`], after Lévy et al. 2002, the thesis' [22]:
+//!   the overlapping faces are sorted to the nearer of the two first found overlapping, the
+//!   side with less overlapping area is cut off, again while the rest still overlaps) when
+//!   that part has at most [`CUT_OFF_AREA`] of the chart's area; the part cut off is a chart
+//!   of its own, re-attached at the end to a neighbour where it fits ([`reattach`]). A larger
+//!   overlap splits the chart between the two overlapping faces
 //!   ([`crate::surface::dcharts::split_between`]: each face goes with the nearer of the two,
-//!   through the chart), so the overlapping parts end up in different pieces; a chart that
-//!   needed seams to be a disk (a tube whose layout spirals over itself) is halved along
-//!   the bisector instead;
+//!   through the chart); a chart that needed seams to be a disk (a tube whose layout
+//!   spirals over itself) is halved along the bisector instead;
 //! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts` below: up
 //!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
-//!   region, then shortened while it stays within the tolerance);
+//!   region, then shortened while it stays within the tolerance), then gussets where the
+//!   surface is saddle-shaped ([`gussets`]: a slit toward the most negative angle defect
+//!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
+//!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
 //!
 //! and is split along the bisector of its two most distant faces
 //! ([`crate::surface::dcharts::bisect`]) when
@@ -44,6 +52,11 @@
 //! on a 1 m piece), fabric 1.03 (woven cloth gives a few percent on the bias, and stuffing
 //! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
 //! visible fault.
+//!
+//! The two sides of a seam (a cut inside a piece, or the edge a gusset shares with its
+//! chart) have the same 3D length; laid flat they are as long as the parameterisation makes
+//! them, equal only where it is isometric: on a non-developable piece they differ by up to
+//! its stretch (the torus of the tests: 4.8 % on one seam), which sewing takes up as ease.
 
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
@@ -70,6 +83,14 @@ pub struct FlattenOptions {
     /// Most darts cut into a chart over the tolerance before it is split (see the module doc); 0
     /// for none.
     pub darts: usize,
+    /// Most gussets cut into a chart still over the tolerance after its darts (see
+    /// [`gussets`]); 0 for none (default 2).
+    pub gussets: usize,
+    /// Merging threshold `η` for re-attaching a cut-off gusset to an adjacent piece: the mean
+    /// cylinder fitting error of the gusset and two face rings of the piece around their common
+    /// boundary ([`dcharts::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
+    /// [`dcharts::DChartsOptions::eta`].
+    pub reattach_eta: f64,
 }
 
 impl Default for FlattenOptions {
@@ -80,6 +101,8 @@ impl Default for FlattenOptions {
             tolerance: material_tolerance(MaterialKind::Paper),
             max_splits: 3,
             darts: 4,
+            gussets: 2,
+            reattach_eta: 1e-3,
         }
     }
 }
@@ -119,6 +142,8 @@ struct Laid {
     cuts: Vec<usize>,
     uv: Vec<Vec<DVec2>>,
     stretch: Stretch,
+    /// A gusset cut off a chart ([`gussets`]), to be re-attached to a neighbour if one fits.
+    gusset: bool,
 }
 
 /// A chart waiting to be laid flat.
@@ -128,6 +153,9 @@ struct Todo {
     splits: usize,
     /// Edges cut open inside it (sorted), inherited from the surface or a larger chart.
     cuts: Vec<usize>,
+    /// Cut off a larger chart for overlapping it ([`cut_off`]): to be re-attached to a
+    /// neighbour if one fits ([`reattach`]).
+    cut_off: bool,
 }
 
 /// What [`Charts::lay`] made of a chart.
@@ -270,6 +298,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
             cuts: ctx.cuts_within(&faces, &surface_cuts),
             faces,
             splits: 0,
+            cut_off: false,
         })
         .collect();
     todo.reverse();
@@ -301,11 +330,13 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
             faces: b,
             splits,
             cuts: cb,
+            cut_off: false,
         });
         todo.push(Todo {
             faces: a,
             splits,
             cuts: ca,
+            cut_off: false,
         });
     };
     let split_it = |todo: &mut Vec<Todo>, t: &Todo, splits: usize| {
@@ -340,6 +371,39 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
                 if !t.cuts.is_empty() && split_it(&mut todo, &t, t.splits) {
                     continue;
                 }
+                // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
+                let pairs = overlaps(&uv, overlap_eps, OVERLAP_PAIRS);
+                let (fx, fy) = (t.faces[x], t.faces[y]);
+                if let Some((rest, parts)) = cut_off(
+                    &ctx,
+                    &t.faces,
+                    &t.cuts,
+                    &[fx],
+                    &[fy],
+                    &pairs,
+                    &uv,
+                    overlap_eps,
+                ) {
+                    let area = |fs: &[usize]| fs.iter().map(|&f| graph.area[f]).sum::<f64>();
+                    let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
+                    if off <= CUT_OFF_AREA * area(&t.faces) {
+                        for p in parts.into_iter().rev() {
+                            todo.push(Todo {
+                                faces: p.faces,
+                                splits: t.splits,
+                                cuts: p.cuts,
+                                cut_off: true,
+                            });
+                        }
+                        todo.push(Todo {
+                            faces: rest.faces,
+                            splits: t.splits,
+                            cuts: rest.cuts,
+                            cut_off: t.cut_off,
+                        });
+                        continue;
+                    }
+                }
                 let (a, b) = split_between(&graph, &t.faces, t.faces[x], t.faces[y]);
                 if !a.is_empty() && !b.is_empty() {
                     push_halves(&mut todo, a, b, &t, t.splits);
@@ -356,10 +420,18 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
             cuts: t.cuts,
             uv,
             stretch,
+            gusset: t.cut_off,
         };
         if laid.stretch.l2 > opts.tolerance && opts.darts > 0 && laid.faces.len() >= DART_MIN_FACES
         {
             darts(&ctx, &mut laid, opts, overlap_eps)?;
+        }
+        if laid.stretch.l2 > opts.tolerance
+            && opts.gussets > 0
+            && laid.faces.len() >= DART_MIN_FACES
+        {
+            let gussets = gussets(&ctx, &mut laid, opts, overlap_eps);
+            done.extend(gussets);
         }
         if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
             // Darts are dropped: each half gets its own.
@@ -367,6 +439,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
                 faces: laid.faces,
                 splits: t.splits,
                 cuts: inherited,
+                cut_off: t.cut_off,
             };
             if split_it(&mut todo, &t, t.splits + 1) {
                 continue;
@@ -375,6 +448,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         }
         done.push(laid);
     }
+    reattach(&ctx, &mut done, opts, overlap_eps);
 
     // Islands numbered by smallest face.
     done.sort_by_key(|l| l.faces.iter().copied().min().unwrap_or(0));
@@ -479,8 +553,15 @@ fn bend(mesh: &crate::geom::mesh::Mesh, f: usize, i: usize, g: usize) -> f64 {
 }
 
 /// Two faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`, if
-/// any: a sweep over x of the triangles' boxes.
+/// any.
 fn self_overlap(uv: &[Vec<DVec2>], eps: f64) -> Option<(usize, usize)> {
+    overlaps(uv, eps, 1).first().copied()
+}
+
+/// Pairs of faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`,
+/// at most `limit` of them, in sweep order: a sweep over x of the triangles' boxes.
+fn overlaps(uv: &[Vec<DVec2>], eps: f64, limit: usize) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
     let mut tris: Vec<([DVec2; 3], usize)> = Vec::new();
     for (k, c) in uv.iter().enumerate() {
         for t in polygon::triangulate(c) {
@@ -504,12 +585,22 @@ fn self_overlap(uv: &[Vec<DVec2>], eps: f64) -> Option<(usize, usize)> {
                 continue;
             }
             if polygon::triangles_overlap(&tris[i].0, &tris[j].0, eps) {
-                return Some((tris[i].1, tris[j].1));
+                out.push((tris[i].1, tris[j].1));
+                if out.len() >= limit {
+                    return out;
+                }
             }
         }
     }
-    None
+    out
 }
+
+/// Most overlapping face pairs looked at when cutting an overlap off.
+const OVERLAP_PAIRS: usize = 10_000;
+
+/// A global overlap is cut off ([`cut_off`]) when the part cut off has at most this fraction
+/// of the chart's area; a larger one splits the chart between the two overlapping faces.
+const CUT_OFF_AREA: f64 = 0.25;
 
 /// Charts with fewer faces get no darts (they are split or reported as they are).
 pub const DART_MIN_FACES: usize = 24;
@@ -518,7 +609,7 @@ pub const DART_MIN_FACES: usize = 24;
 /// fitting error"; McCartney et al.): while the chart's L2 stretch is over the tolerance, at
 /// most [`FlattenOptions::darts`] times, a cut is made from the chart's boundary to the tip
 /// where the surface is most curved, and kept when the chart lays flat with a lower L2, no
-/// flip and no overlap (a cut that would overlap is a gusset; none are made). Then (§5.3,
+/// flip and no overlap (a cut that would overlap is a gusset: [`gussets`]). Then (§5.3,
 /// "shortening darts") each dart, once the chart is within the tolerance, is shortened from its
 /// tip to the fewest edges that keep it there (bisection on the number of edges kept).
 ///
@@ -552,7 +643,7 @@ fn darts(
         if laid.stretch.l2 <= opts.tolerance {
             break;
         }
-        let Some((tip, path)) = dart_path(ctx, &laid.faces, &laid.cuts, &tips) else {
+        let Some((tip, path)) = dart_path(ctx, &laid.faces, &laid.cuts, &tips, 1.0) else {
             break;
         };
         let mut cuts = laid.cuts.clone();
@@ -617,12 +708,15 @@ fn darts(
     Ok(())
 }
 
-/// Where the next dart goes: its tip and its edges, tip first (see [`darts`]).
+/// Where the next dart goes: its tip and its edges, tip first (see [`darts`]). `sign` 1 looks
+/// for positive angle defect (a dart, which opens), −1 for negative (a gusset, whose slit
+/// overlaps).
 fn dart_path(
     ctx: &Charts,
     faces: &[usize],
     cuts: &[usize],
     tips: &[(usize, f64)],
+    sign: f64,
 ) -> Option<(usize, Vec<usize>)> {
     let mesh = ctx.mesh;
     let topo = ctx.topo;
@@ -669,7 +763,7 @@ fn dart_path(
     let mut field: Vec<f64> = (0..nv)
         .map(|v| {
             if inner_v(v) {
-                (2.0 * std::f64::consts::PI - defect[v]).max(0.0)
+                (sign * (2.0 * std::f64::consts::PI - defect[v])).max(0.0)
             } else {
                 0.0
             }
@@ -715,4 +809,390 @@ fn dart_path(
     let w = |e: usize| dcharts::cut_weight(mesh, topo, ctx.graph, e);
     let path = dcharts::path_to(&adj, &w, &sources, tip, topo)?;
     (!path.is_empty()).then_some((tip, path))
+}
+
+/// Length of a path of mesh edges.
+fn path_length(ctx: &Charts, path: &[usize]) -> f64 {
+    path.iter()
+        .map(|&e| {
+            let [a, b] = ctx.topo.edges[e].verts;
+            ctx.mesh.vertices[a].distance(ctx.mesh.vertices[b])
+        })
+        .sum()
+}
+
+/// Gussets (thesis §5.2.3 last paragraph, §5.3 "fixing gussets and overlaps"): where the
+/// surface has negative angle defect (a saddle: more material around a point than a flat
+/// disk holds), a slit from the chart's boundary to the most negative point ([`dart_path`]
+/// with the sign turned) does not open like a dart: its two sides overlap in 2D. The
+/// overlapping region is then cut off ([`cut_off`]), and the rest of the chart lays flat with
+/// a wedge-shaped gap that the cut-off part, laid flat on its own, fills: the gusset, a small
+/// separate piece whose edges are seams with the chart (the slit on one side, the edge it was
+/// cut along on the other), so the pattern stage draws it with notches like any piece. At
+/// most [`FlattenOptions::gussets`] times while the chart is over the tolerance; a gusset is
+/// kept only when the chart and its gussets together have a lower L2 than the chart had, no
+/// flip, no overlap, and every gusset is within the tolerance. A slit that opens after all
+/// (no overlap) is kept as a dart when it lowers L2. Returns the gussets (laid, marked for
+/// [`reattach`]).
+fn gussets(ctx: &Charts, laid: &mut Laid, opts: &FlattenOptions, eps: f64) -> Vec<Laid> {
+    let mut out: Vec<Laid> = Vec::new();
+    let mut tips: Vec<(usize, f64)> = Vec::new();
+    for _ in 0..opts.gussets {
+        if laid.stretch.l2 <= opts.tolerance {
+            break;
+        }
+        let Some((tip, path)) = dart_path(ctx, &laid.faces, &laid.cuts, &tips, -1.0) else {
+            break;
+        };
+        let mut cuts = laid.cuts.clone();
+        cuts.extend(&path);
+        cuts.sort_unstable();
+        cuts.dedup();
+        let Ok(Layout::Laid(uv, s)) = ctx.lay(&laid.faces, &cuts) else {
+            break;
+        };
+        let pairs = overlaps(&uv, eps, OVERLAP_PAIRS);
+        let len = path_length(ctx, &path);
+        if pairs.is_empty() {
+            // It opened: a dart after all.
+            if s.flipped > 0 || s.l2 >= laid.stretch.l2 {
+                break;
+            }
+            tips.push((tip, len));
+            laid.cuts = cuts;
+            laid.uv = uv;
+            laid.stretch = s;
+            continue;
+        }
+        // The slit's two sides: walking the path from the tip, the face that runs along each
+        // edge in the walking direction is on the left.
+        let mut left = Vec::new();
+        let mut right = Vec::new();
+        let mut inside = vec![false; ctx.mesh.faces.len()];
+        for &f in &laid.faces {
+            inside[f] = true;
+        }
+        let mut v = tip;
+        for &e in &path {
+            let [a, b] = ctx.topo.edges[e].verts;
+            let u = if a == v { b } else { a };
+            for &(f, i) in &ctx.topo.edges[e].uses {
+                if !inside[f] {
+                    continue;
+                }
+                let (p, q) = Topology::corner_verts(ctx.mesh, f, i);
+                if p == v && q == u {
+                    left.push(f);
+                } else {
+                    right.push(f);
+                }
+            }
+            v = u;
+        }
+        let Some((rest, pieces)) =
+            cut_off(ctx, &laid.faces, &cuts, &left, &right, &pairs, &uv, eps)
+        else {
+            break;
+        };
+        let mut all: Vec<Stretch> = pieces.iter().map(|p| p.stretch).collect();
+        all.push(rest.stretch);
+        let together = distortion::combine(&all);
+        if together.l2 >= laid.stretch.l2 || pieces.iter().any(|p| p.stretch.l2 > opts.tolerance) {
+            break;
+        }
+        tips.push((tip, len));
+        *laid = rest;
+        out.extend(pieces);
+    }
+    out
+}
+
+/// Cut the overlapping region off a chart laid out as `uv` (faces `faces`, opened along
+/// `cuts`), after Lévy et al. 2002 (the thesis' [22]): the chart is split so that each part is
+/// overlap-free. The faces of the overlapping pairs are sorted to the side of `a` or `b`
+/// (nearer through the opened chart, in face steps; ties to `a`): for a gusset the two sides
+/// of its slit, for a global overlap the two faces found overlapping. The side with less
+/// overlapping area is cut off; the rest is its largest connected part (by area; the others
+/// go with the part cut off), laid flat again, and while it still overlaps its overlapping
+/// faces on that side are cut off too (at most 8 rounds). Returns the rest and the cut-off
+/// part's connected pieces, each laid flat (cut into a disk where needed), or `None` when
+/// some part cannot be laid flat without a flip or an overlap.
+#[allow(clippy::too_many_arguments)]
+fn cut_off(
+    ctx: &Charts,
+    faces: &[usize],
+    cuts: &[usize],
+    a: &[usize],
+    b: &[usize],
+    pairs: &[(usize, usize)],
+    uv: &[Vec<DVec2>],
+    eps: f64,
+) -> Option<(Laid, Vec<Laid>)> {
+    let nf = ctx.mesh.faces.len();
+    let mut inside = vec![false; nf];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let is_cut = |e: usize| cuts.binary_search(&e).is_ok();
+    // Faces joined through uncut chart edges.
+    let neighbours = |f: usize, within: &[bool]| -> Vec<usize> {
+        ctx.topo.face_edges[f]
+            .iter()
+            .filter(|&&e| !is_cut(e))
+            .filter_map(|&e| match ctx.topo.edges[e].uses[..] {
+                [(x, _), (y, _)] if x != y => Some(if x == f { y } else { x }),
+                _ => None,
+            })
+            .filter(|&h| within[h])
+            .collect()
+    };
+    let steps = |seeds: &[usize]| -> Vec<usize> {
+        let mut d = vec![usize::MAX; nf];
+        let mut queue = std::collections::VecDeque::new();
+        for &s in seeds {
+            if inside[s] && d[s] == usize::MAX {
+                d[s] = 0;
+                queue.push_back(s);
+            }
+        }
+        while let Some(f) = queue.pop_front() {
+            for h in neighbours(f, &inside) {
+                if d[h] == usize::MAX {
+                    d[h] = d[f] + 1;
+                    queue.push_back(h);
+                }
+            }
+        }
+        d
+    };
+    let (da, db) = (steps(a), steps(b));
+    let on_a = |f: usize| da[f] <= db[f];
+    let area2 = |k: usize| polygon::signed_area(&uv[k]).abs();
+    let (mut sa, mut sb) = (0.0, 0.0);
+    let mut fa: Vec<usize> = Vec::new();
+    let mut fb: Vec<usize> = Vec::new();
+    for &(x, y) in pairs {
+        for k in [x, y] {
+            let f = faces[k];
+            if on_a(f) {
+                sa += area2(k);
+                fa.push(f);
+            } else {
+                sb += area2(k);
+                fb.push(f);
+            }
+        }
+    }
+    let take_a = !fa.is_empty() && (fb.is_empty() || sa <= sb);
+    let side = |f: usize| on_a(f) == take_a;
+    let mut off = vec![false; nf];
+    for f in if take_a { fa } else { fb } {
+        off[f] = true;
+    }
+    let mut rest_laid: Option<Laid> = None;
+    for _ in 0..8 {
+        // The rest is the largest connected part left (by area, ties: smallest face); the
+        // other parts go with the cut-off faces.
+        let mut keep = vec![false; nf];
+        let mut best: Option<(f64, Vec<usize>)> = None;
+        let mut seen = vec![false; nf];
+        for &f0 in faces {
+            if off[f0] || seen[f0] {
+                continue;
+            }
+            let mut comp = vec![f0];
+            seen[f0] = true;
+            let mut k = 0;
+            while k < comp.len() {
+                for h in neighbours(comp[k], &inside) {
+                    if !off[h] && !seen[h] {
+                        seen[h] = true;
+                        comp.push(h);
+                    }
+                }
+                k += 1;
+            }
+            let area: f64 = comp.iter().map(|&f| ctx.graph.area[f]).sum();
+            if best.as_ref().is_none_or(|(a, _)| area > *a) {
+                best = Some((area, comp));
+            }
+        }
+        let (_, main) = best?;
+        for &f in &main {
+            keep[f] = true;
+        }
+        for &f in faces {
+            if !keep[f] {
+                off[f] = true;
+            }
+        }
+        let rest: Vec<usize> = faces.iter().copied().filter(|&f| !off[f]).collect();
+        if rest.is_empty() {
+            return None;
+        }
+        let rc = ctx.disk(&rest, &ctx.cuts_within(&rest, cuts))?;
+        let Ok(Layout::Laid(ruv, rs)) = ctx.lay(&rest, &rc) else {
+            return None;
+        };
+        if rs.flipped > 0 {
+            return None;
+        }
+        let more = overlaps(&ruv, eps, OVERLAP_PAIRS);
+        if more.is_empty() {
+            rest_laid = Some(Laid {
+                faces: rest,
+                cuts: rc,
+                uv: ruv,
+                stretch: rs,
+                gusset: false,
+            });
+            break;
+        }
+        let mut grew = false;
+        for (x, y) in more {
+            for k in [x, y] {
+                let f = rest[k];
+                if side(f) && !off[f] {
+                    off[f] = true;
+                    grew = true;
+                }
+            }
+        }
+        if !grew {
+            return None;
+        }
+    }
+    let rest = rest_laid?;
+    // The cut-off faces, by connected piece (face order: ascending).
+    let mut seen = vec![false; nf];
+    let mut pieces = Vec::new();
+    for &f0 in faces {
+        if !off[f0] || seen[f0] {
+            continue;
+        }
+        let mut comp = vec![f0];
+        seen[f0] = true;
+        let mut k = 0;
+        while k < comp.len() {
+            for h in neighbours(comp[k], &off) {
+                if !seen[h] {
+                    seen[h] = true;
+                    comp.push(h);
+                }
+            }
+            k += 1;
+        }
+        comp.sort_unstable();
+        let pc = ctx.disk(&comp, &ctx.cuts_within(&comp, cuts))?;
+        let Ok(Layout::Laid(puv, ps)) = ctx.lay(&comp, &pc) else {
+            return None;
+        };
+        if ps.flipped > 0 || (comp.len() > 1 && self_overlap(&puv, eps).is_some()) {
+            return None;
+        }
+        pieces.push(Laid {
+            faces: comp,
+            cuts: pc,
+            uv: puv,
+            stretch: ps,
+            gusset: true,
+        });
+    }
+    Some((rest, pieces))
+}
+
+/// Re-attach each gusset (and each part cut off for overlapping) to an adjacent piece when
+/// the merging criterion of §5.2.3 holds and the merge creates no new overlap (§5.3): the
+/// neighbours are tried by the length of the common boundary, longest first (ties: lower
+/// piece); the criterion is the mean cylinder fitting error of the gusset's faces and two
+/// rings of the neighbour's faces around their common boundary below
+/// [`FlattenOptions::reattach_eta`]; the merged chart (cut into a disk where needed) must lay
+/// flat with no flip, no overlap and an L2 stretch within the tolerance. The piece a gusset
+/// was cut from fails the overlap test by construction (that is why it was cut off), unless
+/// its layout has changed since.
+fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    if !done.iter().any(|l| l.gusset) {
+        return;
+    }
+    let nf = ctx.mesh.faces.len();
+    let mut owner = vec![usize::MAX; nf];
+    for (k, l) in done.iter().enumerate() {
+        for &f in &l.faces {
+            owner[f] = k;
+        }
+    }
+    let mut gone = vec![false; done.len()];
+    let mut order: Vec<usize> = (0..done.len()).filter(|&k| done[k].gusset).collect();
+    order.sort_by_key(|&k| done[k].faces.iter().copied().min().unwrap_or(0));
+    for gi in order {
+        let mut shared: std::collections::BTreeMap<usize, f64> = Default::default();
+        for &f in &done[gi].faces {
+            for &(h, len) in &ctx.graph.adj[f] {
+                let k = owner[h];
+                if k != gi && k != usize::MAX && !gone[k] {
+                    *shared.entry(k).or_default() += len;
+                }
+            }
+        }
+        let mut cands: Vec<(f64, usize)> = shared.into_iter().map(|(k, l)| (l, k)).collect();
+        cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        for (_, k) in cands {
+            // Two rings of the neighbour around the common boundary, and the gusset.
+            let mut region: Vec<usize> = done[gi].faces.clone();
+            let mut mark = vec![false; nf];
+            for &f in &region {
+                mark[f] = true;
+            }
+            let mut front: Vec<usize> = region.clone();
+            for _ in 0..2 {
+                let mut next = Vec::new();
+                for &f in &front {
+                    for &(h, _) in &ctx.graph.adj[f] {
+                        if owner[h] == k && !mark[h] {
+                            mark[h] = true;
+                            next.push(h);
+                        }
+                    }
+                }
+                region.extend(&next);
+                front = next;
+            }
+            match dcharts::cylinder_error(ctx.graph, &region) {
+                Some(err) if err < opts.reattach_eta => {}
+                _ => continue,
+            }
+            let mut faces = done[k].faces.clone();
+            faces.extend(&done[gi].faces);
+            let mut cuts = done[k].cuts.clone();
+            cuts.extend(&done[gi].cuts);
+            cuts.sort_unstable();
+            cuts.dedup();
+            let Some(cuts) = ctx.disk(&faces, &cuts) else {
+                continue;
+            };
+            let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
+                continue;
+            };
+            if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
+                continue;
+            }
+            for &f in &done[gi].faces {
+                owner[f] = k;
+            }
+            done[k] = Laid {
+                faces,
+                cuts,
+                uv,
+                stretch: s,
+                gusset: false,
+            };
+            gone[gi] = true;
+            break;
+        }
+    }
+    let mut k = 0;
+    done.retain(|_| {
+        k += 1;
+        !gone[k - 1]
+    });
 }

@@ -31,15 +31,27 @@
 //! - **Merging** (§5.2.3): two adjacent charts merge when the faces within
 //!   [`DChartsOptions::merge_rings`] rings of their common boundary fit a cylinder
 //!   (`θ = π/2`) with mean error below `η` ([`DChartsOptions::eta`]), best pair first, and
-//!   only when the merged chart can be cut into a disk ([`disk_cuts`]: no handle).
+//!   only when the merged chart can be cut into a disk ([`disk_cuts`]). A merge that makes a
+//!   handle (two charts meeting along two separate boundary segments, closing a ring) is
+//!   allowed now that handles are cut open: the thesis' criterion is about developability
+//!   alone, and the merged region fits a cylinder near the common boundary by `η`. Whether it
+//!   flattens within the material's tolerance is the flatten stage's question (it knows the
+//!   material): it adds darts and gussets, and splits or reports a piece that stays over
+//!   ([`crate::flatten::charts`]). Checking it here would need the parameteriser inside the
+//!   surface stage; on the acceptance meshes no merge made a handle (same figures).
 //! - **Cuts** (§5.2.3 "cuts connecting the boundary loops"): a chart that is not a disk gets
 //!   seams inside it ([`disk_cuts`], [`Segmentation::cuts`], carried by
 //!   [`super::Surface::cuts`]): a tube the shortest path between its two rims, a sphere with
 //!   holes a tree of such paths, a closed shell one path between two far-apart vertices; bent
-//!   edges count shorter, so seams follow creases. Only a chart that cutting cannot make a
-//!   disk (a handle, or faces joined through a single vertex) is split in two along the
+//!   edges count shorter, so seams follow creases. A chart with handles (genus g > 0: a ring
+//!   region, a mug handle, a whole torus) is cut open along 2g loops as well
+//!   ([`handle_cuts`]: tree–cotree, Eppstein 2003, with the greedy shortest system of loops
+//!   of Erickson and Whittlesey 2005, rooted at the chart's boundary once its boundary loops
+//!   are joined, or at its lowest vertex when it is closed), with the same edge weights. Only
+//!   a chart that cutting cannot make a disk — faces joined through a single vertex only
+//!   (disconnected through edges) or across a non-manifold edge — is split in two along the
 //!   bisector of its two most distant faces ([`bisect`]). Darts (partial cuts toward the most
-//!   curved region) are made by the flatten stage, which knows the stretch
+//!   curved region) and gussets are made by the flatten stage, which knows the stretch
 //!   ([`crate::flatten::charts`]).
 //!
 //! Choices where the thesis is silent: `F` is taken as `F + 10⁻⁶` in the cost so that on an
@@ -52,8 +64,7 @@
 //! reaches unreached components first). The result is deterministic: ties break on face
 //! index, charts are numbered by their smallest face.
 //!
-//! Not done: cutting handles open (a chart with a handle is split instead), the min-cut
-//! straightening of closed boundary loops, gussets (a cut that would overlap is not made).
+//! Not done: the min-cut straightening of closed boundary loops.
 
 use super::dcs::{self, Moments, Proxy};
 use crate::geom::mesh::{Mesh, Topology};
@@ -131,8 +142,8 @@ pub struct Segmentation {
     pub merged: usize,
     /// Boundary segments re-routed by straightening.
     pub straightened: usize,
-    /// Splits made so that every chart is a disk (charts with handles; tubes and closed
-    /// shells are cut open instead).
+    /// Splits made so that every chart is a disk (charts joined through a single vertex or a
+    /// non-manifold edge; tubes, closed shells and handles are cut open instead).
     pub split: usize,
     /// Edges cut open inside charts so that every chart is a disk ([`disk_cuts`]), as mesh
     /// vertex pairs (smaller first), sorted: what [`super::Surface::cuts`] takes.
@@ -577,8 +588,9 @@ pub fn split_between(g: &Graph, faces: &[usize], a: usize, b: usize) -> (Vec<usi
         .partition(|&&f| da[f] < db[f] || (da[f] == db[f] && da[f].is_finite() && f < b))
 }
 
-/// Split every chart that cutting cannot make a disk ([`disk_cuts`]: handles, pinched or
-/// non-manifold charts) until all can be; returns the number of splits.
+/// Split every chart that cutting cannot make a disk ([`disk_cuts`]: faces joined only
+/// through a vertex, or non-manifold charts; handles are cut, not split) until all can be;
+/// returns the number of splits.
 fn make_disks(
     mesh: &Mesh,
     topo: &Topology,
@@ -800,6 +812,15 @@ fn compact_ids(chart: &mut [usize], count: &mut usize) {
         *c = map[*c];
     }
     *count = next;
+}
+
+/// Mean fitting error of the faces' normals to their best cylinder (a DCS proxy with
+/// `θ = π/2`, eq. 5.4): the merging criterion of §5.2.3, compared with `η`. `None` when the
+/// faces have no area.
+pub fn cylinder_error(g: &Graph, faces: &[usize]) -> Option<f64> {
+    let mo = g.moments(faces.iter().copied());
+    let p = dcs::fit_with_cos(&mo, 0.0)?;
+    Some(dcs::mean_error(&p, &mo))
 }
 
 /// Merge adjacent charts whose common boundary region fits a cylinder (§5.2.3); returns the
@@ -1322,8 +1343,10 @@ fn trace(topo: &Topology, via: &[usize], mut v: usize) -> Vec<usize> {
 /// already joined to the nearest loop not yet joined), a closed shell one path between two
 /// vertices far apart (the second farthest from the first, the first farthest from the
 /// chart's lowest vertex). Paths run along chart edges, bent edges counting shorter
-/// ([`cut_weight`]). Empty when the chart already is a disk; `None` when cutting cannot make
-/// it one (disconnected, non-manifold, or with handles): the caller splits it.
+/// ([`cut_weight`]). A chart with handles (V − E + F = 2 − 2g − b, g > 0) then gets its 2g
+/// generator loops cut too ([`handle_cuts`]; on a closed chart they replace the path). Empty
+/// when the chart already is a disk; `None` when cutting cannot make it one (faces not
+/// connected through edges, or a non-manifold edge): the caller splits it.
 pub fn disk_cuts(
     mesh: &Mesh,
     topo: &Topology,
@@ -1335,7 +1358,12 @@ pub fn disk_cuts(
     if op.is_disk() {
         return Some(Vec::new());
     }
-    if !op.connected || op.nonmanifold || op.euler != 2 - op.loops as i64 {
+    if !op.connected || op.nonmanifold {
+        return None;
+    }
+    // Twice the genus: V − E + F = 2 − 2g − b.
+    let twice_genus = 2 - op.loops as i64 - op.euler;
+    if twice_genus < 0 || twice_genus % 2 != 0 {
         return None;
     }
     let adj = inner_graph(mesh, topo, faces, cut);
@@ -1365,7 +1393,8 @@ pub fn disk_cuts(
             loop_of[v] = loop_of[v].min(r);
         }
     }
-    if op.loops == 0 {
+    // A closed surface with handles: the generators alone open it (below).
+    if op.loops == 0 && twice_genus == 0 {
         let &low = faces
             .iter()
             .flat_map(|&f| mesh.faces[f].verts.iter())
@@ -1382,7 +1411,7 @@ pub fn disk_cuts(
         let (da, via, _) = vertex_paths(&adj, &w, &[a], &never);
         let b = far(&da);
         added = trace(topo, &via, b);
-    } else {
+    } else if op.loops > 0 {
         // Root: the loop through the lowest boundary vertex; the others joined one by one.
         let mut reached = vec![false; nv];
         let mut loop_reached: std::collections::BTreeSet<usize> = Default::default();
@@ -1418,8 +1447,126 @@ pub fn disk_cuts(
     }
     added.sort_unstable();
     added.dedup();
+    if twice_genus > 0 {
+        let with = |e: usize| cut(e) || added.binary_search(&e).is_ok();
+        added.extend(handle_cuts(mesh, topo, g, faces, &with));
+        added.sort_unstable();
+        added.dedup();
+    }
     let with = |e: usize| cut(e) || added.binary_search(&e).is_ok();
     open(mesh, topo, faces, &with).is_disk().then_some(added)
+}
+
+/// Edges cutting the handles of a chart open (the chart already cut where `cut` holds, with
+/// at most one boundary loop): the greedy system of loops of Erickson and Whittlesey (2005)
+/// built by a tree–cotree decomposition (Eppstein 2003) of the opened chart. The tree `T` is
+/// the shortest-path tree (weights [`cut_weight`]) from the boundary loop, all of its
+/// vertices roots (or, on a closed surface, from the local vertex of the chart's lowest mesh
+/// vertex); the cotree `C` is a maximum spanning tree of the dual graph over the edges not in
+/// `T`, each weighted by the length of its loop (root → one end, the edge, other end → root);
+/// the `2g` edges left over close the shortest loops, and each with its two tree paths is
+/// cut. Cutting these loops (joined to the boundary, or through the root) leaves a disk.
+/// Empty when nothing is left over (no handle).
+fn handle_cuts(
+    mesh: &Mesh,
+    topo: &Topology,
+    g: &Graph,
+    faces: &[usize],
+    cut: &dyn Fn(usize) -> bool,
+) -> Vec<usize> {
+    let op = open(mesh, topo, faces, cut);
+    let at = positions(mesh.faces.len(), faces);
+    let nl = op.vertex.len();
+    // Local edges of the opened chart: (edge, local ends, local faces); boundary vertices.
+    let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nl];
+    let mut dual: Vec<(usize, usize, usize, usize, usize)> = Vec::new(); // (e, a, b, k, kg)
+    let mut root = vec![false; nl];
+    for (k, &f) in faces.iter().enumerate() {
+        let m = mesh.faces[f].verts.len();
+        for (i, &e) in topo.face_edges[f].iter().enumerate() {
+            let (a, b) = (op.corners[k][i], op.corners[k][(i + 1) % m]);
+            if !inner(topo, &at, e, cut) {
+                root[a] = true;
+                root[b] = true;
+                continue;
+            }
+            let Some(&(h, _)) = topo.edges[e].uses.iter().find(|u| u.0 != f) else {
+                continue;
+            };
+            let kg = at[h];
+            if k < kg {
+                adj[a].push((b, e));
+                adj[b].push((a, e));
+                dual.push((e, a, b, k, kg));
+            }
+        }
+    }
+    if !root.iter().any(|&r| r) {
+        // Closed: the local vertex of the lowest mesh vertex.
+        let Some(r) = (0..nl).min_by_key(|&l| (op.vertex[l], l)) else {
+            return Vec::new();
+        };
+        root[r] = true;
+    }
+    let w = |e: usize| cut_weight(mesh, topo, g, e);
+    // Shortest-path tree from the roots over local vertices.
+    let mut d = vec![f64::INFINITY; nl];
+    let mut via = vec![(NONE, NONE); nl]; // (edge, previous local vertex)
+    let mut heap = BinaryHeap::new();
+    for (l, _) in root.iter().enumerate().filter(|&(_, &r)| r) {
+        d[l] = 0.0;
+        heap.push(Entry {
+            key: 0.0,
+            face: l,
+            d: 0.0,
+        });
+    }
+    while let Some(Entry { key, face: v, .. }) = heap.pop() {
+        if key > d[v] {
+            continue;
+        }
+        for &(u, e) in &adj[v] {
+            let nd = key + w(e);
+            if nd < d[u] {
+                d[u] = nd;
+                via[u] = (e, v);
+                heap.push(Entry {
+                    key: nd,
+                    face: u,
+                    d: nd,
+                });
+            }
+        }
+    }
+    let in_tree = |e: usize, a: usize, b: usize| via[a].0 == e || via[b].0 == e;
+    // Cotree: maximum spanning tree of the dual over the edges not in T, longest loops first.
+    let mut rest: Vec<(f64, usize, usize, usize, usize, usize)> = dual
+        .iter()
+        .filter(|&&(e, a, b, _, _)| !in_tree(e, a, b))
+        .map(|&(e, a, b, k, kg)| (d[a] + d[b] + w(e), e, a, b, k, kg))
+        .collect();
+    rest.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    let mut out: Vec<usize> = Vec::new();
+    for &(_, e, a, b, k, kg) in &rest {
+        if uf_find(&mut parent, k) != uf_find(&mut parent, kg) {
+            uf_union(&mut parent, k, kg);
+            continue;
+        }
+        // A generator: the edge and the tree paths from its ends to the roots.
+        out.push(e);
+        for mut v in [a, b] {
+            let mut steps = 0;
+            while !root[v] && via[v].0 != NONE && steps <= nl {
+                out.push(via[v].0);
+                v = via[v].1;
+                steps += 1;
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// Total length of the chart boundaries: mesh edges between two different charts.
