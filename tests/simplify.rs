@@ -94,8 +94,14 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
     for (p0, p1) in plain.iter().zip(&simple) {
         assert!(p0.simplified.is_none());
         let s = p1.simplified.expect("simplified");
-        assert_eq!(s.vertices_before, p0.border.iter().map(|r| r.len()).sum());
-        assert_eq!(s.vertices_after, p1.border.iter().map(|r| r.len()).sum());
+        assert_eq!(
+            s.vertices_before,
+            p0.border.iter().map(|r| r.len()).sum::<usize>()
+        );
+        assert_eq!(
+            s.vertices_after,
+            p1.border.iter().map(|r| r.len()).sum::<usize>()
+        );
         assert!(
             s.max_deviation <= tol + 1e-9,
             "{} {}",
@@ -154,10 +160,20 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
         );
         // Side B is side A reversed, vertex for vertex: the same 3D vertices survive. The 2D
         // copies differ, so compare which original vertex each is (its index in the chain).
+        // (A chain all round a ring ends where it starts: search forward from the last match.)
         let idx = |s: &SeamSide, orig: &SeamSide| -> Vec<usize> {
+            let mut from = 0;
             s.points
                 .iter()
-                .map(|q| orig.points.iter().position(|o| o == q).expect("original"))
+                .map(|q| {
+                    let k = from
+                        + orig.points[from..]
+                            .iter()
+                            .position(|o| o == q)
+                            .expect("an original vertex, in order");
+                    from = k + 1;
+                    k
+                })
                 .collect()
         };
         let ia = idx(a, a0);

@@ -3,7 +3,9 @@
 //! (mountain or valley, with the angle), seams with the same id written on both sides and
 //! notches at equal arc lengths ([`marks`]), a label naming the piece and the side that faces
 //! up, a grain line for fabric, bend notes for metal, and the material's finishing: glue tabs
-//! for paper, seam allowance for fabric, kerf compensation ([`allowance`]).
+//! for paper, seam allowance for fabric, kerf compensation ([`allowance`]). Pieces laid out
+//! from D-Charts have the seams between them simplified first ([`simplify`], thesis §5.3):
+//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge.
 //!
 //! Conventions: pieces are drawn as seen from the printed side, which is the outside of a
 //! closed mesh; a convex edge therefore folds away from the viewer and is a mountain fold, a
