@@ -91,6 +91,7 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
     let mut max_dev = 0.0f64;
     let mut max_mismatch = 0.0f64;
     let mut max_mismatch_before = 0.0f64;
+    let mut max_growth = 0.0f64;
     for (p0, p1) in plain.iter().zip(&simple) {
         assert!(p0.simplified.is_none());
         let s = p1.simplified.expect("simplified");
@@ -124,6 +125,21 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
                 assert!(polygon::is_simple_ring(r1), "{} crosses itself", p1.name);
             }
         }
+        // No fold line crosses the simplified border (they meet only at fold ends).
+        for f in p1.folds.iter().filter(|f| !f.tab) {
+            for r in &p1.border {
+                for i in 0..r.len() {
+                    let (a, b) = (r[i], r[(i + 1) % r.len()]);
+                    let shared = [a, b].iter().any(|q| *q == f.a || *q == f.b);
+                    assert!(
+                        shared || !polygon::segments_intersect(a, b, f.a, f.b),
+                        "{}: fold {} crosses the border",
+                        p1.name,
+                        f.edge
+                    );
+                }
+            }
+        }
         for r in &p1.outline {
             assert!(
                 polygon::is_simple_ring(r),
@@ -153,6 +169,7 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
         let mismatch = (la - lb).abs();
         max_mismatch = max_mismatch.max(mismatch);
         max_mismatch_before = max_mismatch_before.max(was);
+        max_growth = max_growth.max(mismatch - was);
         assert!(
             mismatch <= flatcut::pattern::simplify::MISMATCH_MM.max(was) + 1e-9,
             "seam {}: {la} vs {lb} (was {was})",
@@ -194,7 +211,7 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
         }
     }
     println!(
-        "{name}: {} pieces, {} seams, outline vertices {before} -> {after} ({:.0} %), max deviation {max_dev:.4} mm (tolerance {tol}), seam length mismatch max {max_mismatch:.4} mm (before {max_mismatch_before:.4}), {notches} notch pairs",
+        "{name}: {} pieces, {} seams, outline vertices {before} -> {after} ({:.0} %), max deviation {max_dev:.4} mm (tolerance {tol}), seam length mismatch max {max_mismatch:.4} mm (before {max_mismatch_before:.4}; largest growth on one seam {max_growth:.4}), {notches} notch pairs",
         simple.len(),
         pairs1.len(),
         100.0 * after as f64 / before as f64
