@@ -54,6 +54,10 @@ pub const MISMATCH_MM: f64 = 0.1;
 /// Least distance (mm) between a new segment and the rest of the piece's border.
 const CLEARANCE_MM: f64 = 2.0 * super::allowance::CLEAN_MM;
 
+/// Two 2D copies of one mesh vertex (a fold's end, a border point) closer than this (mm) are
+/// the same point: charts agree on shared vertices to about 1e-9 relative, not exactly.
+const SAME_MM: f64 = 1e-6;
+
 /// Sharpest corner (radians) a collapse may make where the chord meets the border next to it.
 const SPIKE_RAD: f64 = 0.05;
 
@@ -174,7 +178,7 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
                 let q = rings[p][r].pts[j];
                 folds[p]
                     .iter()
-                    .any(|&(u, v)| u.distance(q) < 1e-9 || v.distance(q) < 1e-9)
+                    .any(|&(u, v)| u.distance(q) < SAME_MM || v.distance(q) < SAME_MM)
             });
             if on_fold || cand_at[a.0][a.1][a.2].is_some() || cand_at[b.0][b.1][b.2].is_some() {
                 continue;
@@ -286,9 +290,9 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
             let mut pts = Vec::with_capacity(ring.count);
             let mut edges = Vec::with_capacity(ring.count);
             let mut faces = Vec::with_capacity(ring.count);
-            for i in 0..n {
+            for (i, slot) in idx.iter_mut().enumerate() {
                 if ring.alive[i] {
-                    idx[i] = pts.len();
+                    *slot = pts.len();
                     pts.push(ring.pts[i]);
                     edges.push(p.border_edges[r][i]);
                     faces.push(p.border_faces[r][i]);
@@ -438,7 +442,7 @@ fn collapsible(
         if inside(u) || inside(w) {
             return false;
         }
-        let touches = |x: DVec2| x.distance(a) < 1e-9 || x.distance(b) < 1e-9;
+        let touches = |x: DVec2| x.distance(a) < SAME_MM || x.distance(b) < SAME_MM;
         if !touches(u) && !touches(w) && polygon::segments_intersect(a, b, u, w) {
             return false;
         }
