@@ -125,8 +125,24 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
                 assert!(polygon::is_simple_ring(r1), "{} crosses itself", p1.name);
             }
         }
-        // No fold line crosses the simplified border (they meet only at fold ends).
-        for f in p1.folds.iter().filter(|f| !f.tab) {
+        // No fold line crosses the simplified border (they meet only at fold ends) unless it
+        // already crossed the unsimplified one.
+        let crosses = |rings: &[Vec<DVec2>], f: &flatcut::pattern::Fold| {
+            rings.iter().any(|r| {
+                (0..r.len()).any(|i| {
+                    let (a, b) = (r[i], r[(i + 1) % r.len()]);
+                    let touch = [f.a, f.b]
+                        .iter()
+                        .any(|q| polygon::segment_distance(*q, a, b) < 1e-6);
+                    !touch && polygon::segments_intersect(a, b, f.a, f.b)
+                })
+            })
+        };
+        for f in p1
+            .folds
+            .iter()
+            .filter(|f| !f.tab && !crosses(&p0.border, f))
+        {
             for r in &p1.border {
                 for i in 0..r.len() {
                     let (a, b) = (r[i], r[(i + 1) % r.len()]);
