@@ -12,7 +12,8 @@
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
 //! name = "box"             # optional; default: the mesh file stem
 //! segment = "dcharts"      # optional: "faces" | "dcharts" (smooth meshes, issue 7); see
-//!                          # `SegmentSpec` for this and `charts`, `f_max`, `approximate`
+//!                          # `SegmentSpec` for this and `charts`, `f_max`, `approximate`,
+//!                          # `simplify`
 //!
 //! [material]               # optional table
 //! kind = "paper"           # "paper" | "fabric" | "metal"; default paper
@@ -650,6 +651,7 @@ struct RawSurface {
     charts: Option<Spanned<Val>>,
     f_max: Option<Spanned<Val>>,
     approximate: Option<Spanned<toml::Value>>,
+    simplify: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -1274,7 +1276,8 @@ impl Ctx<'_> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Smooth meshes (issue 7): `segment`, `charts`, `f_max`, `approximate` on `kind = "mesh"`
+// Smooth meshes (issue 7): `segment`, `charts`, `f_max`, `approximate`, `simplify` on
+// `kind = "mesh"`
 // ---------------------------------------------------------------------------------------------
 
 /// How a mesh surface is cut into pieces (`kind = "mesh"` keys, issue 7):
@@ -1287,6 +1290,9 @@ impl Ctx<'_> {
 /// f_max = 0.2              # D-Charts fitting threshold, > 0 and <= 1
 /// approximate = { iterations = 1, fixed = ["boundary", 12] }   # DCS approximation first;
 ///                          # fixed: "boundary" and/or 1-based vertex numbers of the mesh
+/// simplify = 0.5           # mm >= 0: largest deviation of a simplified seam between charts
+///                          # (thesis §5.3, `pattern::simplify`); 0: off; default by material
+///                          # (paper and fabric 0.5, metal 0.1); exact unfoldings never change
 /// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SegmentSpec {
@@ -1295,6 +1301,8 @@ pub struct SegmentSpec {
     pub charts: Option<usize>,
     pub f_max: Option<f64>,
     pub approximate: Option<ApproximateSpec>,
+    /// Seam simplification tolerance (mm); `None`: the material's default.
+    pub simplify: Option<f64>,
 }
 
 /// `segment = "faces" | "dcharts"`.
@@ -1360,11 +1368,20 @@ impl Ctx<'_> {
             None => None,
             Some(v) => Some(self.approximate(v, &format!("{key}.approximate"))?),
         };
+        let simplify = self
+            .number(
+                &s.simplify,
+                &format!("{key}.simplify"),
+                "a tolerance in mm, at least 0 (0: no simplification)",
+                |v| v >= 0.0,
+            )?
+            .map(|(v, _)| v);
         Ok(SegmentSpec {
             mode,
             charts,
             f_max,
             approximate,
+            simplify,
         })
     }
 
@@ -1482,6 +1499,7 @@ impl Ctx<'_> {
                 ("charts", span(&s.charts)),
                 ("f_max", span(&s.f_max)),
                 ("approximate", span(&s.approximate)),
+                ("simplify", span(&s.simplify)),
             ],
             "is for mesh surfaces; a strip takes the curves `p` and `q`",
         )?;

@@ -7,7 +7,11 @@
 //! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
 //! it measured some) and the files written. Pieces and surfaces laid out from charts of a
 //! smooth mesh (issue 7) carry `stretch`: `{l2, linf, flipped}` (1 = isometric); it is `null`
-//! for exact unfoldings.
+//! for exact unfoldings. Those whose seams were simplified (thesis §5.3) also carry `simplify`:
+//! `{tolerance_mm, vertices_before, vertices_after, max_deviation_mm, max_seam_mismatch_mm}`
+//! (border vertices of all its rings; the largest distance of an original border vertex from
+//! the simplified border; the largest length difference between the two sides of one of its
+//! seams); exact unfoldings have no such key.
 //!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
 //! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
@@ -49,7 +53,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             let pts: Vec<_> = p.outline.iter().flatten().map(|q| at.apply(*q)).collect();
             let (lo, hi) = crate::geom::polygon::bounds(pts).unwrap_or_default();
             let count = |k| p.folds.iter().filter(|f| f.kind == k && !f.tab).count();
-            json!({
+            let mut v = json!({
                 "id": p.id,
                 "name": p.name,
                 "surface": p.surface,
@@ -75,7 +79,19 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "offset_mm": [r6(at.offset.x), r6(at.offset.y)],
                 "bbox_mm": [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)],
                 "stretch": piece_stretch(flats, p),
-            })
+            });
+            // Seams simplified (D-Charts pieces, thesis §5.3): only there, so that the report
+            // of an exact unfolding stays as it was.
+            if let Some(s) = &p.simplified {
+                v["simplify"] = json!({
+                    "tolerance_mm": r6(s.tolerance),
+                    "vertices_before": s.vertices_before,
+                    "vertices_after": s.vertices_after,
+                    "max_deviation_mm": r6(s.max_deviation),
+                    "max_seam_mismatch_mm": r6(s.max_seam_mismatch),
+                });
+            }
+            v
         })
         .collect();
     let sheets: Vec<Value> = layout

@@ -77,8 +77,9 @@ pub struct SeamSide {
     pub tab: bool,
 }
 
-/// Finds the seams of one flat's pieces, writes their ids and places their notches.
-pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts: &PatternOptions) {
+/// Finds the seams of one flat's pieces: each piece gets its side of every seam it has, in
+/// seam order, without notches (see [`place`]).
+pub(super) fn find(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize) {
     // Where each cut mesh edge lies on the borders: (piece, ring, segment).
     type Loc = (usize, usize, usize);
     let mut at: HashMap<usize, Vec<Loc>> = HashMap::new();
@@ -188,31 +189,77 @@ pub(super) fn seams(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize, opts
                 tab: false,
             }
         };
-        let mut sa = side(a, true, pieces[b.0].id);
-        let mut sb = side(b, false, pieces[a.0].id);
-        if let Some(spacing) = opts.notches {
-            let at_a = notch_positions(sa.length, spacing);
-            // Side B runs the chain backwards, segment for segment (each segment is one mesh
-            // edge); a notch goes at the same fraction of the same edge on both sides, which
-            // holds even where the two flat copies differ by the unfolding's tolerance.
-            sb.notches = at_a
-                .iter()
-                .rev()
-                .map(|&s| {
-                    let (k, t) = segment_at(&sa.points, s);
-                    arc_at(&sb.points, count - 1 - k, 1.0 - t)
-                })
-                .collect();
-            sa.notches = at_a;
-        }
-        for (l, s) in [(a, sa), (b, sb)] {
-            let p = &mut pieces[l.0];
-            if let Some(m) = id_mark(flat, p, &s) {
-                p.marks.push(m);
+        let sa = side(a, true, pieces[b.0].id);
+        let sb = side(b, false, pieces[a.0].id);
+        pieces[a.0].seams.push(sa);
+        pieces[b.0].seams.push(sb);
+    }
+}
+
+/// Both sides of every seam of these pieces, as (piece index, seam index) of side A and of
+/// side B, in seam order. A side without its partner is left out.
+pub(super) fn pairs(pieces: &[Piece]) -> Vec<[(usize, usize); 2]> {
+    let mut a: Vec<(usize, (usize, usize))> = Vec::new();
+    let mut b: HashMap<usize, (usize, usize)> = HashMap::new();
+    for (pi, p) in pieces.iter().enumerate() {
+        for (si, s) in p.seams.iter().enumerate() {
+            if s.is_a {
+                a.push((s.id, (pi, si)));
+            } else {
+                b.insert(s.id, (pi, si));
             }
-            p.seams.push(s);
         }
     }
+    a.sort_by_key(|x| x.0);
+    a.into_iter()
+        .filter_map(|(id, sa)| b.get(&id).map(|&sb| [sa, sb]))
+        .collect()
+}
+
+/// Places the notches of every seam found by [`find`] and writes its id along both sides.
+/// `by_arc`: put side B's notches at the same fraction of the whole side as side A's (chains
+/// simplified by [`super::simplify`], whose two sides may differ in length by a little);
+/// otherwise at the same fraction of the same mesh edge.
+pub(super) fn place(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions, by_arc: bool) {
+    for [(pa, ia), (pb, ib)] in pairs(pieces) {
+        if let Some(spacing) = opts.notches {
+            let (sa, sb) = (&pieces[pa].seams[ia], &pieces[pb].seams[ib]);
+            let at_a = notch_positions(sa.length, spacing);
+            let count = sa.count;
+            let at_b: Vec<f64> = if by_arc {
+                let (la, lb) = (polyline_length(&sa.points), polyline_length(&sb.points));
+                at_a.iter()
+                    .rev()
+                    .map(|&s| if la > 0.0 { (1.0 - s / la) * lb } else { 0.0 })
+                    .collect()
+            } else {
+                // Side B runs the chain backwards, segment for segment (each segment is one
+                // mesh edge); a notch goes at the same fraction of the same edge on both
+                // sides, which holds even where the two flat copies differ by the
+                // unfolding's tolerance.
+                at_a.iter()
+                    .rev()
+                    .map(|&s| {
+                        let (k, t) = segment_at(&sa.points, s);
+                        arc_at(&sb.points, count - 1 - k, 1.0 - t)
+                    })
+                    .collect()
+            };
+            pieces[pa].seams[ia].notches = at_a;
+            pieces[pb].seams[ib].notches = at_b;
+        }
+        for (pi, si) in [(pa, ia), (pb, ib)] {
+            let p = &pieces[pi];
+            if let Some(m) = id_mark(flat, p, &p.seams[si]) {
+                pieces[pi].marks.push(m);
+            }
+        }
+    }
+}
+
+/// Length of an open polyline (mm).
+pub fn polyline_length(points: &[DVec2]) -> f64 {
+    points.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
 /// Arc lengths of the notches along a seam of length `len` from side A's start.

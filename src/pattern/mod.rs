@@ -3,7 +3,9 @@
 //! (mountain or valley, with the angle), seams with the same id written on both sides and
 //! notches at equal arc lengths ([`marks`]), a label naming the piece and the side that faces
 //! up, a grain line for fabric, bend notes for metal, and the material's finishing: glue tabs
-//! for paper, seam allowance for fabric, kerf compensation ([`allowance`]).
+//! for paper, seam allowance for fabric, kerf compensation ([`allowance`]). Pieces laid out
+//! from D-Charts have the seams between them simplified first ([`simplify`], thesis §5.3):
+//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge.
 //!
 //! Conventions: pieces are drawn as seen from the printed side, which is the outside of a
 //! closed mesh; a convex edge therefore folds away from the viewer and is a mountain fold, a
@@ -27,6 +29,7 @@ use serde::Serialize;
 
 pub mod allowance;
 pub mod marks;
+pub mod simplify;
 
 pub use marks::{SeamSide, Text};
 
@@ -80,6 +83,13 @@ pub struct PatternOptions {
     pub bend_notches: bool,
     /// Draw a grain-line arrow (and keep the grain along the roll when nesting).
     pub grain: bool,
+    /// Largest deviation (mm) of a simplified seam from its original chain, for pieces laid
+    /// out from D-Charts ([`simplify`], thesis §5.3); 0 leaves them as they are. Other pieces
+    /// (exact unfoldings) are never simplified. Default: 0 in the bare net, 0.5 mm for paper
+    /// and fabric, 0.1 mm for metal ([`PatternOptions::for_material`]).
+    pub simplify: f64,
+    /// The spec's `simplify` of single surfaces, by surface name, over [`Self::simplify`].
+    pub simplify_surfaces: Vec<(String, f64)>,
 }
 
 impl Default for PatternOptions {
@@ -98,16 +108,24 @@ impl Default for PatternOptions {
             bend_notes: false,
             bend_notches: false,
             grain: false,
+            simplify: 0.0,
+            simplify_surfaces: Vec::new(),
         }
     }
 }
 
 impl PatternOptions {
     /// Defaults of a material: paper gets glue tabs on one side of each seam; fabric a 10 mm
-    /// seam allowance, notches every 50 mm and a grain line; metal its bend notes.
+    /// seam allowance, notches every 50 mm and a grain line; metal its bend notes. Seams of
+    /// D-Charts pieces are simplified within 0.5 mm on paper and fabric (about what a knife,
+    /// scissors or a sewing line follow anyway), 0.1 mm on metal.
     pub fn for_material(kind: MaterialKind) -> Self {
         let bare = PatternOptions {
             material: kind,
+            simplify: match kind {
+                MaterialKind::Metal => 0.1,
+                _ => 0.5,
+            },
             ..PatternOptions::default()
         };
         match kind {
@@ -153,7 +171,20 @@ impl PatternOptions {
         if let Some(b) = p.bend_notches {
             o.bend_notches = b;
         }
+        o.simplify_surfaces = spec
+            .surfaces
+            .iter()
+            .filter_map(|s| s.segment.simplify.map(|t| (s.name.clone(), t)))
+            .collect();
         o
+    }
+
+    /// The simplification tolerance (mm) for a surface: its own, else the default.
+    pub fn simplify_for(&self, surface: &str) -> f64 {
+        self.simplify_surfaces
+            .iter()
+            .find(|(n, _)| n == surface)
+            .map_or(self.simplify, |(_, t)| *t)
     }
 }
 
@@ -243,6 +274,8 @@ pub struct Piece {
     /// Direction of the grain line in the piece's frame (radians from +x), for materials with
     /// a grain (fabric). The nest stage keeps it parallel to the roll (sheet y axis), either way.
     pub grain: Option<f64>,
+    /// What simplifying its seams did ([`simplify`]); `None` when they were not simplified.
+    pub simplified: Option<simplify::Simplified>,
 }
 
 impl Piece {
@@ -269,6 +302,7 @@ impl Piece {
             grain_line: Vec::new(),
             label: Text::default(),
             grain: None,
+            simplified: None,
         }
     }
 
@@ -320,7 +354,15 @@ pub fn build(flats: &[Flat], opts: &PatternOptions) -> Result<Vec<Piece>, Patter
             pieces.push(net(flat, faces, id, name, opts)?);
         }
         let mine = &mut pieces[first..];
-        marks::seams(flat, mine, &mut next_seam, opts);
+        marks::find(flat, mine, &mut next_seam);
+        // Chart boundaries zig-zag along mesh edges: simplified (thesis §5.3) before any mark
+        // is placed on them. Exact unfoldings keep their borders.
+        let tolerance = opts.simplify_for(&flat.surface.name);
+        let simplified = flat.surface.charts.is_some() && tolerance > 0.0;
+        if simplified {
+            simplify::apply(mine, tolerance);
+        }
+        marks::place(flat, mine, opts, simplified);
         for p in mine.iter_mut() {
             marks::finish(flat, p, opts);
         }
