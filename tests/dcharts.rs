@@ -162,6 +162,18 @@ fn mushroom_charts_and_stretch() {
     assert_eq!(s.flipped, 0);
 }
 
+/// Two triangles `a b c`, `a c d` of the quad `a b c d`.
+fn push_quad(faces: &mut Vec<Face>, [a, b, c, d]: [usize; 4]) {
+    faces.push(Face {
+        verts: vec![a, b, c],
+        line: None,
+    });
+    faces.push(Face {
+        verts: vec![a, c, d],
+        line: None,
+    });
+}
+
 /// A truncated cone of `rings` × `n` planar trapezoids, each split in two triangles.
 fn frustum(r0: f64, r1: f64, h: f64, n: usize, rings: usize) -> Mesh {
     let mut vertices = Vec::new();
@@ -179,14 +191,7 @@ fn frustum(r0: f64, r1: f64, h: f64, n: usize, rings: usize) -> Mesh {
             let a = k * n + i;
             let b = k * n + (i + 1) % n;
             let (c, d) = (b + n, a + n);
-            faces.push(Face {
-                verts: vec![a, b, c],
-                line: None,
-            });
-            faces.push(Face {
-                verts: vec![a, c, d],
-                line: None,
-            });
+            push_quad(&mut faces, [a, b, c, d]);
         }
     }
     Mesh { vertices, faces }
@@ -367,17 +372,8 @@ fn cap(r: f64, deg: f64, n: usize, rings: usize) -> Mesh {
             let (a, b) = (o + i, o + (i + 1) % n);
             let (c, d) = (p + i, p + (i + 1) % n);
             if k % 2 == 1 {
-                faces.push(Face {
-                    verts: vec![a, c, d],
-                    line: None,
-                });
-                faces.push(Face {
-                    verts: vec![a, d, b],
-                    line: None,
-                });
+                push_quad(&mut faces, [a, c, d, b]);
             } else {
-                let cm = p + (i + n - 1) % n;
-                let _ = cm;
                 faces.push(Face {
                     verts: vec![a, c, b],
                     line: None,
@@ -757,14 +753,7 @@ fn torus(big: f64, small: f64, n: usize, m: usize) -> Mesh {
     for i in 0..n {
         for j in 0..m {
             let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            faces.push(Face {
-                verts: vec![a, b, c],
-                line: None,
-            });
-            faces.push(Face {
-                verts: vec![a, c, d],
-                line: None,
-            });
+            push_quad(&mut faces, [a, b, c, d]);
         }
     }
     Mesh { vertices, faces }
@@ -809,14 +798,7 @@ fn genus_two(cell: f64) -> Mesh {
                     .iter()
                     .map(|c| vid([x + c[0], y + c[1], c[2]], &mut vertices))
                     .collect();
-                faces.push(Face {
-                    verts: vec![v[0], v[1], v[2]],
-                    line: None,
-                });
-                faces.push(Face {
-                    verts: vec![v[0], v[2], v[3]],
-                    line: None,
-                });
+                push_quad(&mut faces, [v[0], v[1], v[2], v[3]]);
             }
         }
     }
@@ -1053,14 +1035,7 @@ fn saddle(half: f64, c: f64, n: usize) -> Mesh {
     for i in 0..n {
         for j in 0..n {
             let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            faces.push(Face {
-                verts: vec![a, b, c],
-                line: None,
-            });
-            faces.push(Face {
-                verts: vec![a, c, d],
-                line: None,
-            });
+            push_quad(&mut faces, [a, b, c, d]);
         }
     }
     Mesh { vertices, faces }
