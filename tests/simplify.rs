@@ -92,6 +92,7 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
     let mut max_mismatch = 0.0f64;
     let mut max_mismatch_before = 0.0f64;
     let mut max_growth = 0.0f64;
+    let mut min_id_mean = f64::INFINITY;
     for (p0, p1) in plain.iter().zip(&simple) {
         assert!(p0.simplified.is_none());
         let s = p1.simplified.expect("simplified");
@@ -167,6 +168,42 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
                 p1.name
             );
         }
+        // Seam ids: inside the piece, and no smaller than on the unsimplified piece (a
+        // simplified segment stands for several mesh edges; the room beside it is measured in
+        // the piece, not taken from its first face).
+        let id_heights = |p: &Piece| -> Vec<f64> {
+            p.marks
+                .iter()
+                .map(|m| {
+                    let up = m.text.dir.map_or(DVec2::Y, |d| d.perp());
+                    let h = m.text.strokes.iter().flatten().map(|q| q.dot(up));
+                    let (lo, hi) = h.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), v| {
+                        (l.min(v), u.max(v))
+                    });
+                    (hi - lo).max(0.0)
+                })
+                .collect()
+        };
+        for m in &p1.marks {
+            for q in m.text.strokes.iter().flatten() {
+                assert!(
+                    polygon::contains_rings(&p1.border, *q),
+                    "{}: seam id {} sticks out at {q}",
+                    p1.name,
+                    m.id
+                );
+            }
+        }
+        let (h0, h1) = (id_heights(p0), id_heights(p1));
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+        min_id_mean = min_id_mean.min(mean(&h1));
+        assert!(
+            mean(&h1) >= mean(&h0) - 1e-9,
+            "{}: seam ids {:.2} mm high on average, {:.2} before simplifying",
+            p1.name,
+            mean(&h1),
+            mean(&h0)
+        );
         // Still the same side up, holes still inside the outer ring.
         assert!(polygon::signed_area(&p1.border[0]) > 0.0);
         for h in &p1.border[1..] {
@@ -231,7 +268,7 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
         }
     }
     println!(
-        "{name}: {} pieces, {} seams, outline vertices {before} -> {after} ({:.0} %), max deviation {max_dev:.4} mm (tolerance {tol}), seam length mismatch max {max_mismatch:.4} mm (before {max_mismatch_before:.4}; largest growth on one seam {max_growth:.4}), {notches} notch pairs",
+        "{name}: {} pieces, {} seams, outline vertices {before} -> {after} ({:.0} %), max deviation {max_dev:.4} mm (tolerance {tol}), seam length mismatch max {max_mismatch:.4} mm (before {max_mismatch_before:.4}; largest growth on one seam {max_growth:.4}), {notches} notch pairs, seam ids at least {min_id_mean:.2} mm high on average per piece",
         simple.len(),
         pairs1.len(),
         100.0 * after as f64 / before as f64

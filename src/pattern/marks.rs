@@ -292,14 +292,74 @@ fn id_mark(flat: &Flat, p: &Piece, s: &SeamSide) -> Option<EdgeMark> {
     })?;
     let (a, b) = (p.border[s.ring][k], p.border[s.ring][(k + 1) % n]);
     let f = p.border_faces[s.ring][k];
-    let depth = 2.0 * flat.surface.mesh.face_area(f) / a.distance(b).max(f64::MIN_POSITIVE);
+    let face_depth = 2.0 * flat.surface.mesh.face_area(f) / a.distance(b).max(f64::MIN_POSITIVE);
+    let mut text = edge_text(&s.id.to_string(), a, b, face_depth, 3.0);
+    if p.simplified.is_some() {
+        // A simplified side's segment may stand for many mesh edges, so its first face says
+        // little about the room beside it: the room is measured in the piece itself, and the
+        // text made smaller until it lies inside the piece.
+        let mut depth = room_inward(p, s.ring, k).max(face_depth);
+        for _ in 0..8 {
+            let t = edge_text(&s.id.to_string(), a, b, depth, 3.0);
+            if t.points().all(|q| polygon::contains_rings(&p.border, q)) {
+                text = t;
+                break;
+            }
+            depth *= 0.7;
+        }
+    }
     Some(EdgeMark {
         id: s.id,
         edge: p.border_edges[s.ring][k],
         a,
         b,
-        text: edge_text(&s.id.to_string(), a, b, depth, 3.0),
+        text,
     })
+}
+
+/// How far the piece reaches inward (to the left) from border segment `k` of ring `ring`:
+/// the least distance, from nine points along the segment's middle, to the first other border
+/// segment or fold line met going straight in.
+fn room_inward(p: &Piece, ring: usize, k: usize) -> f64 {
+    let r = &p.border[ring];
+    let (a, b) = (r[k], r[(k + 1) % r.len()]);
+    let len = a.distance(b);
+    if len.is_nan() || len <= 0.0 {
+        return 0.0;
+    }
+    let inward = ((b - a) / len).perp();
+    let mut obstacles: Vec<(DVec2, DVec2)> = Vec::new();
+    for (ri, rr) in p.border.iter().enumerate() {
+        for j in 0..rr.len() {
+            if ri != ring || j != k {
+                obstacles.push((rr[j], rr[(j + 1) % rr.len()]));
+            }
+        }
+    }
+    obstacles.extend(p.folds.iter().filter(|f| !f.tab).map(|f| (f.a, f.b)));
+    let mut room = f64::INFINITY;
+    for i in 1..=9 {
+        let q = a.lerp(b, 0.1 * i as f64);
+        for &(c, d) in &obstacles {
+            // q + t·inward = c + u·(d − c), t > 0, u in [0, 1].
+            let e = d - c;
+            let den = inward.perp_dot(e);
+            if den.abs() < 1e-12 {
+                continue;
+            }
+            let w = c - q;
+            let t = w.perp_dot(e) / den;
+            let u = w.perp_dot(inward) / den;
+            if t > 1e-9 && (-1e-12..=1.0 + 1e-12).contains(&u) {
+                room = room.min(t);
+            }
+        }
+    }
+    if room.is_finite() {
+        room
+    } else {
+        0.0
+    }
 }
 
 /// Label, grain line, bend notes and notch strokes of a piece whose seams are known.

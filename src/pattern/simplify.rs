@@ -54,9 +54,15 @@ pub const MISMATCH_MM: f64 = 0.1;
 /// Least distance (mm) between a new segment and the rest of the piece's border.
 const CLEARANCE_MM: f64 = 2.0 * super::allowance::CLEAN_MM;
 
-/// Two 2D copies of one mesh vertex (a fold's end, a border point) closer than this (mm) are
-/// the same point: charts agree on shared vertices to about 1e-9 relative, not exactly.
+/// Two 2D copies of one mesh vertex (a fold's end, a border point) closer than this (mm), or
+/// than 1e-8 of their distance from the origin on large pieces, are the same point: charts
+/// agree on shared vertices to about 1e-9 relative, not exactly.
 const SAME_MM: f64 = 1e-6;
+
+/// Whether `x` and `q` are copies of one vertex (see [`SAME_MM`]).
+fn same(x: DVec2, q: DVec2) -> bool {
+    x.distance(q) < SAME_MM.max(1e-8 * x.length().max(q.length()))
+}
 
 /// Sharpest corner (radians) a collapse may make where the chord meets the border next to it.
 const SPIKE_RAD: f64 = 0.05;
@@ -176,9 +182,7 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
             let b = (pb, sb.ring, (sb.first + sb.count - i) % nb);
             let on_fold = [a, b].iter().any(|&(p, r, j)| {
                 let q = rings[p][r].pts[j];
-                folds[p]
-                    .iter()
-                    .any(|&(u, v)| u.distance(q) < SAME_MM || v.distance(q) < SAME_MM)
+                folds[p].iter().any(|&(u, v)| same(u, q) || same(v, q))
             });
             if on_fold || cand_at[a.0][a.1][a.2].is_some() || cand_at[b.0][b.1][b.2].is_some() {
                 continue;
@@ -442,7 +446,7 @@ fn collapsible(
         if inside(u) || inside(w) {
             return false;
         }
-        let touches = |x: DVec2| x.distance(a) < SAME_MM || x.distance(b) < SAME_MM;
+        let touches = |x: DVec2| same(x, a) || same(x, b);
         if !touches(u) && !touches(w) && polygon::segments_intersect(a, b, u, w) {
             return false;
         }
