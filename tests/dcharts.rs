@@ -371,17 +371,11 @@ fn cap(r: f64, deg: f64, n: usize, rings: usize) -> Mesh {
         for i in 0..n {
             let (a, b) = (o + i, o + (i + 1) % n);
             let (c, d) = (p + i, p + (i + 1) % n);
+            // Alternate rings split their quads along the other diagonal.
             if k % 2 == 1 {
                 push_quad(&mut faces, [a, c, d, b]);
             } else {
-                faces.push(Face {
-                    verts: vec![a, c, b],
-                    line: None,
-                });
-                faces.push(Face {
-                    verts: vec![b, c, d],
-                    line: None,
-                });
+                push_quad(&mut faces, [b, a, c, d]);
             }
         }
     }
