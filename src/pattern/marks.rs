@@ -293,21 +293,21 @@ fn id_mark(flat: &Flat, p: &Piece, s: &SeamSide) -> Option<EdgeMark> {
     let (a, b) = (p.border[s.ring][k], p.border[s.ring][(k + 1) % n]);
     let f = p.border_faces[s.ring][k];
     let face_depth = 2.0 * flat.surface.mesh.face_area(f) / a.distance(b).max(f64::MIN_POSITIVE);
-    let mut text = edge_text(&s.id.to_string(), a, b, face_depth, 3.0);
-    if p.simplified.is_some() {
+    let id = s.id.to_string();
+    let face_text = || edge_text(&id, a, b, face_depth, 3.0);
+    let text = if p.simplified.is_some() {
         // A simplified side's segment may stand for many mesh edges, so its first face says
         // little about the room beside it: the room is measured in the piece itself, and the
         // text made smaller until it lies inside the piece.
-        let mut depth = room_inward(p, s.ring, k).max(face_depth);
-        for _ in 0..8 {
-            let t = edge_text(&s.id.to_string(), a, b, depth, 3.0);
-            if t.points().all(|q| polygon::contains_rings(&p.border, q)) {
-                text = t;
-                break;
-            }
-            depth *= 0.7;
-        }
-    }
+        let room = room_inward(p, s.ring, k).max(face_depth);
+        std::iter::successors(Some(room), |d| Some(d * 0.7))
+            .take(8)
+            .map(|d| edge_text(&id, a, b, d, 3.0))
+            .find(|t| t.points().all(|q| polygon::contains_rings(&p.border, q)))
+            .unwrap_or_else(face_text)
+    } else {
+        face_text()
+    };
     Some(EdgeMark {
         id: s.id,
         edge: p.border_edges[s.ring][k],
