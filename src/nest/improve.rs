@@ -16,8 +16,9 @@
 //! guided local search escapes the local minima that plain overlap minimisation sticks in.
 //! A run of sweeps ends after 25 sweeps without a new least overlap (one at least 2 % lower
 //! restarts the count) and is a strike unless it lowered the overlap by 2 %; the least
-//! overlapping layout is restored, weights kept, and after 3 strikes in a row (2 in
-//! compression) the separator gives up; zero overlap is a feasible layout.
+//! overlapping layout is restored, weights kept, and after 3 strikes in a row the separator
+//! gives up (in compression: 5 strikes of 100 sweeps, as sparrow); zero overlap is a feasible
+//! layout.
 //!
 //! **Strip** ([`optimise_strip`]): exploration (90 % of the budget, as in sparrow), then
 //! compression. Exploration shrinks the best feasible strip by 0.1 % by cutting a slice out at
@@ -26,9 +27,9 @@
 //! the next try is drawn from the pool (index `|N(0, 0.25)|` × pool size, so the least
 //! overlapping most often) and disrupted: two large items of different shapes swap places, and
 //! items lying under a swapped item's new place move into the room it left (sparrow).
-//! Compression shrinks the best by small random ratios (between 0.001 % and a bound that falls
-//! from 0.05 % to 0.001 % over the phase) with a shorter separator. Only feasible layouts are
-//! kept, so stopping at any time returns a valid layout.
+//! Compression shrinks the best by a ratio that falls linearly from 0.05 % to 0.001 % over the
+//! phase, at a random x, and separates more patiently (sparrow's compression). Only feasible
+//! layouts are kept, so stopping at any time returns a valid layout.
 //!
 //! **Bins** ([`optimise_bins`]): the items of the last bin are moved one by one into earlier
 //! bins (bottom-left if there is room, else inserted and separated); a bin that empties is
@@ -44,14 +45,24 @@
 //! side count as one; weights persist across strikes within one separation and start at 1.
 //! Tuned on albano at 60 s (four seeds, one thread): patience 10 / 25 / 50 / 100 gave 87.76 /
 //! 88.16 / 88.12 / 88.05 %; a 95 % exploration share 88.31 %. Tried since and not kept (two
-//! threads, seeds 1–6 unless said, mean): as it is, 88.89 % (88.37–89.50); halving the
-//! exploration shrink after 25 failures in a row at one length, 88.89 % (88.40–89.18; after 10
-//! failures, seeds 1–3: 88.57 %); a 50 % exploration share, 88.84 % (30 %, seeds 1–3: 88.69 %);
-//! seeds 1–3 against 88.74 % as it is: 16 poles per item 88.46 %, more poles where they cover
-//! less than 90 % 88.37 %, sideways moves in the coordinate descent 88.42 %, sparrow's factor
-//! π on the pole sum 88.57 %. The spread between seeds (about ±0.4) is larger than any of
-//! these differences. A trace shows why: a run finds most of its length in a few lucky
-//! separations and stays at one length for long stretches, in exploration and compression.
+//! threads, seeds 1–6 unless said, mean), against 88.89 % (88.37–89.50) before sparrow's
+//! compression: halving the exploration shrink after 25 failures in a row at one length,
+//! 88.89 % (after 10 failures, seeds 1–3: 88.57 %); a 50 % exploration share, 88.84 % (30 %,
+//! seeds 1–3: 88.69 %); seeds 1–3 against 88.74 %: 16 poles per item 88.46 %, more poles
+//! where they cover less than 90 % 88.37 %, sideways moves in the coordinate descent 88.42 %,
+//! sparrow's factor π on the pole sum 88.57 %. Sparrow's compression (a ratio falling with
+//! the budget instead of a random one below it; 5 strikes of 100 sweeps instead of 2 of 25)
+//! gave 89.03 % (88.32–89.50) and is kept. With it, not kept: the exploration cut at the
+//! middle of the strip, as sparrow cuts, 88.24 % (seeds 1–3); one try in four a fresh cut of
+//! the best instead of a draw from the pool, 88.43 % (seeds 1–4); the two searches handing
+//! each other the shorter layout at three points of the budget, 88.98 %; an 80 % exploration
+//! share, 89.00 %; sparrow's large items (the largest that make up 75 % of the area),
+//! 88.65 %; 25 container samples 88.47 % (100, seed 1: 87.96 %); three workers per sweep in
+//! one thread, the best kept, 88.20 % (seeds 1–3); exploration patience 50, 88.57 %.
+//! The spread between seeds (about ±0.4) is larger than most of these differences. A trace
+//! shows why: a run finds its length in bursts (after one lucky separation, the next two or
+//! three shrinks succeed at once) and stays at one length for up to a third of the budget
+//! between them.
 
 use super::engine::{boxes_near, collide, in_material, overlap_proxy, Placed};
 use super::problem::{Container, Ctx, State};
@@ -68,6 +79,9 @@ const POOL: usize = 64;
 const EXPLORE_SHARE: f64 = 0.9;
 /// Exploration shrinks the strip by this ratio after each success (sparrow's 0.1 %).
 const EXPLORE_STEP: f64 = 0.001;
+/// The compression separator's strikes and patience (sparrow's).
+const COMPRESS_STRIKES: usize = 5;
+const COMPRESS_PATIENCE: usize = 100;
 
 /// Pair overlaps and weights of one state.
 struct Sep {
@@ -468,19 +482,18 @@ pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
             cur = Some((next, len));
         }
     }
-    // Compression: small random shrinks of the best, kept when they separate; the largest
-    // ratio falls from 0.05 % to 0.001 % over the phase.
+    // Compression: small shrinks of the best, kept when they separate; the ratio falls from
+    // 0.05 % to 0.001 % over the phase.
     let (hi0, lo0) = (0.0005, 0.00001);
     let start = ctx.progress();
     while !ctx.done() && best_len > lower * (1.0 + 1e-6) {
         let t = ((ctx.progress() - start) / (1.0 - start).max(1e-9)).clamp(0.0, 1.0);
-        let hi = hi0 + (lo0 - hi0) * t;
-        let r = ctx.rng.range(lo0.min(hi), hi);
+        let r = hi0 + (lo0 - hi0) * t;
         let new_len = (best_len * (1.0 - r)).max(lower);
         let Some(mut cand) = shrink(ctx, &best, best_len, new_len) else {
             break;
         };
-        if separate(ctx, &mut cand, new_len, 2, 25) == 0.0 {
+        if separate(ctx, &mut cand, new_len, COMPRESS_STRIKES, COMPRESS_PATIENCE) == 0.0 {
             best_len = cand.extent().min(new_len);
             best = cand;
         }
