@@ -48,17 +48,18 @@
 //! threads, seeds 1–6 unless said, mean), against 88.89 % (88.37–89.50) before sparrow's
 //! compression: halving the exploration shrink after 25 failures in a row at one length,
 //! 88.89 % (after 10 failures, seeds 1–3: 88.57 %); a 50 % exploration share, 88.84 % (30 %,
-//! seeds 1–3: 88.69 %); seeds 1–3 against 88.74 %: 16 poles per item 88.46 %, more poles
-//! where they cover less than 90 % 88.37 %, sideways moves in the coordinate descent 88.42 %,
-//! sparrow's factor π on the pole sum 88.57 %. Sparrow's compression (a ratio falling with
-//! the budget instead of a random one below it; 5 strikes of 100 sweeps instead of 2 of 25)
-//! gave 89.03 % (88.32–89.50) and is kept. With it, not kept: the exploration cut at the
-//! middle of the strip, as sparrow cuts, 88.24 % (seeds 1–3); one try in four a fresh cut of
-//! the best instead of a draw from the pool, 88.43 % (seeds 1–4); the two searches handing
-//! each other the shorter layout at three points of the budget, 88.98 %; an 80 % exploration
-//! share, 89.00 %; sparrow's large items (the largest that make up 75 % of the area),
-//! 88.65 %; 25 container samples 88.47 % (100, seed 1: 87.96 %); three workers per sweep in
-//! one thread, the best kept, 88.20 % (seeds 1–3); exploration patience 50, 88.57 %.
+//! seeds 1–3: 88.69 %); one try in four a fresh cut of the best instead of a draw from the
+//! pool, 88.43 % (seeds 1–4); seeds 1–3 against 88.74 %: 16 poles per item 88.46 %, more
+//! poles where they cover less than 90 % 88.37 %, sideways moves in the coordinate descent
+//! 88.42 %, sparrow's factor π on the pole sum 88.57 %, the exploration cut at the middle of
+//! the strip (as sparrow cuts) 88.24 %. Sparrow's compression (a ratio falling with the budget
+//! instead of a random one below it; 5 strikes of 100 sweeps instead of 2 of 25) gave 89.03 %
+//! (88.32–89.50) and is kept. With it, not kept: the two searches handing each other the
+//! shorter layout at three points of the budget, 88.98 %; an 80 % exploration share,
+//! 89.00 %; sparrow's large items (the largest that make up 75 % of the area), 88.65 %; 25
+//! container samples 88.47 % (100, seed 1: 87.96 %); three workers per sweep in one thread,
+//! the best kept, 88.20 % (seeds 1–3); exploration patience 50, 88.57 %; 4 strikes in
+//! exploration 88.32 % (2, seeds 1–4: 88.58 %).
 //! The spread between seeds (about ±0.4) is larger than most of these differences. A trace
 //! shows why: a run finds its length in bursts (after one lucky separation, the next two or
 //! three shrinks succeed at once) and stays at one length for up to a third of the budget
