@@ -17,6 +17,7 @@ pub mod geom;
 pub mod nest;
 pub mod output;
 pub mod pattern;
+pub mod pipeline;
 pub mod spec;
 pub mod surface;
 pub mod toolpath;

@@ -467,8 +467,8 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
 
         // What the job asked for, in device units, per tool, with passes: the machine's job
         // (overcut, drag-knife holder path and precut included).
-        let (_, _, design) = flatcut::cli::cut::plan_job(&spec, &p, true).unwrap();
-        let job = flatcut::cli::cut::machine_job(&design, &p, &spec);
+        let (_, _, design) = flatcut::pipeline::plan_job(&spec, &p, true).unwrap();
+        let job = flatcut::pipeline::machine_job(&design, &p, &spec);
         assert_eq!(job.sheets.len(), 1);
         let sheet = &job.sheets[0];
         // With a drag knife the simulator records the trailing blade tip: what the design

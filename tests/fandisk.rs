@@ -15,7 +15,7 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
     assert!(mesh_path.is_file(), "{} missing", mesh_path.display());
     let spec_path = mesh_path.with_file_name("fandisk-test.toml");
     let spec = flatcut::spec::parse(SPEC, &spec_path).expect("spec");
-    let (flats, pieces) = flatcut::cli::pieces(&spec, true).expect("pieces");
+    let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).expect("pieces");
     let flat = &flats[0];
     assert_eq!(flat.surface.mesh.faces.len(), 12_946);
     assert!(flat.islands.len() <= 7, "{} islands", flat.islands.len());

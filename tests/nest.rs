@@ -196,7 +196,7 @@ fn patterns_nest_feasibly_on_sheets_and_roll() {
     assert!(names.len() >= 4);
     for path in names {
         let spec = flatcut::spec::load(&path).expect("spec");
-        let (_, one) = flatcut::cli::pieces(&spec, true).expect("pieces");
+        let (_, one) = flatcut::pipeline::pieces(&spec, true).expect("pieces");
         let pieces: Vec<_> = (0..4)
             .flat_map(|c| {
                 one.iter().map(move |p| {

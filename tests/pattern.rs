@@ -119,7 +119,7 @@ fn seams_reassemble_in_3d_and_notches_meet() {
         MaterialKind::Paper,
         Some(20.0),
     );
-    let (flats, pieces) = flatcut::cli::pieces(&cube, true).unwrap();
+    let (flats, pieces) = flatcut::pipeline::pieces(&cube, true).unwrap();
     let (n, k) = check_seams(&flats, &pieces);
     assert!(n >= 1 && k > 0, "{n} seams, {k} notches");
     // Every cut edge of the cube is in exactly one seam: 7 edges, 700 mm per side.
@@ -133,7 +133,7 @@ fn seams_reassemble_in_3d_and_notches_meet() {
 
     let dir = scratch("pattern-fandisk-seams");
     let fan = load(&fandisk_spec(&dir), MaterialKind::Fabric, Some(10.0));
-    let (flats, pieces) = flatcut::cli::pieces(&fan, true).unwrap();
+    let (flats, pieces) = flatcut::pipeline::pieces(&fan, true).unwrap();
     let (n, k) = check_seams(&flats, &pieces);
     assert!(n > 20 && k > 50, "{n} seams, {k} notches");
 }
@@ -227,7 +227,7 @@ fn labels_are_inside_and_upright_marks_inside() {
     let dir = scratch("pattern-labels");
     let spec = load(&fandisk_spec(&dir), MaterialKind::Paper, None);
     let profile = flatcut::device::profile::find("hpgl-pens").unwrap();
-    let (_, layout, job) = flatcut::cli::cut::plan_job(&spec, &profile, true).unwrap();
+    let (_, layout, job) = flatcut::pipeline::plan_job(&spec, &profile, true).unwrap();
     let mut labels = 0;
     for sheet in &job.sheets {
         for s in &sheet.strokes {
@@ -283,7 +283,7 @@ fn fabric_gets_allowance_and_notch_slits_metal_bend_notes() {
     let cube = load(&manifest("patterns/cube.toml"), MaterialKind::Fabric, None);
     let mut spec = cube.clone();
     spec.pattern.notches = None; // the material's default: every 50 mm
-    let (_, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     let p = &pieces[0];
     assert_eq!(p.seam_line, p.border);
     // The cut line keeps 10 mm from the sewing line everywhere (more at mitred corners).
@@ -311,7 +311,7 @@ fn fabric_gets_allowance_and_notch_slits_metal_bend_notes() {
     let mut metal = cube;
     metal.material.kind = MaterialKind::Metal;
     metal.pattern.bend_notches = Some(true);
-    let (_, pieces) = flatcut::cli::pieces(&metal, true).unwrap();
+    let (_, pieces) = flatcut::pipeline::pieces(&metal, true).unwrap();
     let p = &pieces[0];
     assert_eq!(p.notes.len(), p.folds.len());
     assert!(p.seams.iter().all(|s| !s.tab));
@@ -332,7 +332,7 @@ fn metal_bend_notes_stay_on_the_blank_of_a_boundary_panel() {
         MaterialKind::Metal,
         None,
     );
-    let (_, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     let p = &pieces[0];
     assert!(p.folds.len() > 10, "{} bends", p.folds.len());
     assert!(

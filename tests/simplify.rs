@@ -28,7 +28,7 @@ fn spec(dir: &Path, file: &str, mesh: &str, scale: f64, extra: &str) -> PathBuf 
 fn pieces(path: &Path) -> (Vec<Flat>, Vec<Piece>) {
     let text = std::fs::read_to_string(path).unwrap();
     let spec = flatcut::spec::parse(&text, path).unwrap();
-    flatcut::cli::pieces(&spec, true).unwrap()
+    flatcut::pipeline::pieces(&spec, true).unwrap()
 }
 
 fn length(points: &[DVec2]) -> f64 {

@@ -112,7 +112,7 @@ fn strip_square_to_round_area_matches_classical_construction() {
         "--height",
         "300",
     ]);
-    let (flats, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     assert_eq!(pieces.len(), 1);
     let blank = pieces[0].area;
     // Four flat triangles: each side with the circle's tangent point above its middle.
@@ -210,7 +210,7 @@ fn strip_fittings_flatten_isometrically_into_one_piece() {
         ],
     ] {
         let spec = fitting_spec(args);
-        let (flats, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+        let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
         assert_eq!(pieces.len(), 1, "{}", args[0]);
         let m = &flats[0].surface.mesh;
         let bridges = m.faces.len() + 1;
@@ -491,7 +491,7 @@ height = 1000
     std::fs::write(&path, spec_text).unwrap();
     let spec = flatcut::spec::load(&path).unwrap();
     assert_eq!(spec.surfaces.len(), 3);
-    let (flats, pieces) = flatcut::cli::pieces(&spec, true).unwrap();
+    let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     assert!(pieces.len() >= 3);
     for f in &flats {
         check_isometric(f);
@@ -502,7 +502,7 @@ height = 1000
         .filter(|p| p.surface == "spline")
         .all(|p| p.folds.is_empty()));
     // The same spec twice gives the same meshes (determinism).
-    let (again, _) = flatcut::cli::pieces(&spec, true).unwrap();
+    let (again, _) = flatcut::pipeline::pieces(&spec, true).unwrap();
     for (a, b) in flats.iter().zip(&again) {
         assert_eq!(a.surface.mesh, b.surface.mesh);
     }

@@ -10,7 +10,7 @@ fn fandisk_layout() -> flatcut::nest::Layout {
     let mesh_path = shared_data("meshes/fandisk.obj");
     let spec_path = mesh_path.with_file_name("fandisk-toolpath-test.toml");
     let spec = flatcut::spec::parse(SPEC, &spec_path).expect("spec");
-    let (_, pieces) = flatcut::cli::pieces(&spec, true).expect("pieces");
+    let (_, pieces) = flatcut::pipeline::pieces(&spec, true).expect("pieces");
     let opts = flatcut::nest::NestOptions {
         width: 297.0,
         height: Some(420.0),

@@ -16,8 +16,7 @@ pub struct CheckArgs {
 }
 
 pub fn run(a: &CheckArgs) -> Result<(), Error> {
-    let raw = crate::surface::obj::read(&a.obj)?;
-    let s = crate::surface::obj::stats(&raw);
+    let s = crate::pipeline::check_mesh(&a.obj)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&s).unwrap_or_default());
         return Ok(());

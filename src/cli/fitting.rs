@@ -1,6 +1,6 @@
 //! `flatcut fitting KIND`: a sheet-metal fitting from shop dimensions in millimetres (see
 //! [`crate::surface::fittings`]), developed as a strip and sent through the same pipeline as
-//! `cut` ([`super::cut::run_spec`]): the same device, `--dry-run` and `-o` handling, the same
+//! `cut` ([`crate::pipeline::cut`]): the same device, `--dry-run` and `-o` handling, the same
 //! files (program, SVG, PNG, DXF, report).
 //!
 //! Choices: the material is metal unless `--material` says otherwise; the thickness defaults to
@@ -9,7 +9,7 @@
 //! named after the kind (`cone`, `square-to-round`, …) unless `--name` is given; the device,
 //! as for `cut`, defaults to `sim`.
 
-use super::cut::{run_spec, CutArgs};
+use crate::pipeline::{Extras, Search, Toolpath};
 use crate::spec::{
     Material, MaterialKind, PatternSpec, SheetSpec, Spec, SurfaceKind, SurfaceSpec, Units,
 };
@@ -257,20 +257,26 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
 
 pub fn run(a: &FittingArgs) -> Result<(), Error> {
     let spec = spec(a)?;
-    let cut = CutArgs {
-        input: spec.path.clone(),
+    let device = a.device.clone().unwrap_or_else(|| "sim".to_string());
+    let profile = crate::pipeline::device(&device, None, None)?;
+    super::link::need_port(&profile, &a.link, a.dry_run)?;
+    let extras = Extras {
         output: a.output.clone(),
-        device: a.device.clone(),
-        material: None,
-        pattern: Default::default(),
-        search: Default::default(),
-        smooth: Default::default(),
-        toolpath: Default::default(),
-        dry_run: a.dry_run,
-        link: a.link.clone(),
-        alternatives: None,
         quiet: a.quiet,
-        surface_obj: None,
+        ..Default::default()
     };
-    run_spec(spec, &cut)
+    let run = crate::pipeline::cut(
+        &spec,
+        &profile,
+        &Search::default(),
+        &Toolpath::default(),
+        &extras,
+    )?;
+    if !a.quiet {
+        super::print_cut(&spec, &run, &profile.name, a.dry_run);
+    }
+    if !a.dry_run {
+        super::link::deliver_and_print(&run.programs, &profile, &a.link, &run.dir, a.quiet)?;
+    }
+    Ok(())
 }

@@ -57,6 +57,33 @@ pub fn simulated(profile: &Profile, link: &LinkArgs) -> bool {
         || (matches!(profile.name.as_str(), "sim" | "sim-dragknife") && link.port.is_none())
 }
 
+/// A real machine needs a port unless nothing is sent: refuse before any work is done.
+pub fn need_port(profile: &Profile, link: &LinkArgs, dry_run: bool) -> Result<(), Error> {
+    if !dry_run && !simulated(profile, link) && link.port.is_none() {
+        return Err(Error::Usage(format!(
+            "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
+            profile.name
+        )));
+    }
+    Ok(())
+}
+
+/// [`deliver`], printing what it says unless `quiet`.
+pub fn deliver_and_print(
+    programs: &[(String, Vec<u8>)],
+    profile: &Profile,
+    link: &LinkArgs,
+    dir: &Path,
+    quiet: bool,
+) -> Result<(), Error> {
+    for line in deliver(programs, profile, link, dir, quiet)? {
+        if !quiet {
+            println!("{line}");
+        }
+    }
+    Ok(())
+}
+
 /// Send each program (name, bytes) in turn; returns the lines to print.
 pub fn deliver(
     programs: &[(String, Vec<u8>)],

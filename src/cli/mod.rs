@@ -1,7 +1,10 @@
-//! Command line: clap argument structs, one file per subcommand, and the composition of the
-//! pipeline stages that the subcommands share. `main.rs` only parses and maps errors to exit
-//! codes.
+//! Command line: clap argument structs, one file per subcommand, each of which parses its
+//! flags, calls [`crate::pipeline`] and prints; no subcommand's file calls another's. What
+//! several subcommands share lives beside them: the flag groups ([`args`]), the link to a
+//! machine with its progress bars and Ctrl-C ([`link`]), and the summary `cut` and `fitting`
+//! print. `main.rs` only parses and maps errors to exit codes.
 
+pub mod args;
 pub mod check;
 pub mod cut;
 pub mod fitting;
@@ -12,12 +15,10 @@ pub mod ports;
 pub mod send;
 pub mod sim;
 
-use crate::flatten::{Flat, UnfoldOptions};
-use crate::pattern::{PatternOptions, Piece};
+use crate::pipeline::CutRun;
 use crate::spec::Spec;
 use crate::Error;
 use clap::{Parser, Subcommand};
-use std::path::Path;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -89,124 +90,52 @@ pub fn run(cli: Cli) -> Result<(), Error> {
     }
 }
 
-/// Pattern settings on the command line; they override the spec's `[pattern]` table.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct PatternArgs {
-    /// Glue tabs: none, one-side or both (default: one-side for paper, else none).
-    #[arg(long, value_enum)]
-    pub tabs: Option<crate::pattern::Tabs>,
-    /// Notches along every seam, every MM millimetres (default 50 with the flag; fabric has
-    /// them at 50 mm anyway; 0 turns them off).
-    #[arg(long, value_name = "MM", num_args = 0..=1, default_missing_value = "50")]
-    pub notches: Option<f64>,
-    /// Seam allowance in mm (default: 10 for fabric, else 0).
-    #[arg(long, value_name = "MM")]
-    pub allowance: Option<f64>,
-    /// Width of the cut in mm: cut contours move half of it away from the piece.
-    #[arg(long, value_name = "MM")]
-    pub kerf: Option<f64>,
-    /// V notches in the outline where bend lines meet it (sheet metal).
-    #[arg(long)]
-    pub bend_notches: bool,
-}
-
-impl PatternArgs {
-    /// Puts the flags into the spec (flags win), refusing values that make no sense.
-    pub fn apply(&self, spec: &mut Spec) -> Result<(), Error> {
-        let check = |v: Option<f64>, flag: &str| match v {
-            Some(x) if !(x.is_finite() && x >= 0.0) => Err(Error::Usage(format!(
-                "--{flag} {x}: must be a length in mm, at least 0"
-            ))),
-            _ => Ok(()),
-        };
-        check(self.notches, "notches")?;
-        check(self.allowance, "allowance")?;
-        check(self.kerf, "kerf")?;
-        let p = &mut spec.pattern;
-        p.tabs = self.tabs.or(p.tabs);
-        p.notches = self.notches.or(p.notches);
-        p.allowance = self.allowance.or(p.allowance);
-        p.kerf = self.kerf.or(p.kerf);
-        if self.bend_notches {
-            p.bend_notches = Some(true);
-        }
-        Ok(())
+/// What `cut` and `fitting` print after the files are written.
+fn print_cut(spec: &Spec, run: &CutRun, device: &str, dry_run: bool) {
+    let layout = &run.layout;
+    let n = run.job.sheets.len();
+    let cut: f64 = layout.pieces.iter().map(|p| p.cut_length()).sum();
+    let fold: f64 = layout.pieces.iter().map(|p| p.fold_length()).sum::<f64>() + 0.0; // not -0
+    println!(
+        "{}: {} pieces on {} {} ({:.0} mm cut, {:.0} mm folds), device {}",
+        spec.name,
+        layout.pieces.len(),
+        layout.sheets.len(),
+        if layout.roll {
+            "roll"
+        } else if n == 1 {
+            "sheet"
+        } else {
+            "sheets"
+        },
+        cut,
+        fold,
+        device
+    );
+    for i in 0..layout.sheets.len() {
+        println!(
+            "  {} {}: {:.0} × {:.0} mm, {:.1} % used",
+            if layout.roll { "roll" } else { "sheet" },
+            i + 1,
+            layout.sheets[i].width,
+            layout.sheets[i].height,
+            100.0 * layout.utilisation(i)
+        );
     }
-}
-
-/// Surfaces → flats → pieces for a spec; prints import warnings to stderr.
-pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
-    let mut flats = Vec::new();
-    for s in &spec.surfaces {
-        let surface = crate::surface::build(&s.for_material(&spec.material)).map_err(|e| {
-            if s.line > 0 {
-                Error::At {
-                    file: spec.path.clone(),
-                    line: s.line,
-                    source: Box::new(e.into()),
-                }
-            } else {
-                e.into()
-            }
-        })?;
-        if !quiet {
-            for w in &surface.warnings {
-                eprintln!("flatcut: warning: {w}");
-            }
-        }
-        // Charted (smooth) surfaces are parameterised, the rest unfolded exactly (issue 7).
-        let opts = crate::flatten::charts::FlattenOptions {
-            unfold: UnfoldOptions::default(),
-            ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
-        };
-        let flat = crate::flatten::charts::flatten(surface, &opts)?;
-        if !quiet && flat.surface.charts.is_some() {
-            for w in flat
-                .surface
-                .warnings
-                .iter()
-                .filter(|w| w.contains("stretches by"))
-            {
-                eprintln!("flatcut: warning: {w}");
-            }
-        }
-        flats.push(flat);
+    if let Some(len) = layout.roll_length() {
+        println!("  roll length used: {len:.1} mm");
     }
-    let opts = PatternOptions::from_spec(spec);
-    let pieces = crate::pattern::build(&flats, &opts)?;
-    Ok((flats, pieces))
-}
-
-/// Write a file so that it is either complete or absent: write a hidden temporary file beside
-/// it, flush it to disk, then rename it over the final name.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    use std::io::Write;
-    let err = |source| Error::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(e));
+    if let Some((lo, hi)) = layout.remnant {
+        println!(
+            "  left on the last sheet: {:.0} × {:.0} mm at ({:.0}, {:.0})",
+            hi.x - lo.x,
+            hi.y - lo.y,
+            lo.x,
+            lo.y
+        );
     }
-    Ok(())
-}
-
-/// Create the output directory.
-pub fn create_dir(dir: &Path) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-        path: dir.to_path_buf(),
-        source,
-    })
+    println!("wrote {}: {}", run.dir.display(), run.files.join(", "));
+    if dry_run {
+        println!("dry run: nothing sent");
+    }
 }

@@ -3,7 +3,7 @@
 //! report go to `-o DIR`, default `out/send`). The file's extension must match the device's
 //! language, so that G-code never reaches an HP-GL cutter by mistake.
 
-use super::link::{deliver, LinkArgs};
+use super::link::{deliver_and_print, LinkArgs};
 use crate::Error;
 use clap::Args;
 use std::path::PathBuf;
@@ -27,48 +27,18 @@ pub struct SendArgs {
 
 pub fn run(a: &SendArgs) -> Result<(), Error> {
     let profile = crate::device::profile::find(&a.device)?;
-    let bytes = std::fs::read(&a.file)
-        .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", a.file.display())))?;
-    let ext = a
-        .file
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let expected: &[&str] = match profile.language {
-        crate::device::Language::Hpgl => &["plt", "hpgl", "hpg"],
-        crate::device::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
-    };
-    if !expected.contains(&ext.as_str()) {
-        return Err(Error::Usage(format!(
-            "{}: device `{}` speaks {}, which is sent from a .{} file; this file is `.{ext}`",
-            a.file.display(),
-            profile.name,
-            profile.language.label(),
-            expected[0]
-        )));
-    }
-    if bytes.is_empty() {
-        return Err(Error::Usage(format!(
-            "{}: the file is empty",
-            a.file.display()
-        )));
-    }
+    let bytes = crate::pipeline::read_program(&a.file, &profile)?;
     let dir = a
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/send"));
     if super::link::simulated(&profile, &a.link) {
-        super::create_dir(&dir)?;
+        crate::pipeline::create_dir(&dir)?;
     }
     let name = a
         .file
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    for line in deliver(&[(name, bytes)], &profile, &a.link, &dir, a.quiet)? {
-        if !a.quiet {
-            println!("{line}");
-        }
-    }
-    Ok(())
+    deliver_and_print(&[(name, bytes)], &profile, &a.link, &dir, a.quiet)
 }

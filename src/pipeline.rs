@@ -1,0 +1,621 @@
+//! The one composer of the pipeline: spec → surfaces → flats → pieces → layout → job →
+//! programs → files. Every subcommand (`cli`), the integration tests and the benches run the
+//! stages through these functions; no stage calls another stage's entry point, and `cli`
+//! only parses flags, fills the options below and prints.
+//!
+//! - [`pieces`]: spec → surfaces → flats → pieces (surface, flatten and pattern stages).
+//! - [`plan`] / [`plan_job`]: pieces → layout → job (nest and toolpath stages), with the
+//!   device deciding which stroke kinds are drawn at all.
+//! - [`machine_job`]: the job as the device makes it (perforation dashes, overcut, drag-knife
+//!   offset).
+//! - [`cut`] and [`flatten`]: the whole run of `flatcut cut` / `flatcut flatten`, up to the
+//!   files in the output folder; sending the programs is the caller's (`cli::link`), after the
+//!   files are written, so a failed send loses nothing.
+//! - [`nest_instance`]: an ESICUP instance → solution files (`flatcut nest`).
+//!
+//! Choices: options a user did not give are `None` and leave the stage's default; the
+//! command-line flags were checked by `cli` before they get here; warnings of the surface and
+//! flatten stages go to standard error unless `quiet`.
+
+use crate::device::profile::Profile;
+use crate::flatten::Flat;
+use crate::nest::Layout;
+use crate::output::report::{self, RunInfo};
+use crate::pattern::{PatternOptions, Piece};
+use crate::spec::{MaterialKind, Spec};
+use crate::toolpath::{Job, StrokeKind, ToolpathOptions};
+use crate::Error;
+use std::path::{Path, PathBuf};
+
+/// Nesting search settings (`--nest-time`, `--seed`, `--threads`); `None` keeps the default.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Search {
+    /// Search budget in seconds (a deterministic work budget).
+    pub seconds: Option<f64>,
+    /// Seed of the search.
+    pub seed: Option<u64>,
+    /// Independent searches run in parallel (clamped to 1..=64).
+    pub threads: Option<usize>,
+}
+
+impl Search {
+    /// Put the settings that were given into the nest options.
+    pub fn apply(&self, opts: &mut crate::nest::NestOptions) {
+        if let Some(t) = self.seconds {
+            opts.seconds = t;
+        }
+        if let Some(s) = self.seed {
+            opts.seed = s;
+        }
+        if let Some(t) = self.threads {
+            opts.threads = t.clamp(1, 64);
+        }
+    }
+}
+
+/// How folds are made (`--folds`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Folds {
+    Score,
+    Perforate,
+    Draw,
+    None,
+}
+
+/// Toolpath choices a run can make over the defaults (`--folds`, `--per-piece`, `--weed`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Toolpath {
+    /// The tool that makes folds; `None`: the device's best (score, else perforate, else draw).
+    pub folds: Option<Folds>,
+    /// Finish each piece before the next; `None`: on for fabric, which may shift.
+    pub per_piece: Option<bool>,
+    /// Cut weed lines.
+    pub weed: bool,
+}
+
+/// Surfaces → flats → pieces for a spec; prints the surfaces' warnings to stderr unless
+/// `quiet`.
+pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
+    let mut flats = Vec::new();
+    for s in &spec.surfaces {
+        let surface = crate::surface::build(&s.for_material(&spec.material)).map_err(|e| {
+            if s.line > 0 {
+                Error::At {
+                    file: spec.path.clone(),
+                    line: s.line,
+                    source: Box::new(e.into()),
+                }
+            } else {
+                e.into()
+            }
+        })?;
+        if !quiet {
+            for w in &surface.warnings {
+                eprintln!("flatcut: warning: {w}");
+            }
+        }
+        // Charted (smooth) surfaces are parameterised, the rest unfolded exactly.
+        let opts = crate::flatten::charts::FlattenOptions {
+            unfold: crate::flatten::UnfoldOptions::default(),
+            ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
+        };
+        let flat = crate::flatten::charts::flatten(surface, &opts)?;
+        if !quiet && flat.surface.charts.is_some() {
+            for w in flat
+                .surface
+                .warnings
+                .iter()
+                .filter(|w| w.contains("stretches by"))
+            {
+                eprintln!("flatcut: warning: {w}");
+            }
+        }
+        flats.push(flat);
+    }
+    let opts = PatternOptions::from_spec(spec);
+    let pieces = crate::pattern::build(&flats, &opts)?;
+    Ok((flats, pieces))
+}
+
+/// Find a device profile and make its tool table say how folds are made: the tools that
+/// would be picked before the chosen one are taken out of this job's copy of the profile
+/// (folds take the scoring tool, else the perforating one, else the pen; nothing else uses
+/// the first two). A knife offset given replaces the profile's (checked by the caller).
+pub fn device(
+    name: &str,
+    folds: Option<Folds>,
+    knife_offset: Option<f64>,
+) -> Result<Profile, Error> {
+    let mut profile = crate::device::profile::find(name)?;
+    if let Some(v) = knife_offset {
+        profile.knife_offset = v;
+    }
+    let (kind, drop): (StrokeKind, &[&str]) = match folds {
+        // `none` leaves the folds out of the job (`ToolpathOptions::skip_folds`).
+        None | Some(Folds::None) => return Ok(profile),
+        Some(Folds::Score) => (StrokeKind::Score, &[]),
+        Some(Folds::Perforate) => (StrokeKind::Perforate, &["score"]),
+        Some(Folds::Draw) => (StrokeKind::Draw, &["score", "perforate"]),
+    };
+    if !profile.has(kind) {
+        return Err(Error::Usage(format!(
+            "--folds {}: device `{}` has no {} tool (its tools: {})",
+            kind.name(),
+            profile.name,
+            kind.name(),
+            profile.tools.keys().cloned().collect::<Vec<_>>().join(", ")
+        )));
+    }
+    for k in drop {
+        profile.tools.remove(*k);
+    }
+    Ok(profile)
+}
+
+/// Spec → pieces → layout → job for a device: what `cut` sends (the device decides which
+/// stroke kinds are drawn at all), with the default nesting search and toolpath.
+pub fn plan_job(
+    spec: &Spec,
+    profile: &Profile,
+    quiet: bool,
+) -> Result<(Vec<Flat>, Layout, Job), Error> {
+    plan(
+        spec,
+        profile,
+        &Search::default(),
+        &Toolpath::default(),
+        quiet,
+    )
+}
+
+/// [`plan_job`] with the nesting search and toolpath choices given.
+pub fn plan(
+    spec: &Spec,
+    profile: &Profile,
+    search: &Search,
+    choices: &Toolpath,
+    quiet: bool,
+) -> Result<(Vec<Flat>, Layout, Job), Error> {
+    let (flats, pieces) = pieces(spec, quiet)?;
+    let mut nest_opts = crate::nest::NestOptions {
+        width: spec.sheet.width,
+        height: spec.sheet.height,
+        margin: spec.sheet.margin,
+        spacing: spec.sheet.spacing,
+        ..Default::default()
+    };
+    search.apply(&mut nest_opts);
+    let layout = crate::nest::nest(pieces, &nest_opts).map_err(|e| Error::In {
+        file: spec.path.clone(),
+        source: Box::new(e.into()),
+    })?;
+    let mut tp = ToolpathOptions {
+        skip_folds: crate::toolpath::fold_kind(|k| profile.has(k)).is_none(),
+        skip_drawing: !profile.has(StrokeKind::Draw),
+        per_piece: spec.material.kind == MaterialKind::Fabric,
+        weed: None,
+    };
+    if let Some(p) = choices.per_piece {
+        tp.per_piece = p;
+    }
+    if choices.folds == Some(Folds::None) {
+        tp.skip_folds = true;
+    }
+    if choices.weed {
+        tp.weed = Some(crate::toolpath::weed::WeedOptions::default());
+    }
+    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+    Ok((flats, layout, job))
+}
+
+/// The job as the device makes it: folds as the profile's tools make them (perforation
+/// dashes), overcut, drag-knife compensation with its alignment precut in the sheet margin.
+pub fn machine_job(job: &Job, profile: &Profile, spec: &Spec) -> Job {
+    crate::toolpath::knife::prepare(job, &profile.machine_options(spec.sheet.margin))
+}
+
+/// Default output directory for a job name.
+pub fn default_dir(name: &str) -> PathBuf {
+    Path::new("out").join(name)
+}
+
+/// What a run writes besides its main files.
+#[derive(Debug, Clone, Default)]
+pub struct Extras {
+    /// Output folder; `None`: `out/<name>`.
+    pub output: Option<PathBuf>,
+    /// Boundary surfaces: write the N best triangulations as `<surface>-alt-<k>.obj`.
+    pub alternatives: Option<usize>,
+    /// Write the surfaces' 3D mesh as OBJ here.
+    pub surface_obj: Option<PathBuf>,
+    /// Write each surface's mesh with its flat layout as `vt` here.
+    pub uv_obj: Option<PathBuf>,
+    /// Print no warnings.
+    pub quiet: bool,
+}
+
+/// `cut` up to its files: what was made and written.
+#[derive(Debug)]
+pub struct CutRun {
+    pub flats: Vec<Flat>,
+    pub layout: Layout,
+    /// The job as designed (one sheet per layout sheet).
+    pub job: Job,
+    /// The output folder.
+    pub dir: PathBuf,
+    /// Every file written, in the order written (report.json last).
+    pub files: Vec<String>,
+    /// The device programs, one per sheet: (file name, bytes).
+    pub programs: Vec<(String, Vec<u8>)>,
+}
+
+/// The whole of `flatcut cut` but the sending: plan the job for the device, write the program
+/// per sheet, the SVG, a PNG and a DXF per sheet, the asked-for extras and report.json, each
+/// file whole or not at all.
+pub fn cut(
+    spec: &Spec,
+    profile: &Profile,
+    search: &Search,
+    choices: &Toolpath,
+    extras: &Extras,
+) -> Result<CutRun, Error> {
+    let (flats, layout, job) = plan(spec, profile, search, choices, extras.quiet)?;
+    let machine = machine_job(&job, profile, spec);
+    write_extras(&flats, extras)?;
+    let dir = extras
+        .output
+        .clone()
+        .unwrap_or_else(|| default_dir(&spec.name));
+    create_dir(&dir)?;
+    let mut files = Vec::new();
+    let mut programs = Vec::new();
+    let ext = profile.language.extension();
+    let n = job.sheets.len();
+    for (i, sheet) in machine.sheets.iter().enumerate() {
+        let name = sheet_file(&spec.name, i, n, ext);
+        let bytes = crate::output::program(sheet, profile).map_err(|e| e.on_sheet(i + 1))?;
+        write_atomic(&dir.join(&name), &bytes)?;
+        files.push(name.clone());
+        programs.push((name, bytes));
+    }
+    files.extend(write_pictures(&dir, &spec.name, &job)?);
+    files.extend(write_dxf(&dir, &spec.name, &layout)?);
+    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    files.push("report.json".into());
+    write_report(&dir, spec, &profile.name, &files, &flats, &layout)?;
+    Ok(CutRun {
+        flats,
+        layout,
+        job,
+        dir,
+        files,
+        programs,
+    })
+}
+
+/// `flatten` up to its files: the pieces laid side by side.
+#[derive(Debug)]
+pub struct FlattenRun {
+    pub flats: Vec<Flat>,
+    pub layout: Layout,
+    pub dir: PathBuf,
+    pub files: Vec<String>,
+}
+
+/// The whole of `flatcut flatten`: the pieces nested on one strip wide enough for the widest
+/// piece (the pieces, not the sheets, are the result), written as SVG, PNG and report.json.
+pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenRun, Error> {
+    let (flats, pieces) = pieces(spec, extras.quiet)?;
+    write_extras(&flats, extras)?;
+    let widest = pieces
+        .iter()
+        .filter_map(|p| {
+            let pts: Vec<_> = p.points().collect();
+            let r = glam::DVec2::from_angle(crate::geom::polygon::min_area_rect_angle(&pts));
+            crate::geom::polygon::bounds(pts.iter().map(|q| r.rotate(*q)))
+                .map(|(lo, hi)| (hi - lo).x)
+        })
+        .fold(0.0, f64::max);
+    let mut opts = crate::nest::NestOptions {
+        width: spec.sheet.width.max(widest + 2.0 * spec.sheet.margin + 1.0),
+        height: None,
+        margin: spec.sheet.margin,
+        spacing: spec.sheet.spacing,
+        ..Default::default()
+    };
+    search.apply(&mut opts);
+    let layout = crate::nest::nest(pieces, &opts).map_err(|e| Error::In {
+        file: spec.path.clone(),
+        source: Box::new(e.into()),
+    })?;
+    let job = crate::toolpath::plan(&layout, &spec.name, &ToolpathOptions::default());
+    let dir = extras
+        .output
+        .clone()
+        .unwrap_or_else(|| default_dir(&spec.name));
+    create_dir(&dir)?;
+    let mut files = write_pictures(&dir, &spec.name, &job)?;
+    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    files.push("report.json".into());
+    write_report(&dir, spec, "", &files, &flats, &layout)?;
+    Ok(FlattenRun {
+        flats,
+        layout,
+        dir,
+        files,
+    })
+}
+
+/// An ESICUP instance nested: the instance, its solution and where they were written.
+#[derive(Debug)]
+pub struct NestRun {
+    pub instance: crate::nest::esicup::Instance,
+    pub solution: crate::nest::problem::Solution,
+    pub dir: PathBuf,
+}
+
+/// `flatcut nest`: nest an ESICUP strip-packing instance (default budget 60 s) and write
+/// `solution.json` and `layout.svg`.
+pub fn nest_instance(
+    path: &Path,
+    search: &Search,
+    output: Option<PathBuf>,
+) -> Result<NestRun, Error> {
+    use crate::nest::esicup;
+    let inst = esicup::load(path)?;
+    let mut opts = crate::nest::NestOptions {
+        seconds: 60.0,
+        ..Default::default()
+    };
+    search.apply(&mut opts);
+    let cfg = crate::nest::problem::Config {
+        seconds: opts.seconds,
+        seed: opts.seed,
+        threads: opts.threads,
+    };
+    let t0 = std::time::Instant::now();
+    let sol = esicup::solve(&inst, &cfg)?;
+    if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
+        eprintln!("work {} in {:.2} s", sol.work, t0.elapsed().as_secs_f64());
+    }
+    let dir = output.unwrap_or_else(|| default_dir(&inst.name));
+    create_dir(&dir)?;
+    let text = serde_json::to_string_pretty(&esicup::solution_json(&inst, &sol))
+        .unwrap_or_default()
+        + "\n";
+    write_atomic(&dir.join("solution.json"), text.as_bytes())?;
+    write_atomic(&dir.join("layout.svg"), esicup::svg(&inst, &sol).as_bytes())?;
+    Ok(NestRun {
+        instance: inst,
+        solution: sol,
+        dir,
+    })
+}
+
+/// `flatcut check`: a mesh read without repairs and its figures.
+pub fn check_mesh(path: &Path) -> Result<crate::surface::obj::MeshStats, Error> {
+    let raw = crate::surface::obj::read(path)?;
+    Ok(crate::surface::obj::stats(&raw))
+}
+
+/// `flatcut send`: an existing program file, checked against the device's language (by its
+/// extension) and not empty.
+pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", path.display())))?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let expected: &[&str] = match profile.language {
+        crate::device::Language::Hpgl => &["plt", "hpgl", "hpg"],
+        crate::device::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
+    };
+    if !expected.contains(&ext.as_str()) {
+        return Err(Error::Usage(format!(
+            "{}: device `{}` speaks {}, which is sent from a .{} file; this file is `.{ext}`",
+            path.display(),
+            profile.name,
+            profile.language.label(),
+            expected[0]
+        )));
+    }
+    if bytes.is_empty() {
+        return Err(Error::Usage(format!(
+            "{}: the file is empty",
+            path.display()
+        )));
+    }
+    Ok(bytes)
+}
+
+/// `--surface-obj` and `--uv-obj`, written before the run's own files.
+fn write_extras(flats: &[Flat], extras: &Extras) -> Result<(), Error> {
+    if let Some(p) = &extras.surface_obj {
+        write_surface_obj(p, flats)?;
+    }
+    if let Some(p) = &extras.uv_obj {
+        write_uv_obj(p, flats)?;
+    }
+    Ok(())
+}
+
+/// report.json: the run, its pieces, seams, sheets and per-surface figures.
+fn write_report(
+    dir: &Path,
+    spec: &Spec,
+    device: &str,
+    files: &[String],
+    flats: &[Flat],
+    layout: &Layout,
+) -> Result<(), Error> {
+    let info = RunInfo {
+        name: spec.name.clone(),
+        spec: spec.path.display().to_string(),
+        device: device.to_string(),
+        material: spec.material.kind.to_string(),
+        thickness_mm: spec.material.thickness,
+        files: files.to_vec(),
+    };
+    let rep = report::build(&info, flats, layout);
+    let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
+    write_atomic(&dir.join("report.json"), text.as_bytes())
+}
+
+/// Write the surfaces' meshes into one OBJ file (`--surface-obj`), atomically.
+pub fn write_surface_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
+    let mut mesh = crate::geom::mesh::Mesh::default();
+    let mut names = Vec::new();
+    for f in flats {
+        let m = &f.surface.mesh;
+        let base = mesh.vertices.len();
+        mesh.vertices.extend_from_slice(&m.vertices);
+        mesh.faces
+            .extend(m.faces.iter().map(|face| crate::geom::mesh::Face {
+                verts: face.verts.iter().map(|v| v + base).collect(),
+                line: face.line,
+            }));
+        names.push(f.surface.name.clone());
+    }
+    let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));
+    let text = crate::output::obj::write(&mesh, None, &comment).unwrap_or_default();
+    write_atomic(path, text.as_bytes())
+}
+
+/// `--uv-obj FILE`: each surface's mesh with its flat layout (mm) as `vt`; with several
+/// surfaces, FILE gets `-<k>` before its extension from the second on.
+pub fn write_uv_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
+    for (k, flat) in flats.iter().enumerate() {
+        let file = if k == 0 {
+            path.to_path_buf()
+        } else {
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+            let ext = path.extension().map(|s| s.to_string_lossy().into_owned());
+            path.with_file_name(format!(
+                "{}-{}{}",
+                stem.unwrap_or_default(),
+                k + 1,
+                ext.map(|e| format!(".{e}")).unwrap_or_default()
+            ))
+        };
+        let comment = format!(
+            "{}: {} pieces, flat coordinates in mm as vt (one per face corner)\nwritten by flatcut {}",
+            flat.surface.name,
+            flat.islands.len(),
+            env!("CARGO_PKG_VERSION")
+        );
+        let text = crate::output::obj::write(&flat.surface.mesh, Some(&flat.face_2d), &comment)
+            .ok_or_else(|| {
+                Error::Usage(format!(
+                    "{}: the flat layout does not cover every face corner",
+                    file.display()
+                ))
+            })?;
+        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+            create_dir(dir)?;
+        }
+        write_atomic(&file, text.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// `--alternatives N`: write `<surface>-alt-<k>.obj`, the surface's mesh first and then the
+/// alternatives its source found; returns the file names.
+fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Vec<String>, Error> {
+    let mut files = Vec::new();
+    let Some(n) = n else { return Ok(files) };
+    for f in flats {
+        if f.surface.figures.is_empty() && f.surface.alternatives.is_empty() {
+            continue;
+        }
+        let meshes = std::iter::once(&f.surface.mesh).chain(&f.surface.alternatives);
+        for (k, mesh) in meshes.take(n).enumerate() {
+            let name = format!("{}-alt-{}.obj", f.surface.name, k + 1);
+            let comment = format!(
+                "{} triangulation {} of {} found for surface `{}`",
+                if k == 0 { "chosen" } else { "alternative" },
+                k + 1,
+                1 + f.surface.alternatives.len(),
+                f.surface.name
+            );
+            let text = crate::output::obj::write(mesh, None, &comment).unwrap_or_default();
+            write_atomic(&dir.join(&name), text.as_bytes())?;
+            files.push(name);
+        }
+    }
+    Ok(files)
+}
+
+/// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
+fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, Error> {
+    let mut files = Vec::new();
+    let svg = format!("{name}.svg");
+    write_atomic(&dir.join(&svg), crate::output::svg::render(job).as_bytes())?;
+    files.push(svg);
+    for (i, sheet) in job.sheets.iter().enumerate() {
+        let png = format!("{name}-{}.png", i + 1);
+        let bytes =
+            crate::output::png::render(sheet, i + 1, crate::output::png::DEFAULT_PX_PER_MM)?;
+        write_atomic(&dir.join(&png), &bytes)?;
+        files.push(png);
+    }
+    Ok(files)
+}
+
+/// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.
+fn write_dxf(dir: &Path, name: &str, layout: &Layout) -> Result<Vec<String>, Error> {
+    let n = layout.sheets.len();
+    let mut files = Vec::new();
+    for i in 0..n {
+        let file = sheet_file(name, i, n, "dxf");
+        write_atomic(
+            &dir.join(&file),
+            crate::output::dxf::render(layout, i).as_bytes(),
+        )?;
+        files.push(file);
+    }
+    Ok(files)
+}
+
+/// `<name>.<ext>` for a one-sheet job, else `<name>-<k>.<ext>` for sheet `k` (1-based).
+fn sheet_file(name: &str, i: usize, n: usize, ext: &str) -> String {
+    if n == 1 {
+        format!("{name}.{ext}")
+    } else {
+        format!("{name}-{}.{ext}", i + 1)
+    }
+}
+
+/// Write a file so that it is either complete or absent: write a hidden temporary file beside
+/// it, flush it to disk, then rename it over the final name.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    use std::io::Write;
+    let err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(err(e));
+    }
+    Ok(())
+}
+
+/// Create the output directory.
+pub fn create_dir(dir: &Path) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
