@@ -1,8 +1,7 @@
 //! Toolpath acceptance on the fandisk pattern: pen-up travel after ordering against collection
 //! order (issue 8: at least 30 % shorter), with marks, folds and cuts all present.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 const SPEC: &str = FANDISK_SPEC;
 
@@ -24,6 +23,7 @@ fn fandisk_layout() -> flatcut::nest::Layout {
 
 #[test]
 fn fandisk_travel_at_least_30_percent_shorter_than_stroke_order() {
+    require_shared!();
     let layout = fandisk_layout();
     for per_piece in [false, true] {
         let tp = flatcut::toolpath::ToolpathOptions {
@@ -75,6 +75,7 @@ fn fandisk_travel_at_least_30_percent_shorter_than_stroke_order() {
 /// after every piece.
 #[test]
 fn fandisk_weed_lines_cross_and_touch_no_piece() {
+    require_shared!();
     use flatcut::toolpath::{weed, StrokeRole};
     let layout = fandisk_layout();
     let w = weed::WeedOptions::default();

@@ -65,3 +65,29 @@ pub fn fandisk_spec(dir: &Path) -> PathBuf {
     std::fs::write(&path, text).expect("write fandisk spec");
     path
 }
+
+/// Whether `../shared/data` is missing: on a developer's clone without it the tests that read
+/// it skip (say so on stderr and return); when `CI` is set they must run, so this panics.
+pub fn shared_missing() -> bool {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    if dir.is_dir() {
+        return false;
+    }
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "{} is missing and CI is set: the tests that read it must run",
+        dir.display()
+    );
+    eprintln!("skipped: {} is absent", dir.display());
+    true
+}
+
+/// First line of a test that reads `../shared/data`: skips it when the data is absent (not
+/// under CI, see [`shared_missing`]).
+macro_rules! require_shared {
+    () => {
+        if $crate::common::shared_missing() {
+            return;
+        }
+    };
+}

@@ -5,8 +5,7 @@
 //! here, not through the library's parser, and the solution's transformations are applied as
 //! documented in `../shared/data/README.md`.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::geom::polygon::{segment_distance, signed_area, triangles_overlap, triangulate};
 use glam::DVec2;
 use serde_json::Value;
@@ -135,6 +134,7 @@ fn check_solution(instance: &Value, solution: &Value, what: &str) -> f64 {
 /// other on the two cores): feasible, and denser than jagua-rs's bottom-left fill already.
 #[test]
 fn esicup_instances_nest_feasibly_and_beat_bottom_left_fill() {
+    require_shared!();
     // Reference densities of jagua-rs's bottom-left fill (../shared/data/README.md).
     let refs = [
         ("albano", 0.8110),
@@ -167,6 +167,7 @@ fn esicup_instances_nest_feasibly_and_beat_bottom_left_fill() {
 
 #[test]
 fn esicup_same_seed_same_solution() {
+    require_shared!();
     let path = shared_data("nesting/fu.json");
     let inst = flatcut::nest::esicup::load(&path).expect("load");
     let cfg = flatcut::nest::problem::Config {
@@ -266,6 +267,7 @@ fn patterns_nest_feasibly_on_sheets_and_roll() {
 /// naming the file and the item.
 #[test]
 fn nest_command_writes_solution_and_rejects_bad_instances() {
+    require_shared!();
     let out = scratch("nest-cli");
     let o = flatcut(&[
         "nest",
@@ -322,6 +324,7 @@ fn nest_command_writes_solution_and_rejects_bad_instances() {
 #[test]
 #[ignore]
 fn solution_files_are_feasible() {
+    require_shared!();
     let Ok(prefix) = std::env::var("NEST_SOLUTIONS") else {
         panic!("set NEST_SOLUTIONS to the directory prefix");
     };

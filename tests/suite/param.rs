@@ -3,8 +3,7 @@
 //! the mushroom (not developable, one disk) beats libigl's LSCM figure, bad charts are refused
 //! with messages that name the face and its line.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::flatten::distortion;
 use flatcut::flatten::{parameterize, ChartParam, ParamError, ParamMethod};
 use flatcut::geom::mesh::{Face, Mesh};
@@ -201,6 +200,7 @@ fn polygon_faces_of_a_flat_grid_keep_their_shape() {
 
 #[test]
 fn mushroom_disk_beats_libigl_lscm() {
+    require_shared!();
     let path = shared_data("meshes/mushroom.obj");
     let raw = flatcut::surface::obj::read(&path).expect("read mushroom");
     let (mesh, _warnings) = flatcut::surface::obj::validate(raw, 100.0).expect("validate");
@@ -441,6 +441,7 @@ fn closed_holed_and_miswound_charts_are_refused() {
 
 #[test]
 fn cylinder_disk_flattens_nearly_isometrically() {
+    require_shared!();
     // cylinder.obj is one disk (a single boundary loop, Euler characteristic 1).
     let path = shared_data("meshes/cylinder.obj");
     let raw = flatcut::surface::obj::read(&path).expect("read cylinder");

@@ -2,8 +2,7 @@
 //! Blank figures are read from what the user gets (the HPGL of a dry run, the DXF read back
 //! with the `dxf` crate), bad input gets exit 1 naming the flag or key.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::cli::{Cli, Command};
 use flatcut::output::hpgl;
 use flatcut::surface::strip::{Method, Strip};

@@ -4,8 +4,7 @@
 //! `error:N` mid-job, faults (hang-up, silent device, stall, lost XON, garbage, missing port),
 //! and a plain program using the kernel's XON/XOFF streaming into `flatcut sim`.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::device::profile::{self, Profile};
 use flatcut::device::serial;
 use flatcut::device::sim::{self, Faults, SimConfig, SimReport};

@@ -2,8 +2,7 @@
 //! invariants, planar boundaries, the example patterns' figures, darts, holes, rulings, and bad
 //! input through the CLI (exit 1, one line naming the key and line).
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::flatten::{unfold, UnfoldOptions};
 use flatcut::geom::mesh::Mesh;
 use flatcut::surface::boundary::{triangulate, BoundaryError, Dart, Input, Options};

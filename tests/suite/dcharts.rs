@@ -5,8 +5,7 @@
 //! Figures are printed (`cargo test --release --test dcharts -- --nocapture`) for the issue
 //! note.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::flatten::charts::{self as fcharts, FlattenOptions};
 use flatcut::flatten::{distortion, param, Flat};
 use flatcut::geom::mesh::{Face, Mesh};
@@ -77,6 +76,7 @@ fn check_flat(flat: &Flat) {
 
 #[test]
 fn fandisk_few_charts_near_isometric() {
+    require_shared!();
     let mesh = load("fandisk.obj");
     let nf = mesh.faces.len();
     let (seg, flat, s, secs) = run(mesh);
@@ -92,6 +92,7 @@ fn fandisk_few_charts_near_isometric() {
 
 #[test]
 fn straightening_shortens_fandisk_boundaries() {
+    require_shared!();
     // §5.2.2: boundaries re-routed through the fuzzy areas are shorter in total, and the
     // targets still hold.
     let mesh = load("fandisk.obj");
@@ -126,6 +127,7 @@ fn straightening_shortens_fandisk_boundaries() {
 
 #[test]
 fn cylinder_is_one_or_few_charts() {
+    require_shared!();
     let mesh = load("cylinder.obj");
     let (seg, flat, s, secs) = run(mesh);
     println!(
@@ -144,6 +146,7 @@ fn cylinder_is_one_or_few_charts() {
 
 #[test]
 fn mushroom_charts_and_stretch() {
+    require_shared!();
     let mesh = load("mushroom.obj");
     // The whole disk in one piece, for comparison with libigl's LSCM (L2 2.585).
     let all: Vec<usize> = (0..mesh.faces.len()).collect();
@@ -566,6 +569,7 @@ fn bad_options_and_empty_meshes_are_refused() {
 
 #[test]
 fn smooth_detection() {
+    require_shared!();
     assert!(dcharts::is_smooth(&load("mushroom.obj")));
     assert!(dcharts::is_smooth(&cap(100.0, 30.0, 32, 8)));
     let raw = flatcut::surface::obj::read(&manifest("patterns/cube.obj")).unwrap();
@@ -589,6 +593,7 @@ fn vts(text: &str) -> Vec<DVec2> {
 
 #[test]
 fn cli_flatten_writes_uv_obj_and_stretch() {
+    require_shared!();
     let dir = scratch("dcharts-cli");
     let uv = dir.join("fandisk-uv.obj");
     let o = flatcut(&[
@@ -621,6 +626,7 @@ fn cli_flatten_writes_uv_obj_and_stretch() {
 
 #[test]
 fn cli_refuses_bad_segment_settings() {
+    require_shared!();
     let dir = scratch("dcharts-bad");
     let mesh = shared_data("meshes/cylinder.obj");
     let cases = [

@@ -2,8 +2,7 @@
 //! edges, outputs are deterministic, and bad input gets exit code 1 with one line that names
 //! the file and the cause.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::output::hpgl;
 
 fn pen_lengths(plt: &str) -> [f64; 4] {

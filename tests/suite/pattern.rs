@@ -2,8 +2,7 @@
 //! stay simple and apart in the HP-GL, labels lie inside their pieces and read upright on the
 //! sheet, fabric gets its allowance and notch slits, metal its bend notes.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::flatten::Flat;
 use flatcut::geom::polygon;
 use flatcut::pattern::{Piece, SeamSide};
@@ -114,6 +113,7 @@ fn check_seams(flats: &[Flat], pieces: &[Piece]) -> (usize, usize) {
 
 #[test]
 fn seams_reassemble_in_3d_and_notches_meet() {
+    require_shared!();
     let cube = load(
         &manifest("patterns/cube.toml"),
         MaterialKind::Paper,
@@ -175,6 +175,7 @@ fn rings_touch(a: &[DVec2], b: &[DVec2]) -> bool {
 
 #[test]
 fn paper_outlines_with_tabs_are_simple_and_apart() {
+    require_shared!();
     let dir = scratch("pattern-tabs");
     let fan = fandisk_spec(&dir);
     for (name, spec) in [
@@ -224,6 +225,7 @@ fn paper_outlines_with_tabs_are_simple_and_apart() {
 
 #[test]
 fn labels_are_inside_and_upright_marks_inside() {
+    require_shared!();
     let dir = scratch("pattern-labels");
     let spec = load(&fandisk_spec(&dir), MaterialKind::Paper, None);
     let profile = flatcut::device::profile::find("hpgl-pens").unwrap();

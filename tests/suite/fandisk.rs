@@ -2,8 +2,7 @@
 //! Every face keeps its edge lengths on the sheet, no piece overlaps itself or another, and all
 //! lie inside the sheet margins.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::geom::polygon;
 use glam::DVec2;
 
@@ -11,6 +10,7 @@ const SPEC: &str = FANDISK_SPEC;
 
 #[test]
 fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
+    require_shared!();
     let mesh_path = shared_data("meshes/fandisk.obj");
     assert!(mesh_path.is_file(), "{} missing", mesh_path.display());
     let spec_path = mesh_path.with_file_name("fandisk-test.toml");
@@ -63,6 +63,7 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
 
 #[test]
 fn fandisk_cuts_end_to_end() {
+    require_shared!();
     let dir = scratch("fandisk-cli");
     std::fs::write(
         dir.join("fandisk.toml"),

@@ -3,8 +3,7 @@
 //! triangle against the flat sheet, a helix must give a circular cylinder, and a sheet that
 //! would hold a point of the curve of regression is refused with exit 1 and the position.
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::geom::curve::Curve;
 use flatcut::output::hpgl;
 use flatcut::surface::geodesic::{

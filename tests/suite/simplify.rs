@@ -5,8 +5,7 @@
 //!
 //! Figures are printed (`cargo test --release --test simplify -- --nocapture`).
 
-mod common;
-use common::*;
+use crate::common::*;
 use flatcut::flatten::Flat;
 use flatcut::geom::polygon;
 use flatcut::pattern::{Piece, SeamSide};
@@ -303,16 +302,19 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
 
 #[test]
 fn fandisk_seams_simplified_within_half_a_millimetre() {
+    require_shared!();
     check("fandisk", "fandisk.obj", 100.0, 0.5);
 }
 
 #[test]
 fn mushroom_seams_simplified_within_half_a_millimetre() {
+    require_shared!();
     check("mushroom", "mushroom.obj", 300.0, 0.5);
 }
 
 #[test]
 fn simplify_zero_keeps_every_mesh_edge() {
+    require_shared!();
     let dir = scratch("simplify-zero");
     let (flats, ps) = pieces(&spec(
         &dir,
@@ -352,6 +354,7 @@ fn simplify_zero_keeps_every_mesh_edge() {
 
 #[test]
 fn bad_simplify_values_are_refused_with_file_and_line() {
+    require_shared!();
     let dir = scratch("simplify-bad");
     let mesh = shared_data("meshes/cylinder.obj");
     for (k, value) in ["-0.5", "nan", "inf", "\"fine\"", "true"]
@@ -400,6 +403,7 @@ fn bad_simplify_values_are_refused_with_file_and_line() {
 
 #[test]
 fn report_names_vertices_deviation_and_mismatch() {
+    require_shared!();
     let dir = scratch("simplify-report");
     let path = spec(&dir, "fan.toml", "fandisk.obj", 100.0, "");
     let out = dir.join("out");

@@ -1,0 +1,22 @@
+//! The integration tests, one binary: each module is one area (the whole pipeline, the
+//! device over a pseudo-terminal, the CLI, the mesh corpus…), built and linked once.
+//! Tests that read `../shared/data` start with [`require_shared!`]: they skip on a developer's
+//! clone without it and fail when `CI` is set.
+
+#[macro_use]
+mod common;
+
+mod bent;
+mod boundary;
+mod cli;
+mod dcharts;
+mod device;
+mod fandisk;
+mod house;
+mod knife;
+mod nest;
+mod param;
+mod pattern;
+mod simplify;
+mod strip;
+mod toolpath;
