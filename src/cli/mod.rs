@@ -13,7 +13,7 @@ pub mod send;
 pub mod sim;
 
 use crate::flatten::{Flat, UnfoldOptions};
-use crate::pattern::{PatternOptions, Piece};
+use crate::pattern::Piece;
 use crate::spec::Spec;
 use crate::Error;
 use clap::{Parser, Subcommand};
@@ -172,7 +172,7 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
         }
         flats.push(flat);
     }
-    let opts = PatternOptions::from_spec(spec);
+    let opts = spec.pattern_options();
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
 }
