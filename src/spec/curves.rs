@@ -1,17 +1,8 @@
 //! Readers shared by several kinds of surface: curves (an inline list of points, or a table of
 //! kind `points`, `csv`, `circle`, `ellipse`, `rect`, `bezier` or `bspline`, see
 //! [`crate::geom::curve::Curve`]), 3D points and point lists, and `bend_lines`. Strips read
-//! their `p` and `q` with them, bent sheets their `control_points`, boundaries their loops.
-//!
-//! ```toml
-//! p = { kind = "points", points = [[0, 0], [100, 0, 5]], closed = false }
-//! p = { kind = "csv", path = "edge.csv", closed = true }   # relative to the spec's folder
-//! p = { kind = "circle", center = [0, 0, 0], radius = 100 }  # or diameter = 200
-//! p = { kind = "ellipse", center = [0, 0, 150], rx = 80, ry = 50 }
-//! p = { kind = "rect", center = [0, 0, 0], width = 400, height = 300, corner_radius = 0 }
-//! p = { kind = "bezier", control = [[0, 0, 0], [50, 80, 0], [100, 0, 20]] }
-//! p = { kind = "bspline", control = [...], degree = 3, closed = false }
-//! ```
+//! their `p` and `q` with them, bent sheets their `control_points`, boundaries their loops
+//! (the format is in [`super`]'s doc, under Strips).
 //!
 //! Choices: points have 2 or 3 coordinates (z = 0 when left out); a table without `kind` but
 //! with `points` is a point list; a curve's keys are checked here and its messages name the

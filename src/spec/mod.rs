@@ -155,8 +155,8 @@ mod names;
 mod spanned;
 mod strip;
 
-/// The stage types a spec is made of, defined by the stages that read them (mostly
-/// `surface`), re-exported here beside the schema that holds them.
+// The stage types a spec is made of, defined by the stages that read them (mostly `surface`),
+// re-exported here beside the schema that holds them.
 pub use crate::surface::geodesic::BentSpec;
 pub use crate::surface::{
     ApproximateSpec, BoundarySpec, Fixed, Material, MaterialKind, Segment, SegmentSpec, SheetSide,
