@@ -26,7 +26,7 @@ pub enum MaterialKind {
 
 impl MaterialKind {
     /// The names a spec file and the command line use, in the order messages list them.
-    pub const NAMES: [(&'static str, MaterialKind); 3] = [
+    pub(crate) const NAMES: [(&'static str, MaterialKind); 3] = [
         ("paper", MaterialKind::Paper),
         ("fabric", MaterialKind::Fabric),
         ("metal", MaterialKind::Metal),

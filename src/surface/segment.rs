@@ -34,7 +34,7 @@ pub enum Segment {
 
 impl Segment {
     /// The names a spec file and the command line use.
-    pub const NAMES: [(&'static str, Segment); 2] =
+    pub(crate) const NAMES: [(&'static str, Segment); 2] =
         [("faces", Segment::Faces), ("dcharts", Segment::Dcharts)];
 }
 

@@ -79,7 +79,7 @@ pub enum SheetSide {
 }
 
 impl SheetSide {
-    pub const NAMES: [(&'static str, SheetSide); 3] = [
+    pub(crate) const NAMES: [(&'static str, SheetSide); 3] = [
         ("outside", SheetSide::Outside),
         ("inside", SheetSide::Inside),
         ("neutral", SheetSide::Neutral),
@@ -140,7 +140,7 @@ pub enum Units {
 
 impl SurfaceKind {
     /// The names a spec file and the command line use, in the order messages list them.
-    pub const NAMES: [(&'static str, SurfaceKind); 4] = [
+    pub(crate) const NAMES: [(&'static str, SurfaceKind); 4] = [
         ("mesh", SurfaceKind::Mesh),
         ("strip", SurfaceKind::Strip),
         ("bent-sheet", SurfaceKind::BentSheet),
@@ -165,7 +165,7 @@ impl fmt::Display for SurfaceKind {
 
 impl Units {
     /// The names a spec file uses, in the order messages list them.
-    pub const NAMES: [(&'static str, Units); 4] = [
+    pub(crate) const NAMES: [(&'static str, Units); 4] = [
         ("mm", Units::Mm),
         ("cm", Units::Cm),
         ("m", Units::M),
