@@ -21,7 +21,7 @@ use crate::device::profile::Profile;
 use crate::flatten::Flat;
 use crate::nest::Layout;
 use crate::output::report::{self, RunInfo};
-use crate::pattern::{PatternOptions, Piece};
+use crate::pattern::Piece;
 use crate::spec::{MaterialKind, Spec};
 use crate::toolpath::{Job, StrokeKind, ToolpathOptions};
 use crate::Error;
@@ -112,7 +112,7 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
         }
         flats.push(flat);
     }
-    let opts = PatternOptions::from_spec(spec);
+    let opts = spec.pattern_options();
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
 }

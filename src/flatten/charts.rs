@@ -63,8 +63,8 @@ use super::param::{self, ParamMethod};
 use super::{unfold, Flat, FlattenError, UnfoldOptions};
 use crate::geom::mesh::{Face, Mesh, Topology};
 use crate::geom::polygon;
-use crate::spec::MaterialKind;
 use crate::surface::dcharts::{self, bisect, disk_cuts, open, split_between, Graph};
+use crate::surface::MaterialKind;
 use crate::surface::Surface;
 use glam::DVec2;
 

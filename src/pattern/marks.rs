@@ -32,7 +32,7 @@
 use super::{EdgeMark, FoldKind, Notch, PatternOptions, Piece};
 use crate::flatten::Flat;
 use crate::geom::{font, polygon};
-use crate::spec::MaterialKind;
+use crate::surface::MaterialKind;
 use glam::DVec2;
 use std::collections::HashMap;
 

@@ -23,7 +23,7 @@ pub mod bends;
 
 use crate::flatten::Flat;
 use crate::geom::polygon;
-use crate::spec::MaterialKind;
+use crate::surface::MaterialKind;
 use glam::DVec2;
 use serde::Serialize;
 
@@ -148,37 +148,6 @@ impl PatternOptions {
 }
 
 impl PatternOptions {
-    /// The material's defaults with the spec's `[pattern]` settings on top.
-    pub fn from_spec(spec: &crate::spec::Spec) -> Self {
-        let p = &spec.pattern;
-        let mut o = PatternOptions::for_material(spec.material.kind);
-        o.fold_threshold_deg = p.fold_threshold_deg;
-        if let Some(t) = p.tabs {
-            o.tabs = t;
-        }
-        if let Some(h) = p.tab_height {
-            o.tab_height = h;
-        }
-        if let Some(a) = p.allowance {
-            o.allowance = a;
-        }
-        if let Some(n) = p.notches {
-            o.notches = (n > 0.0).then_some(n);
-        }
-        if let Some(k) = p.kerf {
-            o.kerf = k;
-        }
-        if let Some(b) = p.bend_notches {
-            o.bend_notches = b;
-        }
-        o.simplify_surfaces = spec
-            .surfaces
-            .iter()
-            .filter_map(|s| s.segment.simplify.map(|t| (s.name.clone(), t)))
-            .collect();
-        o
-    }
-
     /// The simplification tolerance (mm) for a surface: its own, else the default.
     pub fn simplify_for(&self, surface: &str) -> f64 {
         self.simplify_surfaces

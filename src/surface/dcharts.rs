@@ -973,9 +973,9 @@ pub const CREASE_DEG: f64 = 20.0;
 /// parameterised triangle by triangle.
 pub fn apply(
     surface: &mut super::Surface,
-    seg: &crate::spec::SegmentSpec,
+    seg: &crate::surface::SegmentSpec,
 ) -> Result<(), super::SurfaceError> {
-    use crate::spec::{Fixed, Segment};
+    use crate::surface::{Fixed, Segment};
     let invalid = |message: String| super::SurfaceError::Invalid {
         path: surface.source.clone(),
         message: format!("surface `{}`: {message}", surface.name),

@@ -26,8 +26,8 @@
 //! side and every bend of a convex fitting is a mountain there (BEND_DOWN in the DXF).
 
 use crate::geom::curve::{circle_segments, Curve};
-use crate::spec::StripSpec;
 use crate::surface::strip::{BendLines, Method};
+use crate::surface::StripSpec;
 use glam::DVec3;
 
 /// A fitting and its dimensions (mm, degrees for angles).
@@ -430,7 +430,7 @@ impl Fitting {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spec::{SurfaceKind, SurfaceSpec, Units};
+    use crate::surface::{SurfaceKind, SurfaceSpec, Units};
     use std::f64::consts::PI;
 
     fn surface(f: &Fitting, opts: &FittingOptions) -> crate::surface::Surface {

@@ -11,12 +11,17 @@ pub mod dcharts;
 pub mod dcs;
 pub mod fittings;
 pub mod geodesic;
+pub mod material;
 pub mod obj;
+pub mod segment;
 pub mod solids;
+pub mod source;
 pub mod strip;
 
 use crate::geom::mesh::Mesh;
-use crate::spec::{SurfaceKind, SurfaceSpec};
+pub use material::{Material, MaterialKind};
+pub use segment::{ApproximateSpec, Fixed, Segment, SegmentSpec};
+pub use source::{BoundarySpec, SheetSide, StripSpec, SurfaceKind, SurfaceSpec, Units};
 use std::path::PathBuf;
 
 /// A developable surface made of flat polygon panels.
