@@ -6,8 +6,7 @@
 //! `layout.placed_items[].transformation` = mirror in x if `reflected`, rotate about the origin
 //! by `rotation` degrees, translate) and [`svg`] draws it.
 
-use super::engine::Orient;
-use super::problem::{self, Container, Item, Orients, Problem, Solution};
+use super::problem::{self, Container, Item, Orient, Orients, Problem, Solution};
 use glam::DVec2;
 use serde::Deserialize;
 use serde_json::json;
@@ -203,7 +202,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Instance, EsicupError> {
 
 /// Nest an instance.
 pub fn solve(inst: &Instance, cfg: &problem::Config) -> Result<Solution, EsicupError> {
-    problem::solve(&inst.problem, cfg).map_err(|u| EsicupError::Item {
+    super::solve::solve(&inst.problem, cfg).map_err(|u| EsicupError::Item {
         path: PathBuf::from(&inst.name),
         item: inst.ids.get(u.item).copied().unwrap_or(-1),
         msg: "it does not fit in the strip".into(),

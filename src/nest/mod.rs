@@ -2,19 +2,21 @@
 //! overlap, inside the margins and with the requested spacing between pieces, as a
 //! [`Layout`] — densely, in the manner of the current state of the art for irregular nesting.
 //!
-//! The method (details and sources in each file):
-//! - [`engine`]: exact `f64` collision detection between polygons with holes, with spacing, and
-//!   the pole-based overlap proxy of sparrow (Gardeyn, Vanden Berghe, Wauters 2025) — our own
-//!   instead of jagua-rs (f32, no holes); see its docs for why.
-//! - [`construct`]: bottom-left fill as the constructive start.
-//! - [`improve`]: guided local search on weighted overlaps (the "separator" of sparrow), strip
-//!   exploration and compression for rolls; for sheets, emptying the last sheet into the
-//!   others, then compressing the last sheet toward its left edge so that its remnant is one
-//!   rectangle ([`Layout::remnant`]).
-//! - [`problem`]: the problem as the optimiser sees it, the deterministic work budget, and the
-//!   independent searches on several threads (best kept).
+//! The files (details and sources in each):
+//! - [`problem`]: the problem as data — items with their allowed orientations, the container
+//!   (a strip or bins), the spacing, the search settings and the solution.
+//! - [`solve`](mod@solve): the solver — independent searches on several threads (the best kept),
+//!   each a constructive start (bottom-left fill) and then the improvement: guided local
+//!   search on weighted overlaps (the "separator" of sparrow, Gardeyn, Vanden Berghe, Wauters
+//!   2025), strip exploration and compression for rolls; for sheets, emptying the last sheet
+//!   into the others, then compressing the last sheet toward its left edge so that its remnant
+//!   is one rectangle ([`Layout::remnant`]); the deterministic work budget.
+//! - `collision`: exact `f64` collision detection between polygons with holes, with spacing,
+//!   and the pole-based overlap proxy of sparrow — our own instead of jagua-rs (f32, no holes);
+//!   see its docs for why.
 //! - [`esicup`]: the ESICUP benchmark instances (JSON as used by jagua-rs and sparrow), their
 //!   solutions and pictures, for `flatcut nest`.
+//! - [`bench`]: the few solver steps the benchmarks in `benches/nest.rs` time.
 //!
 //! flatcut's pieces: the polygon nested is the cut outline (`outline[0]`, with the holes
 //! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it.
@@ -29,17 +31,16 @@
 //!
 //! Same inputs, seed and thread count give the same layout (see [`problem`]).
 
-pub mod construct;
-pub mod engine;
+pub mod bench;
+pub(crate) mod collision;
 pub mod esicup;
-pub mod improve;
 pub mod problem;
+pub(crate) mod solve;
 
 use crate::geom::polygon;
 use crate::pattern::Piece;
-use engine::Orient;
 use glam::DVec2;
-use problem::{Container, Item, Orients, Problem};
+use problem::{Container, Item, Orient, Orients, Problem};
 
 /// Allowed rotations of a piece, in degrees counter-clockwise.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,7 +137,7 @@ impl Placement {
         // Exact for quarter turns, so that rectangles stay edge to edge.
         let q = self.rotation / std::f64::consts::FRAC_PI_2;
         let r = if (q - q.round()).abs() < 1e-12 {
-            engine::rotor(90.0 * q.round())
+            collision::rotor(90.0 * q.round())
         } else {
             DVec2::from_angle(self.rotation)
         };
@@ -321,7 +322,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         seed: opts.seed,
         threads: opts.threads,
     };
-    let sol = problem::solve(&prob, &cfg).map_err(|u| {
+    let sol = solve::solve(&prob, &cfg).map_err(|u| {
         let piece = &pieces[u.item.min(pieces.len().saturating_sub(1))];
         let pts: Vec<DVec2> = piece.points().collect();
         let r = DVec2::from_angle(polygon::min_area_rect_angle(&pts));
@@ -430,9 +431,8 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
     for (k, (p, at)) in layout.pieces.iter().zip(&layout.placements).enumerate() {
         let s = &layout.sheets[at.sheet];
         for q in p.points().map(|q| at.apply(q)) {
-            // Marks on the border may lie a little outside the cut outline, which drops
-            // features below what a knife cuts (`CLEAN_MM`, pattern/allowance.rs).
-            let tol = crate::pattern::allowance::CLEAN_MM;
+            // Marks on the border may lie a little outside the cut outline.
+            let tol = Piece::OVERHANG_MM;
             if q.x < m - tol || q.y < m - tol || q.x > s.width - m + tol || q.y > s.height - m + tol
             {
                 return Err(format!(
@@ -443,11 +443,11 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
         }
     }
     let mut work = 0;
-    let shapes: Vec<engine::Shape> = placed
+    let shapes: Vec<collision::Shape> = placed
         .iter()
         .map(|rings| {
-            let poles = engine::poles(rings);
-            engine::Shape::new(
+            let poles = collision::poles(rings);
+            collision::Shape::new(
                 rings,
                 &poles,
                 Orient {
@@ -464,7 +464,7 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
             }
             let (a, b) = (&shapes[i], &shapes[j]);
             // Shapes are shifted to start at 0: undo it.
-            let near = engine::collide(
+            let near = collision::collide(
                 a,
                 -a.shift,
                 b,

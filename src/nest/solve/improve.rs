@@ -10,15 +10,15 @@
 //! from 25 % down to 2 % of the item's smaller side, along x, y or a diagonal, growing × 1.1 on
 //! success and halving on failure), then refines the best of those more finely (1 % down to
 //! 0.1 %) — sparrow's sampling and two-stage refinement. Overlap between two items is the
-//! pole-based proxy of [`super::engine::overlap_proxy`], counted only for pairs that collide
-//! exactly. After every sweep the pair weights grow where the pair still overlaps (× 1.2 … 2,
-//! more for the pairs that overlap most) and decay back towards 1 elsewhere (× 0.95): this
-//! guided local search escapes the local minima that plain overlap minimisation sticks in.
-//! A run of sweeps ends after 25 sweeps without a new least overlap (one at least 2 % lower
-//! restarts the count) and is a strike unless it lowered the overlap by 2 %; the least
-//! overlapping layout is restored, weights kept, and after 3 strikes in a row the separator
-//! gives up (in compression: 5 strikes of 100 sweeps, as sparrow); zero overlap is a feasible
-//! layout.
+//! pole-based proxy of [`crate::nest::collision::overlap_proxy`], counted only for pairs that
+//! collide exactly. After every sweep the pair weights grow where the pair still overlaps
+//! (× 1.2 … 2, more for the pairs that overlap most) and decay back towards 1 elsewhere
+//! (× 0.95): this guided local search escapes the local minima that plain overlap
+//! minimisation sticks in. A run of sweeps ends after 25 sweeps without a new least overlap
+//! (one at least 2 % lower restarts the count) and is a strike unless it lowered the overlap
+//! by 2 %; the least overlapping layout is restored, weights kept, and after 3 strikes in a row
+//! the separator gives up (in compression: 5 strikes of 100 sweeps, as sparrow); zero overlap
+//! is a feasible layout.
 //!
 //! **Strip** ([`optimise_strip`]): exploration (90 % of the budget, as in sparrow), then
 //! compression. Exploration shrinks the best feasible strip by 0.1 % by cutting a slice out at
@@ -37,36 +37,19 @@
 //! the bin's, so that what is left of it is one rectangle at its right end.
 //!
 //! Choices where sparrow is silent or differs: one search per thread (sparrow runs several
-//! workers inside one separator sweep and keeps the best; tried here with one worker per
-//! thread, it gave 88.04 % on albano at 60 s against 88.69 % for two independent searches,
-//! and the hand-over every sweep cost wall time); the pool keeps at most 64 layouts; a move stops sampling as
-//! soon as it finds a place without overlap; "large" items are those with at least the median
-//! area (sparrow: a convex-hull-area percentile); samples closer than 5 % of the item's smaller
-//! side count as one; weights persist across strikes within one separation and start at 1.
-//! Tuned on albano at 60 s (four seeds, one thread): patience 10 / 25 / 50 / 100 gave 87.76 /
-//! 88.16 / 88.12 / 88.05 %; a 95 % exploration share 88.31 %. Tried since and not kept (two
-//! threads, seeds 1–6 unless said, mean), against 88.89 % (88.37–89.50) before sparrow's
-//! compression: halving the exploration shrink after 25 failures in a row at one length,
-//! 88.89 % (after 10 failures, seeds 1–3: 88.57 %); a 50 % exploration share, 88.84 % (30 %,
-//! seeds 1–3: 88.69 %); one try in four a fresh cut of the best instead of a draw from the
-//! pool, 88.43 % (seeds 1–4); seeds 1–3 against 88.74 %: 16 poles per item 88.46 %, more
-//! poles where they cover less than 90 % 88.37 %, sideways moves in the coordinate descent
-//! 88.42 %, sparrow's factor π on the pole sum 88.57 %, the exploration cut at the middle of
-//! the strip (as sparrow cuts) 88.24 %. Sparrow's compression (a ratio falling with the budget
-//! instead of a random one below it; 5 strikes of 100 sweeps instead of 2 of 25) gave 89.03 %
-//! (88.32–89.50) and is kept. With it, not kept: the two searches handing each other the
-//! shorter layout at three points of the budget, 88.98 %; an 80 % exploration share,
-//! 89.00 %; sparrow's large items (the largest that make up 75 % of the area), 88.65 %; 25
-//! container samples 88.47 % (100, seed 1: 87.96 %); three workers per sweep in one thread,
-//! the best kept, 88.20 % (seeds 1–3); exploration patience 50, 88.57 %; 4 strikes in
-//! exploration 88.32 % (2, seeds 1–4: 88.58 %).
-//! The spread between seeds (about ±0.4) is larger than most of these differences. A trace
-//! shows why: a run finds its length in bursts (after one lucky separation, the next two or
-//! three shrinks succeed at once) and stays at one length for up to a third of the budget
-//! between them.
+//! workers inside one separator sweep and keeps the best; here the searches are independent,
+//! which needs no hand-over between threads every sweep); the pool keeps at most 64 layouts;
+//! a move stops sampling as soon as it finds a place without overlap; "large" items are those
+//! with at least the median area (sparrow: a convex-hull-area percentile); the exploration
+//! cuts at a random x (sparrow cuts at the middle of the strip); samples closer than 5 % of
+//! the item's smaller side count as one; weights persist across strikes within one separation
+//! and start at 1. The item moves ([`Item::random_shape`], [`Item::nearby_shape`]) draw a
+//! random allowed orientation, or keep the current one or turn it by up to 10°.
 
-use super::engine::{boxes_near, collide, in_material, overlap_proxy, Placed};
-use super::problem::{Container, Ctx, State};
+use super::state::{Ctx, State};
+use crate::geom::rng::Rng;
+use crate::nest::collision::{boxes_near, collide, in_material, overlap_proxy, Placed, Shape};
+use crate::nest::problem::{Container, Item, Orient, Orients};
 use glam::DVec2;
 use std::sync::Arc;
 
@@ -83,6 +66,47 @@ const EXPLORE_STEP: f64 = 0.001;
 /// The compression separator's strikes and patience (sparrow's).
 const COMPRESS_STRIKES: usize = 5;
 const COMPRESS_PATIENCE: usize = 100;
+
+/// The moves of an item in the separator (module docs).
+impl Item {
+    /// A random allowed shape.
+    pub(crate) fn random_shape(&self, rng: &mut Rng) -> Arc<Shape> {
+        match &self.orients {
+            Orients::Set(_) => self.shapes[rng.below(self.shapes.len())].clone(),
+            Orients::Free { mirror } => {
+                let o = Orient {
+                    deg: rng.range(0.0, 360.0),
+                    mirror: *mirror && rng.f64() < 0.5,
+                };
+                Arc::new(Shape::new(&self.rings, &self.poles, o))
+            }
+        }
+    }
+
+    /// A shape near `cur`: the same, or (free rotation) turned by a few degrees.
+    pub(crate) fn nearby_shape(&self, cur: &Arc<Shape>, rng: &mut Rng) -> Arc<Shape> {
+        match &self.orients {
+            Orients::Set(_) => {
+                if rng.f64() < 0.8 {
+                    cur.clone()
+                } else {
+                    self.random_shape(rng)
+                }
+            }
+            Orients::Free { .. } => {
+                if rng.f64() < 0.5 {
+                    cur.clone()
+                } else {
+                    let o = Orient {
+                        deg: (cur.orient.deg + rng.range(-10.0, 10.0)).rem_euclid(360.0),
+                        mirror: cur.orient.mirror,
+                    };
+                    Arc::new(Shape::new(&self.rings, &self.poles, o))
+                }
+            }
+        }
+    }
+}
 
 /// Pair overlaps and weights of one state.
 struct Sep {
@@ -360,7 +384,7 @@ fn move_overlapping(
 
 /// One iteration of the separator (for the benchmark): every overlapping item of `st` moves
 /// once, then the weights are updated; returns the overlap left.
-pub fn sweep(ctx: &mut Ctx, st: &mut State, len: f64) -> f64 {
+pub(crate) fn sweep(ctx: &mut Ctx, st: &mut State, len: f64) -> f64 {
     let mut sep = Sep::new(ctx, st);
     move_overlapping(ctx, st, &mut sep, len, &mut Vec::new());
     sep.update_weights();
@@ -375,7 +399,13 @@ pub fn sweep(ctx: &mut Ctx, st: &mut State, len: f64) -> f64 {
 /// is at least 2 % lower restarts the count); it is a strike unless it lowered the overlap
 /// by 2 % from where it started; after `strikes` strikes in a row the separator gives up.
 /// Every run restarts from the least-overlapping layout with the weights it has reached.
-pub fn separate(ctx: &mut Ctx, st: &mut State, len: f64, strikes: usize, patience: usize) -> f64 {
+pub(crate) fn separate(
+    ctx: &mut Ctx,
+    st: &mut State,
+    len: f64,
+    strikes: usize,
+    patience: usize,
+) -> f64 {
     let mut sep = Sep::new(ctx, st);
     let mut min_loss = sep.total();
     if min_loss == 0.0 {
@@ -417,7 +447,7 @@ pub fn separate(ctx: &mut Ctx, st: &mut State, len: f64, strikes: usize, patienc
 
 /// Cut a slice `delta` wide out at a random x of a layout `len` long: items right of the cut
 /// move left; every item is kept inside the new length. None if an item cannot fit.
-pub fn shrink(ctx: &mut Ctx, st: &State, len: f64, new_len: f64) -> Option<State> {
+pub(crate) fn shrink(ctx: &mut Ctx, st: &State, len: f64, new_len: f64) -> Option<State> {
     let delta = len - new_len;
     let cut = ctx.rng.range(0.0, new_len);
     let mut out = st.clone();
@@ -436,7 +466,7 @@ pub fn shrink(ctx: &mut Ctx, st: &State, len: f64, new_len: f64) -> Option<State
 
 /// Shortest feasible layout found within the budget; `st` must be feasible and at most
 /// `max_len` long.
-pub fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
+pub(crate) fn optimise_strip(ctx: &mut Ctx, st: State, max_len: f64) -> State {
     let mut best = st;
     if best.placed.len() <= 1 {
         return best;
@@ -565,7 +595,7 @@ fn disrupt(ctx: &mut Ctx, st: &mut State, len: f64) {
 }
 
 /// Fewer bins, then the last one short (see the module docs).
-pub fn optimise_bins(ctx: &mut Ctx, mut bins: Vec<State>, len: f64) -> Vec<State> {
+pub(crate) fn optimise_bins(ctx: &mut Ctx, mut bins: Vec<State>, len: f64) -> Vec<State> {
     let Container::Bins { height, .. } = ctx.prob.container else {
         return bins;
     };
