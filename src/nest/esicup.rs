@@ -141,13 +141,13 @@ pub fn parse(text: &str, path: &Path) -> Result<Instance, EsicupError> {
             Some(v) if !v.is_empty() => Orients::Set(
                 v.iter()
                     .map(|d| Orient {
-                        deg: *d,
+                        angle_deg: *d,
                         mirror: false,
                     })
                     .collect(),
             ),
             Some(_) => Orients::Set(vec![Orient {
-                deg: 0.0,
+                angle_deg: 0.0,
                 mirror: false,
             }]),
             None => Orients::Free { mirror: false },
@@ -234,7 +234,7 @@ pub fn solution_json(inst: &Instance, sol: &Solution) -> serde_json::Value {
             json!({
                 "item_id": inst.ids[k],
                 "transformation": {
-                    "rotation": p.orient.deg,
+                    "rotation": p.orient.angle_deg,
                     "translation": [p.translation.x, p.translation.y],
                     "reflected": p.orient.mirror,
                 }

@@ -5,7 +5,7 @@
 //! The files (details and sources in each):
 //! - [`problem`]: the problem as data — items with their allowed orientations, the container
 //!   (a strip or bins), the spacing, the search settings and the solution.
-//! - [`solve`](mod@solve): the solver — independent searches on several threads (the best kept),
+//! - `solve`: the solver — independent searches on several threads (the best kept),
 //!   each a constructive start (bottom-left fill) and then the improvement: guided local
 //!   search on weighted overlaps (the "separator" of sparrow, Gardeyn, Vanden Berghe, Wauters
 //!   2025), strip exploration and compression for rolls; for sheets, emptying the last sheet
@@ -19,7 +19,8 @@
 //! - [`bench`]: the few solver steps the benchmarks in `benches/nest.rs` time.
 //!
 //! flatcut's pieces: the polygon nested is the cut outline (`outline[0]`, with the holes
-//! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it.
+//! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it (up to
+//! [`Piece::OVERHANG_MM`]).
 //! Orientations per piece come from [`NestOptions::rotations`] (a set, a step or free; per-piece
 //! overrides in [`NestOptions::piece_rotations`]), doubled by mirror images when
 //! [`NestOptions::mirror`]; a piece with a grain line may only turn so that the grain runs along
@@ -29,7 +30,11 @@
 //! optimiser's strip (length along its x) is the roll turned by 90°, so the length used runs
 //! along the sheet's y axis as before.
 //!
-//! Same inputs, seed and thread count give the same layout (see [`problem`]).
+//! Units: [`Placement::rotation`] is in radians; the rotations a user allows ([`Rotations`])
+//! and the search's orientations ([`problem::Orient`], see why there) are in degrees.
+//!
+//! Same inputs, seed and thread count give the same layout: the searches count work instead
+//! of reading the clock (see `solve/state.rs`).
 
 pub mod bench;
 pub(crate) mod collision;
@@ -229,7 +234,7 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
             };
             for base in [90.0, 270.0] {
                 v.push(Orient {
-                    deg: (base - g).rem_euclid(360.0),
+                    angle_deg: (base - g).rem_euclid(360.0),
                     mirror: m,
                 });
             }
@@ -250,7 +255,7 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
                 .iter()
                 .flat_map(|&m| {
                     d.iter().map(move |&deg| Orient {
-                        deg: deg.rem_euclid(360.0),
+                        angle_deg: deg.rem_euclid(360.0),
                         mirror: m,
                     })
                 })
@@ -295,7 +300,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
             Orients::Set(v) => Orients::Set(
                 v.into_iter()
                     .map(|o| Orient {
-                        deg: to_internal(o.deg).rem_euclid(360.0),
+                        angle_deg: to_internal(o.angle_deg).rem_euclid(360.0),
                         mirror: o.mirror,
                     })
                     .collect(),
@@ -349,14 +354,14 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
                 let t = p.translation;
                 Placement {
                     sheet: 0,
-                    rotation: (p.orient.deg + 90.0).rem_euclid(360.0).to_radians(),
+                    rotation: (p.orient.angle_deg + 90.0).rem_euclid(360.0).to_radians(),
                     mirror: p.orient.mirror,
                     offset: DVec2::new(-t.y, t.x) + DVec2::new(m + uw, m),
                 }
             } else {
                 Placement {
                     sheet: p.bin,
-                    rotation: p.orient.deg.to_radians(),
+                    rotation: p.orient.angle_deg.to_radians(),
                     mirror: p.orient.mirror,
                     offset: p.translation + DVec2::splat(m),
                 }
@@ -451,7 +456,7 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
                 rings,
                 &poles,
                 Orient {
-                    deg: 0.0,
+                    angle_deg: 0.0,
                     mirror: false,
                 },
             )

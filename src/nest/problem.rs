@@ -1,8 +1,8 @@
 //! The nesting problem as data, independent of flatcut's pieces and of the ESICUP files: items
 //! (polygons with holes and their allowed orientations), a container (a strip of fixed height
 //! and free length, or bins of fixed size), the spacing; the search settings ([`Config`]) and
-//! what a search returns ([`Solution`], or the item that fits in no orientation, [`Unfit`]).
-//! The solver is [`super::solve`].
+//! what a search returns ([`Solution`], or the item that fits in no orientation, `Unfit`).
+//! The solver is `nest::solve`.
 //!
 //! An [`Item`] also keeps what every search reads and never changes: its area, its poles and
 //! the shapes of the orientations the construction tries (computed once, when the item is
@@ -58,7 +58,7 @@ impl Item {
                     }
                     for q in 0..4 {
                         v.push(Orient {
-                            deg: (a + 90.0 * q as f64).rem_euclid(360.0),
+                            angle_deg: (a + 90.0 * q as f64).rem_euclid(360.0),
                             mirror: m,
                         });
                     }
@@ -148,7 +148,7 @@ pub struct Solution {
 
 /// An item that fits the container in no allowed orientation.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Unfit {
+pub(crate) struct Unfit {
     pub item: usize,
     pub size: DVec2,
 }
@@ -168,7 +168,7 @@ pub(crate) fn check_fit(prob: &Problem) -> Result<(), Unfit> {
                 it.shapes.iter().any(|s| fits(s))
                     || (0..360).any(|d| {
                         let o = Orient {
-                            deg: d as f64,
+                            angle_deg: d as f64,
                             mirror: *mirror,
                         };
                         fits(&Shape::new(&it.rings, &[], o))

@@ -139,7 +139,7 @@ mod tests {
             &rings,
             &p,
             Orient {
-                deg: 0.0,
+                angle_deg: 0.0,
                 mirror: false,
             },
         )

@@ -13,10 +13,16 @@ use crate::geom::segment::point_segment_dist2;
 use glam::DVec2;
 use std::sync::Arc;
 
-/// Rotation (degrees, counter-clockwise) after an optional mirror `x → −x`.
+/// Rotation (counter-clockwise) after an optional mirror `x → −x`.
+///
+/// The one angle of the stage kept in degrees: the search draws and perturbs orientations in
+/// degrees (a uniform draw below 360, a turn by up to ±10°, reduced modulo 360), multiples of
+/// 90° are recognised exactly there (`rotor`), and ESICUP instances and solutions give
+/// degrees; the layout's [`crate::nest::Placement::rotation`] is in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orient {
-    pub deg: f64,
+    /// Degrees, counter-clockwise.
+    pub angle_deg: f64,
     pub mirror: bool,
 }
 
@@ -44,7 +50,7 @@ impl Orient {
         } else {
             p
         };
-        rotor(self.deg).rotate(p)
+        rotor(self.angle_deg).rotate(p)
     }
 }
 

@@ -75,7 +75,7 @@ impl Item {
             Orients::Set(_) => self.shapes[rng.below(self.shapes.len())].clone(),
             Orients::Free { mirror } => {
                 let o = Orient {
-                    deg: rng.range(0.0, 360.0),
+                    angle_deg: rng.range(0.0, 360.0),
                     mirror: *mirror && rng.f64() < 0.5,
                 };
                 Arc::new(Shape::new(&self.rings, &self.poles, o))
@@ -98,7 +98,8 @@ impl Item {
                     cur.clone()
                 } else {
                     let o = Orient {
-                        deg: (cur.orient.deg + rng.range(-10.0, 10.0)).rem_euclid(360.0),
+                        angle_deg: (cur.orient.angle_deg + rng.range(-10.0, 10.0))
+                            .rem_euclid(360.0),
                         mirror: cur.orient.mirror,
                     };
                     Arc::new(Shape::new(&self.rings, &self.poles, o))

@@ -98,7 +98,7 @@ fn search(ctx: &mut Ctx, thread: usize) -> Option<Solution> {
         ItemPlacement {
             bin: 0,
             orient: Orient {
-                deg: 0.0,
+                angle_deg: 0.0,
                 mirror: false
             },
             translation: DVec2::ZERO,
