@@ -18,35 +18,28 @@ pub trait Point: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Outpu
     fn distance_squared(self, o: Self) -> f64;
 }
 
-impl Point for DVec2 {
-    #[inline]
-    fn dot(self, o: Self) -> f64 {
-        DVec2::dot(self, o)
-    }
-    #[inline]
-    fn length_squared(self) -> f64 {
-        DVec2::length_squared(self)
-    }
-    #[inline]
-    fn distance_squared(self, o: Self) -> f64 {
-        DVec2::distance_squared(self, o)
-    }
+/// Implements [`Point`] with the type's own glam methods.
+macro_rules! impl_point {
+    ($t:ty) => {
+        impl Point for $t {
+            #[inline]
+            fn dot(self, o: Self) -> f64 {
+                <$t>::dot(self, o)
+            }
+            #[inline]
+            fn length_squared(self) -> f64 {
+                <$t>::length_squared(self)
+            }
+            #[inline]
+            fn distance_squared(self, o: Self) -> f64 {
+                <$t>::distance_squared(self, o)
+            }
+        }
+    };
 }
 
-impl Point for DVec3 {
-    #[inline]
-    fn dot(self, o: Self) -> f64 {
-        DVec3::dot(self, o)
-    }
-    #[inline]
-    fn length_squared(self) -> f64 {
-        DVec3::length_squared(self)
-    }
-    #[inline]
-    fn distance_squared(self, o: Self) -> f64 {
-        DVec3::distance_squared(self, o)
-    }
-}
+impl_point!(DVec2);
+impl_point!(DVec3);
 
 /// Squared distance from `p` to the segment `a`–`b`.
 #[inline]

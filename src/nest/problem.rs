@@ -23,7 +23,8 @@ pub enum Orients {
     Free { mirror: bool },
 }
 
-/// An item to place.
+/// An item to place. (The separator's moves of an item, `random_shape` and `nearby_shape`, are
+/// in `solve/improve.rs`.)
 #[derive(Debug, Clone)]
 pub struct Item {
     /// Outer ring (counter-clockwise) then holes (clockwise), no repeated point.

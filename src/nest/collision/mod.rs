@@ -124,7 +124,7 @@ pub(crate) fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: 
 mod tests {
     use super::*;
 
-    fn rect(w: f64, h: f64) -> Vec<Vec<DVec2>> {
+    pub(super) fn rect(w: f64, h: f64) -> Vec<Vec<DVec2>> {
         vec![vec![
             DVec2::new(0.0, 0.0),
             DVec2::new(w, 0.0),
@@ -133,7 +133,7 @@ mod tests {
         ]]
     }
 
-    fn shape(rings: Vec<Vec<DVec2>>) -> Shape {
+    pub(super) fn shape(rings: Vec<Vec<DVec2>>) -> Shape {
         let p = poles(&rings);
         Shape::new(
             &rings,

@@ -96,30 +96,8 @@ fn overlap_proxy_lanes(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64) -> f6
 
 #[cfg(test)]
 mod tests {
-    use super::super::poles::poles;
-    use super::super::shape::Orient;
+    use super::super::tests::{rect, shape};
     use super::*;
-
-    fn rect(w: f64, h: f64) -> Vec<Vec<DVec2>> {
-        vec![vec![
-            DVec2::new(0.0, 0.0),
-            DVec2::new(w, 0.0),
-            DVec2::new(w, h),
-            DVec2::new(0.0, h),
-        ]]
-    }
-
-    fn shape(rings: Vec<Vec<DVec2>>) -> Shape {
-        let p = poles(&rings);
-        Shape::new(
-            &rings,
-            &p,
-            Orient {
-                angle_deg: 0.0,
-                mirror: false,
-            },
-        )
-    }
 
     #[test]
     fn proxy_grows_with_penetration() {
