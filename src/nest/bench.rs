@@ -6,7 +6,7 @@
 
 use super::problem::Problem;
 use super::solve::state::{Ctx, State};
-use super::solve::{construct, improve};
+use super::solve::{construct, improve, separate};
 
 /// One search: its problem, its random numbers (from `seed`) and its work budget.
 #[derive(Debug)]
@@ -44,6 +44,6 @@ impl<'a> Search<'a> {
     /// One separator sweep in a strip `len` long: every overlapping item moves once, then the
     /// weights are updated; returns the overlap left.
     pub fn sweep(&mut self, layout: &mut StripLayout, len: f64) -> f64 {
-        improve::sweep(&mut self.0, &mut layout.0, len)
+        separate::sweep(&mut self.0, &mut layout.0, len)
     }
 }

@@ -1,8 +1,8 @@
 //! The solver: [`solve`] runs independent searches, one per thread, and keeps the best; each
 //! search builds a layout with the constructive start ([`construct`]: bottom-left fill) and
-//! then improves it ([`improve`]: sparrow's separator, strip exploration and compression; for
-//! bins, emptying the last bin, then compressing it). The searches' state and deterministic
-//! work budget are in [`state`].
+//! then improves it ([`improve`]: strip exploration and compression, with sparrow's separator
+//! ([`separate`]) resolving the overlaps each shrink leaves; for bins, emptying the last bin,
+//! then compressing it). The searches' state and deterministic work budget are in [`state`].
 //!
 //! Threads: the seeds of the searches derive from the seed and the thread number; odd threads
 //! start from a different order (neighbours in the largest-first order swapped at random), so
@@ -12,6 +12,7 @@
 
 pub(crate) mod construct;
 pub(crate) mod improve;
+pub(crate) mod separate;
 pub(crate) mod state;
 
 use super::problem::{
