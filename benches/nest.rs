@@ -3,7 +3,7 @@
 //! construction on each of the five ESICUP instances in ../shared/data/nesting.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flatcut::nest::{construct, esicup, improve, problem::Ctx};
+use flatcut::nest::{bench::Search, esicup};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -34,8 +34,8 @@ fn construction(c: &mut Criterion) {
         let ord = order(&inst);
         g.bench_function(name, |b| {
             b.iter(|| {
-                let mut ctx = Ctx::new(&inst.problem, 1, 1.0);
-                black_box(construct::fill_strip(&mut ctx, &ord))
+                let mut search = Search::new(&inst.problem, 1, 1.0);
+                black_box(search.fill_strip(&ord))
             })
         });
     }
@@ -45,17 +45,17 @@ fn construction(c: &mut Criterion) {
 fn improvement(c: &mut Criterion) {
     let inst = load("shirts");
     let ord = order(&inst);
-    let mut ctx = Ctx::new(&inst.problem, 1, 1e6);
-    let st = construct::fill_strip(&mut ctx, &ord).expect("fill");
+    let mut search = Search::new(&inst.problem, 1, 1e6);
+    let st = search.fill_strip(&ord).expect("fill");
     let len = st.extent();
-    let shrunk = improve::shrink(&mut ctx, &st, len, 0.98 * len).expect("shrink");
+    let shrunk = search.shrink(&st, len, 0.98 * len).expect("shrink");
     let mut g = c.benchmark_group("nest_improve");
     g.sample_size(20);
     g.bench_function("shirts_separator_sweep", |b| {
         b.iter(|| {
             let mut s = shrunk.clone();
-            let mut ctx = Ctx::new(&inst.problem, 2, 1e6);
-            black_box(improve::sweep(&mut ctx, &mut s, 0.98 * len))
+            let mut search = Search::new(&inst.problem, 2, 1e6);
+            black_box(search.sweep(&mut s, 0.98 * len))
         })
     });
     g.finish();

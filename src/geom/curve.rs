@@ -246,14 +246,7 @@ pub fn circle_segments(r: f64, tol: f64, multiple: usize) -> usize {
 
 /// Distance from `p` to the segment `a b`.
 fn seg_dist(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let d = b - a;
-    let l2 = d.length_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + d * t)
+    super::segment::point_segment_dist2(p, a, b).sqrt()
 }
 
 /// Samples of `f` on `[t0, t1)` (the end point is left to the next span).

@@ -9,3 +9,5 @@ pub mod font;
 pub mod hull;
 pub mod mesh;
 pub mod polygon;
+pub mod rng;
+pub mod segment;

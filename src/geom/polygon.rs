@@ -238,13 +238,7 @@ pub fn is_simple_ring(ring: &[DVec2]) -> bool {
 
 /// Distance from `p` to the segment `a`–`b`.
 pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
+    super::segment::point_segment_dist2(p, a, b).sqrt()
 }
 
 /// Least distance between the segments `a`–`b` and `c`–`d` (0 when they touch or cross).
@@ -252,10 +246,7 @@ pub fn segment_segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
     if segments_intersect(a, b, c, d) {
         return 0.0;
     }
-    segment_distance(a, c, d)
-        .min(segment_distance(b, c, d))
-        .min(segment_distance(c, a, b))
-        .min(segment_distance(d, a, b))
+    super::segment::end_points_dist2(a, b, c, d).sqrt()
 }
 
 /// Even-odd containment in a set of rings (an outer ring and its holes).

@@ -6,8 +6,7 @@
 //! `layout.placed_items[].transformation` = mirror in x if `reflected`, rotate about the origin
 //! by `rotation` degrees, translate) and [`svg`] draws it.
 
-use super::engine::Orient;
-use super::problem::{self, Container, Item, Orients, Problem, Solution};
+use super::problem::{self, Container, Item, Orient, Orients, Problem, Solution};
 use glam::DVec2;
 use serde::Deserialize;
 use serde_json::json;
@@ -142,13 +141,13 @@ pub fn parse(text: &str, path: &Path) -> Result<Instance, EsicupError> {
             Some(v) if !v.is_empty() => Orients::Set(
                 v.iter()
                     .map(|d| Orient {
-                        deg: *d,
+                        angle_deg: *d,
                         mirror: false,
                     })
                     .collect(),
             ),
             Some(_) => Orients::Set(vec![Orient {
-                deg: 0.0,
+                angle_deg: 0.0,
                 mirror: false,
             }]),
             None => Orients::Free { mirror: false },
@@ -203,7 +202,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Instance, EsicupError> {
 
 /// Nest an instance.
 pub fn solve(inst: &Instance, cfg: &problem::Config) -> Result<Solution, EsicupError> {
-    problem::solve(&inst.problem, cfg).map_err(|u| EsicupError::Item {
+    super::solve::solve(&inst.problem, cfg).map_err(|u| EsicupError::Item {
         path: PathBuf::from(&inst.name),
         item: inst.ids.get(u.item).copied().unwrap_or(-1),
         msg: "it does not fit in the strip".into(),
@@ -235,7 +234,7 @@ pub fn solution_json(inst: &Instance, sol: &Solution) -> serde_json::Value {
             json!({
                 "item_id": inst.ids[k],
                 "transformation": {
-                    "rotation": p.orient.deg,
+                    "rotation": p.orient.angle_deg,
                     "translation": [p.translation.x, p.translation.y],
                     "reflected": p.orient.mirror,
                 }

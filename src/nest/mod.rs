@@ -2,22 +2,25 @@
 //! overlap, inside the margins and with the requested spacing between pieces, as a
 //! [`Layout`] — densely, in the manner of the current state of the art for irregular nesting.
 //!
-//! The method (details and sources in each file):
-//! - [`engine`]: exact `f64` collision detection between polygons with holes, with spacing, and
-//!   the pole-based overlap proxy of sparrow (Gardeyn, Vanden Berghe, Wauters 2025) — our own
-//!   instead of jagua-rs (f32, no holes); see its docs for why.
-//! - [`construct`]: bottom-left fill as the constructive start.
-//! - [`improve`]: guided local search on weighted overlaps (the "separator" of sparrow), strip
-//!   exploration and compression for rolls; for sheets, emptying the last sheet into the
-//!   others, then compressing the last sheet toward its left edge so that its remnant is one
-//!   rectangle ([`Layout::remnant`]).
-//! - [`problem`]: the problem as the optimiser sees it, the deterministic work budget, and the
-//!   independent searches on several threads (best kept).
+//! The files (details and sources in each):
+//! - [`problem`]: the problem as data — items with their allowed orientations, the container
+//!   (a strip or bins), the spacing, the search settings and the solution.
+//! - `solve`: the solver — independent searches on several threads (the best kept),
+//!   each a constructive start (bottom-left fill) and then the improvement: guided local
+//!   search on weighted overlaps (the "separator" of sparrow, Gardeyn, Vanden Berghe, Wauters
+//!   2025), strip exploration and compression for rolls; for sheets, emptying the last sheet
+//!   into the others, then compressing the last sheet toward its left edge so that its remnant
+//!   is one rectangle ([`Layout::remnant`]); the deterministic work budget.
+//! - `collision`: exact `f64` collision detection between polygons with holes, with spacing,
+//!   and the pole-based overlap proxy of sparrow — our own instead of jagua-rs (f32, no holes);
+//!   see its docs for why.
 //! - [`esicup`]: the ESICUP benchmark instances (JSON as used by jagua-rs and sparrow), their
 //!   solutions and pictures, for `flatcut nest`.
+//! - [`bench`]: the few solver steps the benchmarks in `benches/nest.rs` time.
 //!
 //! flatcut's pieces: the polygon nested is the cut outline (`outline[0]`, with the holes
-//! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it.
+//! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it (up to
+//! [`Piece::OVERHANG_MM`]).
 //! Orientations per piece come from [`NestOptions::rotations`] (a set, a step or free; per-piece
 //! overrides in [`NestOptions::piece_rotations`]), doubled by mirror images when
 //! [`NestOptions::mirror`]; a piece with a grain line may only turn so that the grain runs along
@@ -27,19 +30,22 @@
 //! optimiser's strip (length along its x) is the roll turned by 90°, so the length used runs
 //! along the sheet's y axis as before.
 //!
-//! Same inputs, seed and thread count give the same layout (see [`problem`]).
+//! Units: [`Placement::rotation`] is in radians; the rotations a user allows ([`Rotations`])
+//! and the search's orientations ([`problem::Orient`], see why there) are in degrees.
+//!
+//! Same inputs, seed and thread count give the same layout: the searches count work instead
+//! of reading the clock (see `solve/state.rs`).
 
-pub mod construct;
-pub mod engine;
+pub mod bench;
+pub(crate) mod collision;
 pub mod esicup;
-pub mod improve;
 pub mod problem;
+pub(crate) mod solve;
 
 use crate::geom::polygon;
 use crate::pattern::Piece;
-use engine::Orient;
 use glam::DVec2;
-use problem::{Container, Item, Orients, Problem};
+use problem::{Container, Item, Orient, Orients, Problem};
 
 /// Allowed rotations of a piece, in degrees counter-clockwise.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,7 +142,7 @@ impl Placement {
         // Exact for quarter turns, so that rectangles stay edge to edge.
         let q = self.rotation / std::f64::consts::FRAC_PI_2;
         let r = if (q - q.round()).abs() < 1e-12 {
-            engine::rotor(90.0 * q.round())
+            collision::rotor(90.0 * q.round())
         } else {
             DVec2::from_angle(self.rotation)
         };
@@ -228,7 +234,7 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
             };
             for base in [90.0, 270.0] {
                 v.push(Orient {
-                    deg: (base - g).rem_euclid(360.0),
+                    angle_deg: (base - g).rem_euclid(360.0),
                     mirror: m,
                 });
             }
@@ -249,7 +255,7 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
                 .iter()
                 .flat_map(|&m| {
                     d.iter().map(move |&deg| Orient {
-                        deg: deg.rem_euclid(360.0),
+                        angle_deg: deg.rem_euclid(360.0),
                         mirror: m,
                     })
                 })
@@ -294,7 +300,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
             Orients::Set(v) => Orients::Set(
                 v.into_iter()
                     .map(|o| Orient {
-                        deg: to_internal(o.deg).rem_euclid(360.0),
+                        angle_deg: to_internal(o.angle_deg).rem_euclid(360.0),
                         mirror: o.mirror,
                     })
                     .collect(),
@@ -321,7 +327,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         seed: opts.seed,
         threads: opts.threads,
     };
-    let sol = problem::solve(&prob, &cfg).map_err(|u| {
+    let sol = solve::solve(&prob, &cfg).map_err(|u| {
         let piece = &pieces[u.item.min(pieces.len().saturating_sub(1))];
         let pts: Vec<DVec2> = piece.points().collect();
         let r = DVec2::from_angle(polygon::min_area_rect_angle(&pts));
@@ -348,14 +354,14 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
                 let t = p.translation;
                 Placement {
                     sheet: 0,
-                    rotation: (p.orient.deg + 90.0).rem_euclid(360.0).to_radians(),
+                    rotation: (p.orient.angle_deg + 90.0).rem_euclid(360.0).to_radians(),
                     mirror: p.orient.mirror,
                     offset: DVec2::new(-t.y, t.x) + DVec2::new(m + uw, m),
                 }
             } else {
                 Placement {
                     sheet: p.bin,
-                    rotation: p.orient.deg.to_radians(),
+                    rotation: p.orient.angle_deg.to_radians(),
                     mirror: p.orient.mirror,
                     offset: p.translation + DVec2::splat(m),
                 }
@@ -430,9 +436,8 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
     for (k, (p, at)) in layout.pieces.iter().zip(&layout.placements).enumerate() {
         let s = &layout.sheets[at.sheet];
         for q in p.points().map(|q| at.apply(q)) {
-            // Marks on the border may lie a little outside the cut outline, which drops
-            // features below what a knife cuts (`CLEAN_MM`, pattern/allowance.rs).
-            let tol = crate::pattern::allowance::CLEAN_MM;
+            // Marks on the border may lie a little outside the cut outline.
+            let tol = Piece::OVERHANG_MM;
             if q.x < m - tol || q.y < m - tol || q.x > s.width - m + tol || q.y > s.height - m + tol
             {
                 return Err(format!(
@@ -443,15 +448,15 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
         }
     }
     let mut work = 0;
-    let shapes: Vec<engine::Shape> = placed
+    let shapes: Vec<collision::Shape> = placed
         .iter()
         .map(|rings| {
-            let poles = engine::poles(rings);
-            engine::Shape::new(
+            let poles = collision::poles(rings);
+            collision::Shape::new(
                 rings,
                 &poles,
                 Orient {
-                    deg: 0.0,
+                    angle_deg: 0.0,
                     mirror: false,
                 },
             )
@@ -464,7 +469,7 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
             }
             let (a, b) = (&shapes[i], &shapes[j]);
             // Shapes are shifted to start at 0: undo it.
-            let near = engine::collide(
+            let near = collision::collide(
                 a,
                 -a.shift,
                 b,

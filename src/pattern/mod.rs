@@ -248,6 +248,11 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// How far (mm) a piece's strokes (marks on the border) may lie outside its cut outline:
+    /// cleaning the outline closes and drops features narrower than twice this
+    /// ([`allowance::CLEAN_MM`]), which can leave a mark's end just outside it.
+    pub const OVERHANG_MM: f64 = allowance::CLEAN_MM;
+
     /// A piece that is only a cut outline (counter-clockwise ring): no folds, seams or text.
     /// For tests and for nesting shapes that come from elsewhere (ESICUP instances).
     pub fn from_outline(id: usize, name: String, ring: Vec<DVec2>) -> Piece {

@@ -13,8 +13,9 @@
 //! Choices: the candidates come from bounding boxes (not no-fit polygons), which puts
 //! rectangles exactly edge to edge; the slide keeps only positions tested free.
 
-use super::engine::{boxes_near, collide, Placed, Shape};
-use super::problem::{Container, Ctx, State};
+use super::state::{Ctx, State};
+use crate::nest::collision::{boxes_near, collide, Placed, Shape};
+use crate::nest::problem::Container;
 use glam::DVec2;
 use std::sync::Arc;
 
@@ -141,7 +142,7 @@ fn place_item(ctx: &mut Ctx, item: usize, others: &[Placed], max_len: f64) -> Op
 }
 
 /// Bottom-left fill of a strip.
-pub fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
+pub(crate) fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
     let mut st = State::default();
     for &i in order {
         let p = place_item(ctx, i, &st.placed, f64::INFINITY)?;
@@ -152,7 +153,7 @@ pub fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
 }
 
 /// Bottom-left fill of bins `max_len` long: first bin with room.
-pub fn fill_bins(ctx: &mut Ctx, order: &[usize], max_len: f64) -> Option<Vec<State>> {
+pub(crate) fn fill_bins(ctx: &mut Ctx, order: &[usize], max_len: f64) -> Option<Vec<State>> {
     debug_assert!(matches!(ctx.prob.container, Container::Bins { .. }));
     let mut bins: Vec<State> = Vec::new();
     for &i in order {

@@ -1,0 +1,241 @@
+//! Collision detection of the nest stage, in exact `f64` geometry, and the overlap measure the
+//! separator minimises.
+//!
+//! An item is a polygon with holes (outer ring counter-clockwise, holes clockwise). An
+//! [`Orient`] (rotation, optional mirror in x first) turns it into a [`Shape`]: the turned
+//! rings shifted so that their bounding box starts at the origin, its segments, and its
+//! *poles* ([`poles`]). A shape is placed by the position of its bounding box's lower-left
+//! corner, so "inside the container" is a box test.
+//!
+//! Two placed shapes **collide** ([`collide`]) when their material comes closer than the
+//! spacing `s`:
+//! - `s > 0`: some pair of segments is closer than `s` (segment–segment distance), or one
+//!   shape's first pole centre (an interior point) lies in the other's material (inside the
+//!   outer ring and outside every hole) — the containment cases;
+//! - `s = 0`: some pair of segments crosses properly (touching, collinear overlap and shared
+//!   vertices are allowed, so that rectangles tile exactly), or the first pole centre of one
+//!   lies in the other's material; when boundaries touch (some orientation test is exactly
+//!   zero), every pole centre and edge midpoint is probed, and counts when it lies in the
+//!   other's material farther than 1e-9 mm from its boundary (this catches the collinear
+//!   "sliding" overlaps that have no proper crossing).
+//!
+//! A piece inside the hole of another does not collide with it: holes are usable.
+//!
+//! The files: [`shape`] (orientations, turned shapes, bounding boxes, the material test),
+//! [`poles`] (poles of inaccessibility), [`overlap`] (sparrow's pole-based overlap proxy
+//! between two colliding shapes). The segment distances are the shared kernel
+//! [`crate::geom::segment`].
+//!
+//! Why not jagua-rs: it computes in `f32` and takes no holes; this engine is exact in `f64`
+//! (so a feasible layout needs no safety margin and no separate verification pass), handles
+//! holes and spacing directly, and the nesting instances have at most tens of vertices per item,
+//! where the quadratic segment test behind a bounding-box filter is cheap (see `benches/nest.rs`).
+
+pub(crate) mod overlap;
+pub(crate) mod poles;
+pub(crate) mod shape;
+
+pub(crate) use overlap::overlap_proxy;
+pub(crate) use poles::poles;
+pub use shape::Orient;
+pub(crate) use shape::{boxes_near, in_material, rotor, Placed, Shape};
+
+use crate::geom::segment::{orient2, segment_segment_dist2};
+use glam::DVec2;
+use shape::boundary_dist;
+
+/// Exact collision test of shape `a` at `pa` and `b` at `pb` with spacing `s` (see the module
+/// docs). `work` counts segment pairs looked at, the search's deterministic clock.
+pub(crate) fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: &mut u64) -> bool {
+    if !boxes_near(a, pa, b, pb, s) {
+        return false;
+    }
+    *work += (a.segs.len() * b.segs.len()) as u64 / 16 + 4;
+    // Work in a's frame.
+    let d = pb - pa;
+    // Window where both shapes' material can meet.
+    let wlo = d.max(DVec2::ZERO) - DVec2::splat(s);
+    let whi = (d + b.size).min(a.size) + DVec2::splat(s);
+    let s2 = s * s;
+    // Zero spacing: do some boundaries touch (a zero orientation)? Only then can material
+    // overlap without a proper crossing and without one shape's pole in the other.
+    let mut touch = false;
+    for [a0, a1] in &a.segs {
+        let (alo, ahi) = (a0.min(*a1), a0.max(*a1));
+        if ahi.x < wlo.x || ahi.y < wlo.y || alo.x > whi.x || alo.y > whi.y {
+            continue;
+        }
+        for [b0, b1] in &b.segs {
+            let (b0, b1) = (*b0 + d, *b1 + d);
+            let (blo, bhi) = (b0.min(b1), b0.max(b1));
+            // Strictly apart only: touching segments must set `touch` below.
+            if blo.x > ahi.x + s || blo.y > ahi.y + s || alo.x > bhi.x + s || alo.y > bhi.y + s {
+                continue;
+            }
+            if s > 0.0 {
+                if segment_segment_dist2(*a0, *a1, b0, b1) < s2 {
+                    return true;
+                }
+            } else {
+                let o1 = orient2(*a0, *a1, b0);
+                let o2 = orient2(*a0, *a1, b1);
+                let o3 = orient2(b0, b1, *a0);
+                let o4 = orient2(b0, b1, *a1);
+                if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0))
+                    && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0))
+                {
+                    return true;
+                }
+                if o1 == 0.0 || o2 == 0.0 || o3 == 0.0 || o4 == 0.0 {
+                    touch = true;
+                }
+            }
+        }
+    }
+    // No boundaries meet: either apart, or one inside the other.
+    if s > 0.0 || !touch {
+        let inside_b = a
+            .poles
+            .first()
+            .is_some_and(|(c, _)| in_material(&b.rings, *c - d));
+        let inside_a = b
+            .poles
+            .first()
+            .is_some_and(|(c, _)| in_material(&a.rings, *c + d));
+        return inside_b || inside_a;
+    }
+    *work += ((a.mids.len() + a.poles.len()) * b.segs.len()) as u64 / 8;
+    let deep = |rings: &[Vec<DVec2>], segs: &[[DVec2; 2]], p: DVec2| {
+        in_material(rings, p) && boundary_dist(segs, p) > 1e-9
+    };
+    a.poles
+        .iter()
+        .map(|(c, _)| *c)
+        .chain(a.mids.iter().copied())
+        .any(|p| deep(&b.rings, &b.segs, p - d))
+        || b.poles
+            .iter()
+            .map(|(c, _)| *c)
+            .chain(b.mids.iter().copied())
+            .any(|p| deep(&a.rings, &a.segs, p + d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(super) fn rect(w: f64, h: f64) -> Vec<Vec<DVec2>> {
+        vec![vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(w, 0.0),
+            DVec2::new(w, h),
+            DVec2::new(0.0, h),
+        ]]
+    }
+
+    pub(super) fn shape(rings: Vec<Vec<DVec2>>) -> Shape {
+        let p = poles(&rings);
+        Shape::new(
+            &rings,
+            &p,
+            Orient {
+                angle_deg: 0.0,
+                mirror: false,
+            },
+        )
+    }
+
+    #[test]
+    fn touching_rectangles_do_not_collide_but_sliding_ones_do() {
+        let a = shape(rect(2.0, 1.0));
+        let mut w = 0;
+        assert!(!collide(
+            &a,
+            DVec2::ZERO,
+            &a,
+            DVec2::new(2.0, 0.0),
+            0.0,
+            &mut w
+        ));
+        assert!(!collide(
+            &a,
+            DVec2::ZERO,
+            &a,
+            DVec2::new(2.0, 1.0),
+            0.0,
+            &mut w
+        ));
+        // Same height, overlapping by half: no proper crossing, found by the probes.
+        assert!(collide(
+            &a,
+            DVec2::ZERO,
+            &a,
+            DVec2::new(1.0, 0.0),
+            0.0,
+            &mut w
+        ));
+        assert!(collide(&a, DVec2::ZERO, &a, DVec2::ZERO, 0.0, &mut w));
+        // Spacing: 0.5 apart is too close for 0.6, fine for 0.5.
+        assert!(collide(
+            &a,
+            DVec2::ZERO,
+            &a,
+            DVec2::new(2.5, 0.0),
+            0.6,
+            &mut w
+        ));
+        assert!(!collide(
+            &a,
+            DVec2::ZERO,
+            &a,
+            DVec2::new(2.5, 0.0),
+            0.5,
+            &mut w
+        ));
+    }
+
+    #[test]
+    fn a_small_piece_fits_in_a_hole() {
+        let mut rings = rect(10.0, 10.0);
+        rings.push(vec![
+            DVec2::new(2.0, 2.0),
+            DVec2::new(2.0, 8.0),
+            DVec2::new(8.0, 8.0),
+            DVec2::new(8.0, 2.0),
+        ]);
+        let frame = shape(rings);
+        let small = shape(rect(4.0, 4.0));
+        let mut w = 0;
+        assert!(!collide(
+            &frame,
+            DVec2::ZERO,
+            &small,
+            DVec2::new(3.0, 3.0),
+            0.5,
+            &mut w
+        ));
+        assert!(collide(
+            &frame,
+            DVec2::ZERO,
+            &small,
+            DVec2::new(3.0, 3.0),
+            1.5,
+            &mut w
+        ));
+        assert!(collide(
+            &frame,
+            DVec2::ZERO,
+            &small,
+            DVec2::new(5.0, 3.0),
+            0.0,
+            &mut w
+        ));
+        // The largest pole of the frame lies in its material, not in the hole: in a corner,
+        // touching the hole's corner (radius 2√2 / (1 + √2) ≈ 1.17).
+        let (c, r) = frame.poles[0];
+        assert!(
+            in_material(&frame.rings, c) && r > 0.99 && r < 1.18,
+            "{c} {r}"
+        );
+    }
+}

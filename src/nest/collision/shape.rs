@@ -1,0 +1,204 @@
+//! Shapes of the nest stage: an item's rings turned by an [`Orient`] and shifted so that their
+//! bounding box starts at the origin, with the segments, edge midpoints and poles the
+//! collision test and the overlap proxy read; a [`Placed`] shape; the bounding-box test that
+//! filters pairs; the material test (inside the outer ring, outside every hole).
+//!
+//! Choices: rotations by a multiple of 90° are exact ([`rotor`]), so that rectangles stay edge
+//! to edge; a mirror reverses the rings' point order, which is undone so that the outer ring
+//! stays counter-clockwise; the poles are also kept in fixed-size lanes ([`PoleLanes`]) for
+//! the vectorised overlap proxy.
+
+use crate::geom::polygon;
+use crate::geom::segment::point_segment_dist2;
+use glam::DVec2;
+use std::sync::Arc;
+
+/// Rotation (counter-clockwise) after an optional mirror `x → −x`.
+///
+/// The one angle of the stage kept in degrees: the search draws and perturbs orientations in
+/// degrees (a uniform draw below 360, a turn by up to ±10°, reduced modulo 360), multiples of
+/// 90° are recognised exactly there (`rotor`), and ESICUP instances and solutions give
+/// degrees; the layout's [`crate::nest::Placement::rotation`] is in radians.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orient {
+    /// Degrees, counter-clockwise.
+    pub angle_deg: f64,
+    pub mirror: bool,
+}
+
+/// Rotation by `deg` degrees, exact for multiples of 90°.
+pub(crate) fn rotor(deg: f64) -> DVec2 {
+    let q = deg.rem_euclid(360.0);
+    if q == 0.0 {
+        DVec2::new(1.0, 0.0)
+    } else if q == 90.0 {
+        DVec2::new(0.0, 1.0)
+    } else if q == 180.0 {
+        DVec2::new(-1.0, 0.0)
+    } else if q == 270.0 {
+        DVec2::new(0.0, -1.0)
+    } else {
+        DVec2::from_angle(deg.to_radians())
+    }
+}
+
+impl Orient {
+    /// The point turned (mirror first, then rotation).
+    pub fn apply(&self, p: DVec2) -> DVec2 {
+        let p = if self.mirror {
+            DVec2::new(-p.x, p.y)
+        } else {
+            p
+        };
+        rotor(self.angle_deg).rotate(p)
+    }
+}
+
+/// An item turned by an orientation and shifted so that its bounding box starts at 0.
+#[derive(Debug, Clone)]
+pub(crate) struct Shape {
+    pub orient: Orient,
+    /// Rings, outer first; a mirror reverses their order of points, which is undone so that
+    /// the outer ring stays counter-clockwise.
+    pub rings: Vec<Vec<DVec2>>,
+    pub segs: Vec<[DVec2; 2]>,
+    /// Edge midpoints (probes for the zero-spacing containment test).
+    pub mids: Vec<DVec2>,
+    pub poles: Vec<(DVec2, f64)>,
+    /// The poles again, one array per coordinate, padded with empty circles far away, for
+    /// the vectorised [`overlap_proxy`].
+    pub lanes: PoleLanes,
+    pub size: DVec2,
+    /// Area of the material.
+    pub area: f64,
+    /// Add to a turned item point to get the shape point: `shape = orient(q) + shift`.
+    pub shift: DVec2,
+}
+
+impl Shape {
+    /// Turn an item's rings and poles.
+    pub(crate) fn new(rings: &[Vec<DVec2>], poles: &[(DVec2, f64)], orient: Orient) -> Shape {
+        let mut turned: Vec<Vec<DVec2>> = rings
+            .iter()
+            .map(|r| r.iter().map(|p| orient.apply(*p)).collect())
+            .collect();
+        if orient.mirror {
+            for r in &mut turned {
+                r.reverse();
+            }
+        }
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for p in turned.first().into_iter().flatten() {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        if !lo.is_finite() {
+            lo = DVec2::ZERO;
+            hi = DVec2::ZERO;
+        }
+        let shift = -lo;
+        for r in &mut turned {
+            for p in r.iter_mut() {
+                *p += shift;
+            }
+        }
+        let mut segs = Vec::new();
+        let mut mids = Vec::new();
+        for r in &turned {
+            for k in 0..r.len() {
+                let (a, b) = (r[k], r[(k + 1) % r.len()]);
+                segs.push([a, b]);
+                mids.push((a + b) * 0.5);
+            }
+        }
+        let poles: Vec<(DVec2, f64)> = poles
+            .iter()
+            .map(|(c, r)| (orient.apply(*c) + shift, *r))
+            .collect();
+        let lanes = PoleLanes::new(&poles);
+        let area = turned.iter().map(|r| polygon::signed_area(r)).sum();
+        Shape {
+            orient,
+            rings: turned,
+            segs,
+            mids,
+            poles,
+            lanes,
+            size: hi - lo,
+            area,
+            shift,
+        }
+    }
+}
+
+/// A shape at a position (its bounding box's lower-left corner).
+#[derive(Debug, Clone)]
+pub(crate) struct Placed {
+    pub shape: Arc<Shape>,
+    pub pos: DVec2,
+}
+
+impl Placed {
+    pub(crate) fn lo(&self) -> DVec2 {
+        self.pos
+    }
+    pub(crate) fn hi(&self) -> DVec2 {
+        self.pos + self.shape.size
+    }
+}
+
+/// Do the bounding boxes come closer than `s` (touching at exactly `s` is apart)?
+#[inline]
+pub(crate) fn boxes_near(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64) -> bool {
+    pa.x + a.size.x + s > pb.x
+        && pb.x + b.size.x + s > pa.x
+        && pa.y + a.size.y + s > pb.y
+        && pb.y + b.size.y + s > pa.y
+}
+
+/// Is `p` in the material of the rings (inside the outer ring, outside every hole)?
+pub(crate) fn in_material(rings: &[Vec<DVec2>], p: DVec2) -> bool {
+    match rings.split_first() {
+        Some((outer, holes)) => {
+            polygon::contains(outer, p) && !holes.iter().any(|h| polygon::contains(h, p))
+        }
+        None => false,
+    }
+}
+
+/// Distance from `p` to the nearest segment.
+pub(crate) fn boundary_dist(segs: &[[DVec2; 2]], p: DVec2) -> f64 {
+    segs.iter()
+        .map(|[a, b]| point_segment_dist2(p, *a, *b))
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
+}
+
+/// Poles in lanes (see [`Shape::lanes`]): at most [`POLE_LANES`], the rest padded with
+/// radius-0 circles far away, which add exactly 0 to the proxy.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PoleLanes {
+    pub x: [f64; POLE_LANES],
+    pub y: [f64; POLE_LANES],
+    pub r: [f64; POLE_LANES],
+}
+
+/// Lanes of [`PoleLanes`]: the most poles an item keeps ([`poles`]).
+pub(crate) const POLE_LANES: usize = 12;
+
+impl PoleLanes {
+    fn new(poles: &[(DVec2, f64)]) -> PoleLanes {
+        let mut l = PoleLanes {
+            x: [1e12; POLE_LANES],
+            y: [1e12; POLE_LANES],
+            r: [0.0; POLE_LANES],
+        };
+        for (k, (c, r)) in poles.iter().take(POLE_LANES).enumerate() {
+            l.x[k] = c.x;
+            l.y[k] = c.y;
+            l.r[k] = *r;
+        }
+        l
+    }
+}
