@@ -363,13 +363,8 @@ mod tests {
 
     #[test]
     fn hull_of_random_sphere_points_is_closed_and_convex() {
-        let mut s: u64 = 7;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geom::rng::Rng::new(7);
+        let mut rnd = || rng.f64();
         let p: Vec<DVec3> = (0..300)
             .map(|_| DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize() * (50.0 + rnd()))
             .collect();

@@ -556,14 +556,9 @@ mod tests {
     /// Nearest neighbour on scattered strokes leaves long ways back; 2-opt shortens them.
     #[test]
     fn two_opt_beats_nearest_neighbour_and_keeps_every_stroke() {
-        // 300 short strokes scattered over 100 × 100 mm by a fixed linear congruential sequence.
-        let mut k = 7u64;
-        let mut next = || {
-            k = k
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (k >> 11) as f64 / (1u64 << 53) as f64
-        };
+        // 300 short strokes scattered over 100 × 100 mm by the seeded generator.
+        let mut rng = crate::geom::rng::Rng::new(7);
+        let mut next = || rng.f64();
         let strokes: Vec<Stroke> = (0..300)
             .map(|_| {
                 let (x, y) = (100.0 * next(), 100.0 * next());
