@@ -226,7 +226,7 @@ fn paper_outlines_with_tabs_are_simple_and_apart() {
 fn labels_are_inside_and_upright_marks_inside() {
     let dir = scratch("pattern-labels");
     let spec = load(&fandisk_spec(&dir), MaterialKind::Paper, None);
-    let profile = flatcut::device::profile::find("hpgl-pens").unwrap();
+    let profile = flatcut::profile::find("hpgl-pens").unwrap();
     let (_, layout, job) = flatcut::cli::cut::plan_job(&spec, &profile, true).unwrap();
     let mut labels = 0;
     for sheet in &job.sheets {

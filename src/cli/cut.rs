@@ -150,7 +150,7 @@ pub enum FoldChoice {
 /// else the perforating one, else the pen; nothing else uses the first two). A knife offset
 /// given on the command line replaces the profile's.
 pub fn apply_flags(
-    profile: &mut crate::device::Profile,
+    profile: &mut crate::profile::Profile,
     folds: Option<FoldChoice>,
     knife_offset: Option<f64>,
 ) -> Result<(), Error> {
@@ -188,10 +188,13 @@ pub fn apply_flags(
 /// dashes), overcut, drag-knife compensation with its alignment precut in the sheet margin.
 pub fn machine_job(
     job: &crate::toolpath::Job,
-    profile: &crate::device::Profile,
+    profile: &crate::profile::Profile,
     spec: &crate::spec::Spec,
 ) -> crate::toolpath::Job {
-    crate::toolpath::knife::prepare(job, &profile.machine_options(spec.sheet.margin))
+    crate::toolpath::knife::prepare(
+        job,
+        &crate::toolpath::knife::MachineOptions::from_profile(profile, spec.sheet.margin),
+    )
 }
 
 /// Default output directory for a job name.
@@ -204,7 +207,7 @@ pub fn default_dir(name: &str) -> PathBuf {
 #[allow(clippy::type_complexity)]
 pub fn plan_job(
     spec: &crate::spec::Spec,
-    profile: &crate::device::Profile,
+    profile: &crate::profile::Profile,
     quiet: bool,
 ) -> Result<
     (
@@ -221,7 +224,7 @@ pub fn plan_job(
 /// toolpath options adjusted by `adjust` (flags).
 pub fn plan_job_with(
     spec: &crate::spec::Spec,
-    profile: &crate::device::Profile,
+    profile: &crate::profile::Profile,
     search: &super::nest::SearchArgs,
     quiet: bool,
     adjust: impl FnOnce(&mut ToolpathOptions),
@@ -277,7 +280,7 @@ pub fn run_spec(mut spec: crate::spec::Spec, a: &CutArgs) -> Result<(), Error> {
         .clone()
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
-    let mut profile = crate::device::profile::find(&device)?;
+    let mut profile = crate::profile::find(&device)?;
     let t = &a.toolpath;
     apply_flags(&mut profile, t.folds, t.knife_offset)?;
     if !a.dry_run && !super::link::simulated(&profile, &a.link) && a.link.port.is_none() {

@@ -26,7 +26,7 @@ pub struct SendArgs {
 }
 
 pub fn run(a: &SendArgs) -> Result<(), Error> {
-    let profile = crate::device::profile::find(&a.device)?;
+    let profile = crate::profile::find(&a.device)?;
     let bytes = std::fs::read(&a.file)
         .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", a.file.display())))?;
     let ext = a
@@ -35,8 +35,8 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let expected: &[&str] = match profile.language {
-        crate::device::Language::Hpgl => &["plt", "hpgl", "hpg"],
-        crate::device::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
+        crate::profile::Language::Hpgl => &["plt", "hpgl", "hpg"],
+        crate::profile::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
     };
     if !expected.contains(&ext.as_str()) {
         return Err(Error::Usage(format!(

@@ -12,7 +12,7 @@
 //!   lines; for the simulated cutter the transport reads the simulator's CTS flag instead
 //!   ([`Link::with_virtual_cts`]).
 
-use super::profile::{FlowControl, Parity, Profile};
+use crate::profile::{FlowControl, Parity, Profile};
 use serialport::SerialPort;
 use std::io::{Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -30,9 +30,9 @@
 #![allow(clippy::result_large_err)]
 
 use super::grbl::{self as proto, Response};
-use super::profile::{FlowControl, Language, Profile, Protocol};
 use super::serial::Link;
 use super::sim::{XOFF, XON};
+use crate::profile::{FlowControl, Language, Profile, Protocol};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -841,7 +841,7 @@ impl<'a> Grbl<'a> {
         if alarm {
             up.push_str("$X\n");
         }
-        if let Some(t) = self.profile.tool(crate::toolpath::StrokeKind::Cut) {
+        if let Some(t) = self.profile.tool(crate::profile::StrokeKind::Cut) {
             if let Some(z) = t.z_up {
                 up.push_str(&format!("G0 Z{}\n", crate::output::fmt_mm(z)));
             } else if let Some(s) = t.servo_up {

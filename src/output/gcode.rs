@@ -55,7 +55,7 @@
 //!   `end` lines, `M2`.
 
 use super::{fmt_mm, line_error, to_device, tool_error, OutputError};
-use crate::device::{Profile, Tool};
+use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 
 /// Most characters on one line, newline not counted (GRBL's line buffer holds 79).
@@ -350,8 +350,8 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::profile::parse as parse_profile;
     use crate::output::fixtures::{sheet, stroke};
+    use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
     use glam::DVec2;
 
@@ -451,7 +451,7 @@ mod tests {
             "{e}"
         );
         // Profiles are validated when read; a profile built in code still meets these checks.
-        let with = |f: &dyn Fn(&mut crate::device::Tool)| {
+        let with = |f: &dyn Fn(&mut crate::profile::Tool)| {
             let mut p = profile(KNIFE);
             if let Some(t) = p.tools.get_mut("cut") {
                 f(t);

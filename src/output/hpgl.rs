@@ -53,7 +53,7 @@
 //!   conservative bound: HP-GL devices differ, 2^23 units is 209 m at 40 per mm).
 
 use super::{line_error, to_device, tool_error, OutputError};
-use crate::device::{Profile, Tool};
+use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
 
@@ -372,8 +372,8 @@ pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::profile::parse as parse_profile;
     use crate::output::fixtures::{sheet, stroke};
+    use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
 
     /// The bundled `hpgl-pens` profile as it was when the exact text below was pinned: pens
@@ -414,7 +414,7 @@ mod tests {
 
     #[test]
     fn bundled_hpgl_pens_keeps_its_frame() {
-        let profile = crate::device::profile::find("hpgl-pens").unwrap();
+        let profile = crate::profile::find("hpgl-pens").unwrap();
         let text = String::from_utf8(emit(&small_job(), &profile).unwrap()).unwrap();
         assert!(text.starts_with("IN;\n"), "{text}");
         assert!(text.ends_with("PU;SP0;\n"), "{text}");

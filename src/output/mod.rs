@@ -16,7 +16,7 @@
 //!   tool that lacks what the language needs is an error ([`OutputError::Tool`]), as is a
 //!   position beyond what the language can address ([`OutputError::OutOfRange`]).
 
-use crate::device::{Language, Profile};
+use crate::profile::{Language, Profile};
 use crate::toolpath::{SheetJob, StrokeRole};
 use glam::DVec2;
 
@@ -305,7 +305,7 @@ mod tests {
             units_per_mm=40.0\n[tools.cut]\npen=1\n[axes]\n";
         let corners = [(0.0, 0.0), (300.0, 0.0), (300.0, 200.0), (0.0, 200.0)];
         let map = |axes: &str| -> Vec<(f64, f64)> {
-            let p = crate::device::profile::parse(&format!("{base}{axes}"), "test.toml").unwrap();
+            let p = crate::profile::parse(&format!("{base}{axes}"), "test.toml").unwrap();
             corners
                 .iter()
                 .map(|&(x, y)| {
@@ -339,11 +339,8 @@ mod tests {
             vec![(0.0, 12000.0), (0.0, 0.0), (8000.0, 0.0), (8000.0, 12000.0)]
         );
         // Swap then mirror X uses the sheet's height as X's extent; unrounded.
-        let p = crate::device::profile::parse(
-            &format!("{base}swap_xy=true\nflip_x=true\n"),
-            "test.toml",
-        )
-        .unwrap();
+        let p = crate::profile::parse(&format!("{base}swap_xy=true\nflip_x=true\n"), "test.toml")
+            .unwrap();
         let d = to_device(&p, 300.0, 200.0, DVec2::new(0.01, 0.0125));
         assert!((d.x - (200.0 - 0.0125) * 40.0).abs() < 1e-9);
         assert!((d.y - 0.4).abs() < 1e-12);
@@ -356,13 +353,13 @@ mod tests {
             height: 10.0,
             strokes: vec![],
         };
-        let hpgl = crate::device::profile::parse(
+        let hpgl = crate::profile::parse(
             "name='h'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n[tools.cut]\npen=1\n",
             "test.toml",
         )
         .unwrap();
         assert_eq!(program(&sheet, &hpgl).unwrap(), b"IN;\nPU;SP0;\n");
-        let gcode = crate::device::profile::parse(
+        let gcode = crate::profile::parse(
             "name='g'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nmax_power=1000\n[tools.cut]\npower=1\nspeed=1\n",
             "test.toml",
         )

@@ -19,6 +19,7 @@
 //! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
 //! after every piece; everything is deterministic (counts, never clocks, bound the search).
 
+pub use crate::profile::StrokeKind;
 use glam::DVec2;
 use serde::Serialize;
 
@@ -106,29 +107,6 @@ pub fn tool_kind(role: StrokeRole, has: impl Fn(StrokeKind) -> bool) -> Option<S
     match role.kind() {
         StrokeKind::Score => fold_kind(has),
         k => has(k).then_some(k),
-    }
-}
-
-/// Tool classes of a device's tool table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StrokeKind {
-    Cut,
-    Score,
-    Perforate,
-    Draw,
-    Etch,
-}
-
-impl StrokeKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            StrokeKind::Cut => "cut",
-            StrokeKind::Score => "score",
-            StrokeKind::Perforate => "perforate",
-            StrokeKind::Draw => "draw",
-            StrokeKind::Etch => "etch",
-        }
     }
 }
 

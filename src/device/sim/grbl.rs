@@ -21,7 +21,7 @@
 //! Motion time: `G1` at `F` (mm/min), `G0` at [`RAPID_MM_MIN`], `G4` its `P`.
 
 use super::record::Recorder;
-use crate::device::Profile;
+use crate::profile::Profile;
 use glam::{DVec2, DVec3};
 
 /// Rapid (G0) rate, mm/min; GRBL's default `$110`/`$111` max rate is 500, cutters set more.
@@ -446,7 +446,7 @@ mod tests {
     use super::*;
 
     fn knife() -> Profile {
-        crate::device::profile::parse(
+        crate::profile::parse(
             "name='k'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nbuffer=128\n\
              [tools.cut]\nz_down=-1\nz_up=2\nspeed=600\n[tools.score]\nz_down=-0.3\nz_up=2\nspeed=900\n",
             "k.toml",
@@ -510,7 +510,7 @@ mod tests {
 
     #[test]
     fn laser_burns_only_on_g1() {
-        let p = crate::device::profile::parse(
+        let p = crate::profile::parse(
             "name='l'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nmax_power=1000\n\
              [tools.cut]\npower=1000\nspeed=300\n[tools.draw]\npower=200\nspeed=1500\n",
             "l.toml",

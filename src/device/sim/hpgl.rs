@@ -14,7 +14,7 @@
 //! buffer's draining.
 
 use super::record::Recorder;
-use crate::device::Profile;
+use crate::profile::Profile;
 use glam::DVec2;
 use std::collections::BTreeMap;
 
@@ -270,7 +270,7 @@ mod tests {
     use super::*;
 
     fn profile() -> Profile {
-        crate::device::profile::find("hpgl-pens").unwrap()
+        crate::profile::find("hpgl-pens").unwrap()
     }
 
     #[test]

@@ -37,7 +37,7 @@ pub mod hpgl;
 pub mod record;
 
 use crate::device::grbl as proto;
-use crate::device::profile::{FlowControl, Language, Profile};
+use crate::profile::{FlowControl, Language, Profile};
 use record::SimPath;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};

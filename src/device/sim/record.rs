@@ -67,8 +67,8 @@ pub struct Recorder {
 
 impl Recorder {
     /// A recorder for a machine: with a trailing blade when the profile has a knife offset.
-    pub fn for_profile(profile: &crate::device::Profile) -> Recorder {
-        use crate::toolpath::StrokeKind;
+    pub fn for_profile(profile: &crate::profile::Profile) -> Recorder {
+        use crate::profile::StrokeKind;
         let knives: Vec<String> = [StrokeKind::Cut, StrokeKind::Score, StrokeKind::Perforate]
             .into_iter()
             .filter(|k| profile.is_drag_knife(*k))
@@ -217,7 +217,7 @@ mod tests {
     use super::*;
 
     fn drag() -> Recorder {
-        let p = crate::device::profile::find("sim-dragknife").unwrap();
+        let p = crate::profile::find("sim-dragknife").unwrap();
         Recorder::for_profile(&p)
     }
 
@@ -255,7 +255,7 @@ mod tests {
         let start = DVec2::from(r.paths[1].points[0]);
         assert!(start.distance(DVec2::new(0.0, 790.0)) < 0.01, "{start}");
         // A recorder for a machine without an offset records the holder.
-        let mut plain = Recorder::for_profile(&crate::device::profile::find("sim").unwrap());
+        let mut plain = Recorder::for_profile(&crate::profile::find("sim").unwrap());
         plain.down("cut", a);
         plain.travel_to(a, b, Some("cut"));
         assert_eq!(plain.paths[0].points, vec![[0.0, 0.0], [400.0, 0.0]]);
