@@ -8,7 +8,7 @@
 //! port given by `--port` (see [`super::link`]). The files are written before anything is
 //! sent, so a failed or interrupted send loses nothing.
 
-use super::{create_dir, write_atomic};
+use crate::output::files::{create_dir, write_atomic};
 use crate::output::report::{self, RunInfo};
 use crate::spec::MaterialKind;
 use crate::toolpath::{StrokeKind, ToolpathOptions};
@@ -72,7 +72,7 @@ pub fn write_surface_obj(path: &Path, flats: &[crate::flatten::Flat]) -> Result<
     }
     let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));
     let text = crate::output::obj::write(&mesh, None, &comment).unwrap_or_default();
-    write_atomic(path, text.as_bytes())
+    Ok(write_atomic(path, text.as_bytes())?)
 }
 
 /// `--alternatives N`: ask every boundary surface of the spec for its N best triangulations.

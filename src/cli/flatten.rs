@@ -1,7 +1,7 @@
 //! `flatcut flatten SPEC|OBJ`: stops after the pattern stage and writes the pieces as SVG and
 //! PNG (laid side by side on one long strip, no sheet limits) plus `report.json`.
 
-use super::{create_dir, write_atomic};
+use crate::output::files::{create_dir, write_atomic};
 use crate::output::report::{self, RunInfo};
 use crate::toolpath::{Job, ToolpathOptions};
 use crate::Error;

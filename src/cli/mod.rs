@@ -17,7 +17,6 @@ use crate::pattern::{PatternOptions, Piece};
 use crate::spec::Spec;
 use crate::Error;
 use clap::{Parser, Subcommand};
-use std::path::Path;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -175,38 +174,4 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
     let opts = PatternOptions::from_spec(spec);
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
-}
-
-/// Write a file so that it is either complete or absent: write a hidden temporary file beside
-/// it, flush it to disk, then rename it over the final name.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    use std::io::Write;
-    let err = |source| Error::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(e));
-    }
-    Ok(())
-}
-
-/// Create the output directory.
-pub fn create_dir(dir: &Path) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-        path: dir.to_path_buf(),
-        source,
-    })
 }

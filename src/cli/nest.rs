@@ -5,8 +5,8 @@
 //! item with fewer than 3 points, an item that fits the strip in no orientation) is a user
 //! error naming the file and the item.
 
-use super::{create_dir, write_atomic};
 use crate::nest::esicup;
+use crate::output::files::{create_dir, write_atomic};
 use crate::Error;
 use clap::Args;
 use std::path::PathBuf;

@@ -58,7 +58,7 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/send"));
     if super::link::simulated(&profile, &a.link) {
-        super::create_dir(&dir)?;
+        crate::output::files::create_dir(&dir)?;
     }
     let name = a
         .file

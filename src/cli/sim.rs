@@ -48,7 +48,7 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
             a.speed
         )));
     }
-    super::create_dir(&a.output)?;
+    crate::output::files::create_dir(&a.output)?;
     let cancel = cancel_flag();
     let mut cfg = SimConfig::new(profile.clone());
     cfg.time_factor = (a.speed > 0.0).then_some(a.speed);

@@ -2,7 +2,8 @@
 //! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
 //! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
-//! texture coordinates ([`obj`]).
+//! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
+//! run's files ([`files`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
@@ -21,6 +22,7 @@ use crate::toolpath::{SheetJob, StrokeRole};
 use glam::DVec2;
 
 pub mod dxf;
+pub mod files;
 pub mod gcode;
 pub mod hpgl;
 pub mod obj;
@@ -84,6 +86,12 @@ pub enum OutputError {
         limit: f64,
         units: &'static str,
         profile: String,
+    },
+    /// A file of the run could not be written (or its directory made).
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
     },
 }
 
