@@ -309,6 +309,8 @@ fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
     }
 }
 
+/// Stream an HP-GL program under the profile's flow control (XON/XOFF, RTS/CTS, or none:
+/// paced by the program's own execution time), at the line rate.
 fn buffered(
     link: &mut Link,
     profile: &Profile,
@@ -357,23 +359,13 @@ fn buffered(
         }
         // Listen: XON/XOFF and anything else the device says.
         match link.read_ready(&mut input) {
-            Ok(n) => {
-                for &b in &input[..n] {
-                    match b {
-                        XOFF if flow == FlowControl::XonXoff => {
-                            if !stopped {
-                                rep.xoff_received += 1;
-                            }
-                            stopped = true;
-                        }
-                        XON if flow == FlowControl::XonXoff => {
-                            stopped = false;
-                            last_progress = Instant::now();
-                        }
-                        _ => rep.garbage_bytes += 1,
-                    }
-                }
-            }
+            Ok(n) => take_in(
+                &input[..n],
+                flow,
+                &mut rep,
+                &mut stopped,
+                &mut last_progress,
+            ),
             Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
         let cts = link.clear_to_send();
@@ -461,6 +453,32 @@ fn buffered(
     bar.set(sent, "");
     rep.bytes = sent;
     Ok(rep)
+}
+
+/// Take in bytes the device sent while a buffered program goes out: XOFF stops the sender and
+/// XON resumes it (under XON/XOFF flow control); anything else is counted as garbage.
+fn take_in(
+    bytes: &[u8],
+    flow: FlowControl,
+    rep: &mut StreamReport,
+    stopped: &mut bool,
+    last_progress: &mut Instant,
+) {
+    for &b in bytes {
+        match b {
+            XOFF if flow == FlowControl::XonXoff => {
+                if !*stopped {
+                    rep.xoff_received += 1;
+                }
+                *stopped = true;
+            }
+            XON if flow == FlowControl::XonXoff => {
+                *stopped = false;
+                *last_progress = Instant::now();
+            }
+            _ => rep.garbage_bytes += 1,
+        }
+    }
 }
 
 /// For each HP-GL instruction, where it ends in the program and a safe upper bound of when
