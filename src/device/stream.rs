@@ -491,7 +491,7 @@ fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
     let (mut at, mut motion) = (0usize, 0.0f64);
     let mut out = Vec::new();
     let mut rest = program;
-    while let Some(n) = super::sim::hpgl::next_instruction(rest) {
+    while let Some(n) = crate::output::hpgl::read::next_instruction(rest) {
         motion += m.execute(&rest[..n]);
         at += n;
         out.push((at, 1.1 * (motion + at as f64 / rate)));

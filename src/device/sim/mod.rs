@@ -494,7 +494,9 @@ impl Device {
     /// no further byte will complete once the host is done).
     fn has_complete_input(&self) -> bool {
         match self.interp {
-            Interp::Hpgl(_) => hpgl::next_instruction(self.rx.iter()).is_some(),
+            Interp::Hpgl(_) => {
+                crate::output::hpgl::read::next_instruction(self.rx.iter()).is_some()
+            }
             Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
         }
     }
@@ -611,7 +613,9 @@ impl Device {
                     if !self.motion.is_empty() {
                         return;
                     }
-                    let instr: Vec<u8> = if let Some(n) = hpgl::next_instruction(self.rx.iter()) {
+                    let instr: Vec<u8> = if let Some(n) =
+                        crate::output::hpgl::read::next_instruction(self.rx.iter())
+                    {
                         self.rx.drain(..n).collect()
                     } else if let Some((n, op)) = hpgl::executable_prefix(self.rx.iter()) {
                         let part = self.rx.drain(..n).collect();

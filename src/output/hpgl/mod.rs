@@ -57,6 +57,9 @@ use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
 
+pub mod read;
+pub use read::{parse, ParsedStroke};
+
 /// Points per `PD` instruction.
 const PD_POINTS: usize = 32;
 
@@ -264,109 +267,6 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
     }
     out.push_str("PU;SP0;\n");
     Ok(out.into_bytes())
-}
-
-/// A stroke read back from an HP-GL program: pen number, the velocity and force in effect
-/// (as written after `VS` and `FS`/`!FS`; `None` when none was set since `IN`) and the points
-/// in plotter units.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParsedStroke {
-    pub pen: u32,
-    pub speed: Option<f64>,
-    pub force: Option<f64>,
-    pub points: Vec<(i64, i64)>,
-}
-
-/// Read back the pen-down paths of a program made by [`emit`]: absolute `PU`/`PD`/`PA`, `SP`,
-/// `VS`, `FS` and Roland's `!FS`; `IN` resets pen, velocity and force. Other instructions
-/// (a profile's `init` and `end` lines) are skipped, except `PR`, whose relative moves this
-/// reader does not follow. For tests and reports; the full interpreter is the simulated
-/// cutter's.
-pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
-    let mut strokes: Vec<ParsedStroke> = Vec::new();
-    let mut pen = 0u32;
-    let mut speed: Option<f64> = None;
-    let mut force: Option<f64> = None;
-    let mut at = (0i64, 0i64);
-    let mut down = false;
-    for (n, cmd) in program.split(';').enumerate() {
-        let cmd = cmd.trim();
-        let roland = cmd.starts_with('!');
-        let cmd_body = if roland { &cmd[1..] } else { cmd };
-        if cmd_body.len() < 2 || !cmd_body.is_char_boundary(2) {
-            continue;
-        }
-        let (op, args) = cmd_body.split_at(2);
-        let op = op.to_ascii_uppercase();
-        let understood = if roland {
-            op == "FS"
-        } else {
-            matches!(
-                op.as_str(),
-                "IN" | "SP" | "PU" | "PD" | "PA" | "PR" | "VS" | "FS"
-            )
-        };
-        if !understood {
-            continue;
-        }
-        let nums: Vec<f64> = if args.trim().is_empty() {
-            Vec::new()
-        } else {
-            args.split(',')
-                .map(|v| v.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|e| format!("instruction {} `{cmd}`: {e}", n + 1))?
-        };
-        match op.as_str() {
-            "IN" => {
-                pen = 0;
-                speed = None;
-                force = None;
-                down = false;
-            }
-            "SP" => pen = nums.first().copied().unwrap_or(0.0) as u32,
-            "VS" => speed = nums.first().copied(),
-            "FS" => force = nums.first().copied(),
-            "PR" if !nums.is_empty() => {
-                return Err(format!(
-                    "instruction {} `{cmd}`: relative moves are not read",
-                    n + 1
-                ))
-            }
-            "PR" => {}
-            _ => {
-                // PU, PD, PA: pen state (PA keeps it), then absolute moves.
-                let pd = match op.as_str() {
-                    "PU" => false,
-                    "PD" => true,
-                    _ => down,
-                };
-                if nums.len() % 2 != 0 {
-                    return Err(format!("instruction {} `{cmd}`: odd coordinates", n + 1));
-                }
-                for xy in nums.chunks(2) {
-                    let (x, y) = (xy[0].round() as i64, xy[1].round() as i64);
-                    if pd {
-                        if !down {
-                            strokes.push(ParsedStroke {
-                                pen,
-                                speed,
-                                force,
-                                points: vec![at],
-                            });
-                        }
-                        if let Some(s) = strokes.last_mut() {
-                            s.points.push((x, y));
-                        }
-                    }
-                    down = pd;
-                    at = (x, y);
-                }
-                down = pd;
-            }
-        }
-    }
-    Ok(strokes)
 }
 
 #[cfg(test)]
