@@ -54,7 +54,7 @@
 //! - The end: the tool is up after the last stroke's lift; then `M5` (once), the profile's
 //!   `end` lines, `M2`.
 
-use super::{fmt_mm, line_error, to_device, tool_error, OutputError};
+use super::{device_points, fmt_mm, line_error, one_line, stroke_tool, tool_error, OutputError};
 use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 
@@ -243,15 +243,7 @@ fn profile_line<'a>(
     which: &'static str,
     line: &'a str,
 ) -> Result<&'a str, OutputError> {
-    let t = line.trim();
-    if t.contains(['\n', '\r']) {
-        return Err(line_error(
-            profile,
-            which,
-            line,
-            "one block per line: split it into several lines".into(),
-        ));
-    }
+    let t = one_line(profile, which, line, "block")?;
     if t.chars().count() > LINE_MAX {
         return Err(line_error(
             profile,
@@ -285,31 +277,16 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
         }
     }
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
-            continue;
-        };
-        let Some(tool) = profile.tool(kind) else {
+        let Some((kind, tool)) = stroke_tool(profile, stroke.role) else {
             continue;
         };
         let tool = check_tool(profile, kind.name(), tool)?;
-        let mut pts: Vec<(String, String)> = Vec::with_capacity(stroke.points.len());
-        for q in &stroke.points {
-            let d = to_device(profile, sheet.width, sheet.height, *q);
-            for v in [d.x, d.y] {
-                if !(v.is_finite() && v.abs() <= LIMIT_MM) {
-                    return Err(OutputError::OutOfRange {
-                        sheet: None,
-                        stroke: index + 1,
-                        role: stroke.role.name(),
-                        value: v,
-                        limit: LIMIT_MM,
-                        units: "mm",
-                        profile: profile.name.clone(),
-                    });
-                }
-            }
-            pts.push((fmt_mm(d.x), fmt_mm(d.y)));
-        }
+        let fits = |v: f64| v.is_finite() && v.abs() <= LIMIT_MM;
+        let mut pts: Vec<(String, String)> =
+            device_points(profile, sheet, index, stroke, (LIMIT_MM, "mm"), fits)?
+                .iter()
+                .map(|d| (fmt_mm(d.x), fmt_mm(d.y)))
+                .collect();
         pts.dedup();
         let Some(start) = pts.first().cloned() else {
             continue;
@@ -350,7 +327,7 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::fixtures::{sheet, stroke};
+    use crate::output::fixtures::{half_unit_steps, sheet, stroke};
     use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
     use glam::DVec2;
@@ -579,17 +556,7 @@ mod tests {
 
     #[test]
     fn absolute_rounding_does_not_drift() {
-        let mut pts = Vec::new();
-        let mut x = 0.0;
-        for _ in 0..=8000 {
-            pts.push((x, 5.0));
-            x += 0.0125;
-        }
-        let job = SheetJob {
-            width: 200.0,
-            height: 10.0,
-            strokes: vec![stroke(StrokeRole::Cut, &pts)],
-        };
+        let (pts, job) = half_unit_steps(5.0);
         let p = profile("[tools.cut]\nz_down=-1.0\nz_up=2.0\nspeed=1200\n");
         let paths = down_paths(&text(&job, &p), &p);
         let got = &paths[0];

@@ -17,8 +17,8 @@
 //!   tool that lacks what the language needs is an error ([`OutputError::Tool`]), as is a
 //!   position beyond what the language can address ([`OutputError::OutOfRange`]).
 
-use crate::profile::{Language, Profile};
-use crate::toolpath::{SheetJob, StrokeRole};
+use crate::profile::{Language, Profile, StrokeKind, Tool};
+use crate::toolpath::{SheetJob, Stroke, StrokeRole};
 use glam::DVec2;
 
 pub mod dxf;
@@ -135,6 +135,65 @@ pub(crate) fn line_error(
     }
 }
 
+/// An `init` or `end` line of `profile`, trimmed: one `what` (instruction, block) of the
+/// language; a line break inside it is an [`OutputError::ProfileLine`].
+pub(crate) fn one_line<'a>(
+    profile: &Profile,
+    which: &'static str,
+    line: &'a str,
+    what: &str,
+) -> Result<&'a str, OutputError> {
+    let t = line.trim();
+    if t.contains(['\n', '\r']) {
+        return Err(line_error(
+            profile,
+            which,
+            line,
+            format!("one {what} per line: split it into several lines"),
+        ));
+    }
+    Ok(t)
+}
+
+/// The tool that makes a stroke of `role` on `profile`, with its kind
+/// ([`crate::toolpath::tool_kind`]); `None`: the profile has none and the stroke is left out.
+pub(crate) fn stroke_tool(profile: &Profile, role: StrokeRole) -> Option<(StrokeKind, &Tool)> {
+    let kind = crate::toolpath::tool_kind(role, |k| profile.has(k))?;
+    Some((kind, profile.tool(kind)?))
+}
+
+/// The device positions ([`to_device`]) of the points of `stroke`, the sheet's stroke `index`
+/// (0-based), each coordinate checked with `fits`: the first that does not fit is an
+/// [`OutputError::OutOfRange`] that names `limit` in `units`.
+pub(crate) fn device_points(
+    profile: &Profile,
+    sheet: &SheetJob,
+    index: usize,
+    stroke: &Stroke,
+    (limit, units): (f64, &'static str),
+    fits: impl Fn(f64) -> bool,
+) -> Result<Vec<DVec2>, OutputError> {
+    let mut out = Vec::with_capacity(stroke.points.len());
+    for q in &stroke.points {
+        let d = to_device(profile, sheet.width, sheet.height, *q);
+        for v in [d.x, d.y] {
+            if !fits(v) {
+                return Err(OutputError::OutOfRange {
+                    sheet: None,
+                    stroke: index + 1,
+                    role: stroke.role.name(),
+                    value: v,
+                    limit,
+                    units,
+                    profile: profile.name.clone(),
+                });
+            }
+        }
+        out.push(d);
+    }
+    Ok(out)
+}
+
 /// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
 /// ([`hpgl::emit`]), or GRBL G-code ([`gcode::emit`]), by `profile.language` and
 /// `profile.dialect`.
@@ -203,44 +262,18 @@ impl RoleStyle {
 /// marks green; labels dark green; notches black; sewing lines brown dashed; grain lines
 /// purple; weed lines grey.
 pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
-    match role {
-        StrokeRole::Cut => RoleStyle {
-            rgb: [0x00, 0x00, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::FoldMountain => RoleStyle {
-            rgb: [0xd0, 0x00, 0x00],
-            dash_mm: &[3.0, 1.0, 0.5, 1.0],
-        },
-        StrokeRole::FoldValley => RoleStyle {
-            rgb: [0x00, 0x50, 0xd0],
-            dash_mm: &[2.0, 1.0],
-        },
-        StrokeRole::Mark => RoleStyle {
-            rgb: [0x00, 0x80, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Label => RoleStyle {
-            rgb: [0x00, 0x60, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Notch => RoleStyle {
-            rgb: [0x00, 0x00, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Seam => RoleStyle {
-            rgb: [0x80, 0x40, 0x00],
-            dash_mm: &[4.0, 1.5],
-        },
-        StrokeRole::Grain => RoleStyle {
-            rgb: [0x60, 0x00, 0x80],
-            dash_mm: &[],
-        },
-        StrokeRole::Weed => RoleStyle {
-            rgb: [0x90, 0x90, 0x90],
-            dash_mm: &[],
-        },
-    }
+    let (rgb, dash_mm): ([u8; 3], &'static [f64]) = match role {
+        StrokeRole::Cut => ([0x00, 0x00, 0x00], &[]),
+        StrokeRole::FoldMountain => ([0xd0, 0x00, 0x00], &[3.0, 1.0, 0.5, 1.0]),
+        StrokeRole::FoldValley => ([0x00, 0x50, 0xd0], &[2.0, 1.0]),
+        StrokeRole::Mark => ([0x00, 0x80, 0x00], &[]),
+        StrokeRole::Label => ([0x00, 0x60, 0x00], &[]),
+        StrokeRole::Notch => ([0x00, 0x00, 0x00], &[]),
+        StrokeRole::Seam => ([0x80, 0x40, 0x00], &[4.0, 1.5]),
+        StrokeRole::Grain => ([0x60, 0x00, 0x80], &[]),
+        StrokeRole::Weed => ([0x90, 0x90, 0x90], &[]),
+    };
+    RoleStyle { rgb, dash_mm }
 }
 
 /// Formats a coordinate in mm with at most 3 decimals, without trailing zeros and without
@@ -286,6 +319,23 @@ pub(crate) mod fixtures {
             height: 100.0,
             strokes,
         }
+    }
+
+    /// A 200 × 10 mm sheet with one cut along y = `y` from x = 0 to 100 in 8000 steps of
+    /// 0.0125 mm (half a plotter unit: rounded increments would drift), and the cut's points.
+    pub fn half_unit_steps(y: f64) -> (Vec<(f64, f64)>, SheetJob) {
+        let mut pts = Vec::new();
+        let mut x = 0.0;
+        for _ in 0..=8000 {
+            pts.push((x, y));
+            x += 0.0125;
+        }
+        let sheet = SheetJob {
+            width: 200.0,
+            height: 10.0,
+            strokes: vec![stroke(StrokeRole::Cut, &pts)],
+        };
+        (pts, sheet)
     }
 }
 

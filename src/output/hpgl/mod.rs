@@ -52,7 +52,7 @@
 //!   is an error, as is a coordinate beyond ±(2^23 − 1) plotter units in plain HP-GL (a
 //!   conservative bound: HP-GL devices differ, 2^23 units is 209 m at 40 per mm).
 
-use super::{line_error, to_device, tool_error, OutputError};
+use super::{device_points, one_line, stroke_tool, tool_error, OutputError};
 use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
@@ -155,15 +155,7 @@ fn check_tool(profile: &Profile, kind: &str, tool: &Tool) -> Result<HpglTool, Ou
 
 /// An `init`/`end` line as one terminated instruction line.
 fn profile_line(profile: &Profile, which: &'static str, line: &str) -> Result<String, OutputError> {
-    let t = line.trim();
-    if t.contains(['\n', '\r']) {
-        return Err(line_error(
-            profile,
-            which,
-            line,
-            "one instruction per line: split it into several lines".into(),
-        ));
-    }
+    let t = one_line(profile, which, line, "instruction")?;
     Ok(if t.ends_with(';') {
         t.to_string()
     } else {
@@ -186,34 +178,16 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
     let mut speed: Option<String> = None;
     let mut force: Option<String> = None;
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
-            continue;
-        };
-        let Some(tool) = profile.tool(kind) else {
+        let Some((kind, tool)) = stroke_tool(profile, stroke.role) else {
             continue;
         };
         let tool = check_tool(profile, kind.name(), tool)?;
-        let mut pts: Vec<(i64, i64)> = Vec::with_capacity(stroke.points.len());
-        for q in &stroke.points {
-            let d = to_device(profile, sheet.width, sheet.height, *q);
-            let mut unit = [0i64; 2];
-            for (u, v) in unit.iter_mut().zip([d.x, d.y]) {
-                let r = v.round();
-                if !(r.is_finite() && r.abs() <= limit as f64) {
-                    return Err(OutputError::OutOfRange {
-                        sheet: None,
-                        stroke: index + 1,
-                        role: stroke.role.name(),
-                        value: v,
-                        limit: limit as f64,
-                        units: "plotter units",
-                        profile: profile.name.clone(),
-                    });
-                }
-                *u = r as i64;
-            }
-            pts.push((unit[0], unit[1]));
-        }
+        let range = (limit as f64, "plotter units");
+        let fits = |v: f64| v.round().is_finite() && v.round().abs() <= limit as f64;
+        let mut pts: Vec<(i64, i64)> = device_points(profile, sheet, index, stroke, range, fits)?
+            .iter()
+            .map(|d| (d.x.round() as i64, d.y.round() as i64))
+            .collect();
         pts.dedup();
         let Some(&(x0, y0)) = pts.first() else {
             continue;
@@ -272,7 +246,7 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::fixtures::{sheet, stroke};
+    use crate::output::fixtures::{half_unit_steps, sheet, stroke};
     use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
 
@@ -449,17 +423,7 @@ mod tests {
     fn absolute_rounding_does_not_drift() {
         // 8000 steps of 0.0125 mm (half a plotter unit): rounded increments would lose or
         // gain up to half a unit per step.
-        let mut pts = Vec::new();
-        let mut x = 0.0;
-        for _ in 0..=8000 {
-            pts.push((x, 0.0));
-            x += 0.0125;
-        }
-        let sheet = SheetJob {
-            width: 200.0,
-            height: 10.0,
-            strokes: vec![stroke(StrokeRole::Cut, &pts)],
-        };
+        let (pts, sheet) = half_unit_steps(0.0);
         let t = text(&sheet, PENS);
         let back = parse(&t).unwrap();
         let got = &back[0].points;
