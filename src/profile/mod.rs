@@ -382,15 +382,25 @@ mod tests {
         parse(text, "x.toml").unwrap_err().to_string()
     }
 
+    /// The error reading `text` contains `part`.
+    fn says(text: &str, part: &str) {
+        let e = error(text);
+        assert!(e.contains(part), "{e}");
+    }
+
+    /// The error reading `text` starts with `prefix`.
+    fn begins(text: &str, prefix: &str) {
+        let e = error(text);
+        assert!(e.starts_with(prefix), "{e}");
+    }
+
     #[test]
     fn bad_profiles_say_why() {
-        let e = error("name = \"x\"\ncolour = 1\n");
-        assert!(e.contains("x.toml: line 2"), "{e}");
-        let e = error(&format!(
-            "{}\n[tools.cut]\npen=1\n",
-            HPGL.replace("=40", "=0")
-        ));
-        assert!(e.contains("x.toml: line 5: `units_per_mm`"), "{e}");
+        says("name = \"x\"\ncolour = 1\n", "x.toml: line 2");
+        says(
+            &format!("{}\n[tools.cut]\npen=1\n", HPGL.replace("=40", "=0")),
+            "x.toml: line 5: `units_per_mm`",
+        );
         assert!(find("no-such-machine")
             .unwrap_err()
             .to_string()
@@ -400,76 +410,83 @@ mod tests {
     #[test]
     fn bad_tools_name_file_and_key() {
         // A G-code tool with no way down.
-        let e = error(&format!("{GCODE}[tools.cut]\nspeed=600\n"));
-        assert!(
-            e.starts_with("x.toml: line 8: `tools.cut` has no way down"),
-            "{e}"
+        begins(
+            &format!("{GCODE}[tools.cut]\nspeed=600\n"),
+            "x.toml: line 8: `tools.cut` has no way down",
         );
         // Half a pair names the missing half.
-        let e = error(&format!("{GCODE}[tools.cut]\nz_down=-1\nspeed=600\n"));
-        assert!(e.contains("`tools.cut.z_up` is missing"), "{e}");
+        says(
+            &format!("{GCODE}[tools.cut]\nz_down=-1\nspeed=600\n"),
+            "`tools.cut.z_up` is missing",
+        );
         // Two ways down.
-        let e = error(&format!(
-            "{GCODE}max_power=1000\n[tools.cut]\nz_down=-1\nz_up=2\npower=10\n"
-        ));
-        assert!(e.contains("`tools.cut` has more than one way down"), "{e}");
+        says(
+            &format!("{GCODE}max_power=1000\n[tools.cut]\nz_down=-1\nz_up=2\npower=10\n"),
+            "`tools.cut` has more than one way down",
+        );
         // An HP-GL tool without a pen.
-        let e = error(&format!(
-            "{HPGL}[tools.cut]\npen=1\n[tools.score]\nforce=50\n"
-        ));
-        assert!(
-            e.starts_with("x.toml: line 8: `tools.score.pen` is missing"),
-            "{e}"
+        begins(
+            &format!("{HPGL}[tools.cut]\npen=1\n[tools.score]\nforce=50\n"),
+            "x.toml: line 8: `tools.score.pen` is missing",
         );
         // A negative speed, with its line.
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nspeed=-3\n"));
-        assert!(
-            e.starts_with("x.toml: line 8: `tools.cut.speed` must be a positive"),
-            "{e}"
+        begins(
+            &format!("{HPGL}[tools.cut]\npen=1\nspeed=-3\n"),
+            "x.toml: line 8: `tools.cut.speed` must be a positive",
         );
         // Not finite, zero force, no passes.
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nspeed=nan\n"));
-        assert!(
-            e.contains("`tools.cut.speed` must be a finite number"),
-            "{e}"
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\nspeed=nan\n"),
+            "`tools.cut.speed` must be a finite number",
         );
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nforce=0\n"));
-        assert!(e.contains("`tools.cut.force` must be a positive"), "{e}");
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\npasses=0\n"));
-        assert!(
-            e.contains("line 8: `tools.cut.passes` must be at least 1"),
-            "{e}"
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\nforce=0\n"),
+            "`tools.cut.force` must be a positive",
+        );
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\npasses=0\n"),
+            "line 8: `tools.cut.passes` must be at least 1",
         );
         // Laser power beyond $30, or without it.
-        let e = error(&format!("{GCODE}max_power=1000\n[tools.cut]\npower=1200\n"));
-        assert!(
-            e.contains("line 10: `tools.cut.power` must be more than 0 and at most"),
-            "{e}"
+        says(
+            &format!("{GCODE}max_power=1000\n[tools.cut]\npower=1200\n"),
+            "line 10: `tools.cut.power` must be more than 0 and at most",
         );
-        let e = error(&format!("{GCODE}[tools.cut]\npower=100\n"));
-        assert!(
-            e.contains("`tools.cut.power` needs the profile's `max_power`"),
-            "{e}"
+        says(
+            &format!("{GCODE}[tools.cut]\npower=100\n"),
+            "`tools.cut.power` needs the profile's `max_power`",
         );
         // The other language's fields.
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nz_down=-1\n"));
-        assert!(e.contains("`tools.cut.z_down` is for G-code tools"), "{e}");
-        let e = error(&format!("{GCODE}[tools.cut]\npen=1\nz_down=-1\nz_up=1\n"));
-        assert!(e.contains("`tools.cut.pen` is for HP-GL tools"), "{e}");
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\nz_down=-1\n"),
+            "`tools.cut.z_down` is for G-code tools",
+        );
+        says(
+            &format!("{GCODE}[tools.cut]\npen=1\nz_down=-1\nz_up=1\n"),
+            "`tools.cut.pen` is for HP-GL tools",
+        );
         // Knife upside down, servo that does not move, dwell without a servo.
-        let e = error(&format!("{GCODE}[tools.cut]\nz_down=2\nz_up=-1\n"));
-        assert!(e.contains("`tools.cut.z_down` must be below z_up"), "{e}");
-        let e = error(&format!("{GCODE}[tools.cut]\nservo_down=30\nservo_up=30\n"));
-        assert!(e.contains("`tools.cut.servo_down` must differ"), "{e}");
-        let e = error(&format!(
-            "{GCODE}[tools.cut]\nz_down=-1\nz_up=1\ndwell=0.2\n"
-        ));
-        assert!(e.contains("`tools.cut.dwell`"), "{e}");
+        says(
+            &format!("{GCODE}[tools.cut]\nz_down=2\nz_up=-1\n"),
+            "`tools.cut.z_down` must be below z_up",
+        );
+        says(
+            &format!("{GCODE}[tools.cut]\nservo_down=30\nservo_up=30\n"),
+            "`tools.cut.servo_down` must differ",
+        );
+        says(
+            &format!("{GCODE}[tools.cut]\nz_down=-1\nz_up=1\ndwell=0.2\n"),
+            "`tools.cut.dwell`",
+        );
         // Unknown kind, missing cut.
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\n[tools.glue]\npen=2\n"));
-        assert!(e.contains("line 8: `tools.glue` is not a tool kind"), "{e}");
-        let e = error(&format!("{HPGL}[tools.draw]\npen=3\n"));
-        assert!(e.contains("`tools.cut` is missing"), "{e}");
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\n[tools.glue]\npen=2\n"),
+            "line 8: `tools.glue` is not a tool kind",
+        );
+        says(
+            &format!("{HPGL}[tools.draw]\npen=3\n"),
+            "`tools.cut` is missing",
+        );
     }
 
     #[test]
@@ -499,35 +516,29 @@ mod tests {
         assert!(!bundled("grbl-laser").is_drag_knife(StrokeKind::Cut));
         assert!(!bundled("hpgl-pens").is_drag_knife(StrokeKind::Cut));
 
-        let e = error(&format!("{HPGL}knife_offset=-0.25\n[tools.cut]\npen=1\n"));
-        assert!(
-            e.starts_with("x.toml: line 6: `knife_offset` must be 0 (off) or a length"),
-            "{e}"
+        begins(
+            &format!("{HPGL}knife_offset=-0.25\n[tools.cut]\npen=1\n"),
+            "x.toml: line 6: `knife_offset` must be 0 (off) or a length",
         );
-        let e = error(&format!("{HPGL}knife_offset=nan\n[tools.cut]\npen=1\n"));
-        assert!(e.contains("line 6: `knife_offset` must be"), "{e}");
-        let e = error(&format!("{HPGL}overcut=-1\n[tools.cut]\npen=1\n"));
-        assert!(e.contains("line 6: `overcut` must be"), "{e}");
-        let e = error(&format!(
-            "{HPGL}swivel_threshold_deg=200\n[tools.cut]\npen=1\n"
-        ));
-        assert!(
-            e.contains("line 6: `swivel_threshold_deg` must be an angle"),
-            "{e}"
+        says(
+            &format!("{HPGL}knife_offset=nan\n[tools.cut]\npen=1\n"),
+            "line 6: `knife_offset` must be",
         );
-        let e = error(&format!(
-            "{HPGL}[tools.cut]\npen=1\n[tools.perforate]\npen=1\nperforation=[0, 1]\n"
-        ));
-        assert!(
-            e.starts_with(
-                "x.toml: line 10: `tools.perforate.perforation` must be [cut_mm, skip_mm]"
-            ),
-            "{e}"
+        says(
+            &format!("{HPGL}overcut=-1\n[tools.cut]\npen=1\n"),
+            "line 6: `overcut` must be",
         );
-        let e = error(&format!("{HPGL}[tools.cut]\npen=1\nperforation=[3, 1]\n"));
-        assert!(
-            e.contains("line 8: `tools.cut.perforation` is for the perforate tool"),
-            "{e}"
+        says(
+            &format!("{HPGL}swivel_threshold_deg=200\n[tools.cut]\npen=1\n"),
+            "line 6: `swivel_threshold_deg` must be an angle",
+        );
+        begins(
+            &format!("{HPGL}[tools.cut]\npen=1\n[tools.perforate]\npen=1\nperforation=[0, 1]\n"),
+            "x.toml: line 10: `tools.perforate.perforation` must be [cut_mm, skip_mm]",
+        );
+        says(
+            &format!("{HPGL}[tools.cut]\npen=1\nperforation=[3, 1]\n"),
+            "line 8: `tools.cut.perforation` is for the perforate tool",
         );
         let ok = parse(
             &format!(
@@ -546,48 +557,40 @@ mod tests {
     #[test]
     fn language_protocol_and_units_agree() {
         let knife = "[tools.cut]\nz_down=-1\nz_up=2\n";
-        let e = error(&format!(
-            "{}{knife}",
-            GCODE.replace("grbl-character-counting", "buffered")
-        ));
-        assert!(
-            e.contains("line 6: `protocol` must be grbl-character-counting"),
-            "{e}"
+        says(
+            &format!(
+                "{}{knife}",
+                GCODE.replace("grbl-character-counting", "buffered")
+            ),
+            "line 6: `protocol` must be grbl-character-counting",
         );
-        let e = error(&format!(
-            "{}{knife}",
-            GCODE.replace("units_per_mm=1", "units_per_mm=40")
-        ));
-        assert!(
-            e.contains("line 5: `units_per_mm` must be 1 for G-code"),
-            "{e}"
+        says(
+            &format!(
+                "{}{knife}",
+                GCODE.replace("units_per_mm=1", "units_per_mm=40")
+            ),
+            "line 5: `units_per_mm` must be 1 for G-code",
         );
-        let e = error(&format!(
-            "{HPGL}protocol='grbl-send-response'\n[tools.cut]\npen=1\n"
-        ));
-        assert!(e.contains("`protocol` must be buffered"), "{e}");
-        let e = error(&format!(
-            "{}[tools.cut]\npen=1\n",
-            HPGL.replace("hp-gl", "camm-gl3")
-        ));
-        assert!(
-            e.contains("line 4: `dialect` `camm-gl3` is not a dialect"),
-            "{e}"
+        says(
+            &format!("{HPGL}protocol='grbl-send-response'\n[tools.cut]\npen=1\n"),
+            "`protocol` must be buffered",
         );
-        let e = error(&format!("{HPGL}buffer=0\n[tools.cut]\npen=1\n"));
-        assert!(
-            e.contains("line 6: `buffer` must be at least 1 byte"),
-            "{e}"
+        says(
+            &format!("{}[tools.cut]\npen=1\n", HPGL.replace("hp-gl", "camm-gl3")),
+            "line 4: `dialect` `camm-gl3` is not a dialect",
         );
-        let e = error(&format!(
-            "{HPGL}[serial]\nbaud=9600\nstop_bits=3\n[tools.cut]\npen=1\n"
-        ));
-        assert!(
-            e.contains("line 8: `serial.stop_bits` must be 1 or 2"),
-            "{e}"
+        says(
+            &format!("{HPGL}buffer=0\n[tools.cut]\npen=1\n"),
+            "line 6: `buffer` must be at least 1 byte",
         );
-        let e = error(&format!("{HPGL}max_power=1000\n[tools.cut]\npen=1\n"));
-        assert!(e.contains("`max_power` is for G-code lasers only"), "{e}");
+        says(
+            &format!("{HPGL}[serial]\nbaud=9600\nstop_bits=3\n[tools.cut]\npen=1\n"),
+            "line 8: `serial.stop_bits` must be 1 or 2",
+        );
+        says(
+            &format!("{HPGL}max_power=1000\n[tools.cut]\npen=1\n"),
+            "`max_power` is for G-code lasers only",
+        );
         // GRBL with a bigger buffer than its 128 bytes is accepted (no check, no warning).
         assert!(parse(
             &format!("{}{knife}", GCODE.replace("=128", "=256")),

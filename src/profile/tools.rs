@@ -218,55 +218,31 @@ fn check_gcode_tool(table: &str, t: &Tool, max_power: Option<f64>) -> Result<(),
 fn ways_down(table: &str, t: &Tool, max_power: Option<f64>) -> Result<Vec<&'static str>, Problem> {
     let err = |key: &str, message: String| Err(problem(table, key, message));
     let mut ways = Vec::new();
-    match (t.z_down, t.z_up) {
-        (Some(down), Some(up)) if down >= up => {
+    let knife = ("z_down", "z_up", "a knife on Z");
+    if let Some((down, up)) = both(table, (t.z_down, t.z_up), knife)? {
+        if down >= up {
             return err(
                 "z_down",
                 format!("must be below z_up ({down} is not below {up})"),
-            )
+            );
         }
-        (Some(_), Some(_)) => ways.push("z_down/z_up"),
-        (Some(_), None) => {
-            return err(
-                "z_up",
-                "is missing: a knife on Z needs z_down and z_up".into(),
-            )
-        }
-        (None, Some(_)) => {
-            return err(
-                "z_down",
-                "is missing: a knife on Z needs z_down and z_up".into(),
-            )
-        }
-        (None, None) => {}
+        ways.push("z_down/z_up");
     }
-    match (t.servo_down, t.servo_up) {
-        (Some(down), Some(up)) if down < 0.0 || up < 0.0 => {
+    let servo = ("servo_down", "servo_up", "a servo pen");
+    if let Some((down, up)) = both(table, (t.servo_down, t.servo_up), servo)? {
+        if down < 0.0 || up < 0.0 {
             return err(
                 "servo_down",
                 format!("and servo_up are `M3 S` values, 0 or more; got {down} and {up}"),
-            )
+            );
         }
-        (Some(down), Some(up)) if down == up => {
+        if down == up {
             return err(
                 "servo_down",
                 format!("must differ from servo_up (both are {down})"),
-            )
+            );
         }
-        (Some(_), Some(_)) => ways.push("servo_down/servo_up"),
-        (Some(_), None) => {
-            return err(
-                "servo_up",
-                "is missing: a servo pen needs servo_down and servo_up".into(),
-            )
-        }
-        (None, Some(_)) => {
-            return err(
-                "servo_down",
-                "is missing: a servo pen needs servo_down and servo_up".into(),
-            )
-        }
-        (None, None) => {}
+        ways.push("servo_down/servo_up");
     }
     if let Some(power) = t.power {
         let Some(max) = max_power else {
@@ -284,4 +260,27 @@ fn ways_down(table: &str, t: &Tool, max_power: Option<f64>) -> Result<Vec<&'stat
         ways.push("power");
     }
     Ok(ways)
+}
+
+/// A pair of settings that go together, `(down, up)` under the keys `(down_key, up_key)` of
+/// `what`: both values, or `None` when neither is given; one without the other is an error
+/// that names the missing one.
+fn both(
+    table: &str,
+    (down, up): (Option<f64>, Option<f64>),
+    (down_key, up_key, what): (&str, &str, &str),
+) -> Result<Option<(f64, f64)>, Problem> {
+    let missing = |key: &str| {
+        Err(problem(
+            table,
+            key,
+            format!("is missing: {what} needs {down_key} and {up_key}"),
+        ))
+    };
+    match (down, up) {
+        (Some(d), Some(u)) => Ok(Some((d, u))),
+        (Some(_), None) => missing(up_key),
+        (None, Some(_)) => missing(down_key),
+        (None, None) => Ok(None),
+    }
 }
