@@ -483,6 +483,13 @@ impl Block {
 mod tests {
     use super::*;
 
+    /// Execute `lines`, each of which must be accepted.
+    fn run(g: &mut Grbl, lines: &[&str]) {
+        for l in lines {
+            g.execute(l).unwrap();
+        }
+    }
+
     fn knife() -> Profile {
         crate::profile::parse(
             "name='k'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nbuffer=128\n\
@@ -495,22 +502,21 @@ mod tests {
     #[test]
     fn knife_paths_and_errors() {
         let mut g = Grbl::new(&knife());
-        for l in [
-            "G21",
-            "G90",
-            "G94",
-            "G0 Z2",
-            "G0 X10 Y10",
-            "G1 Z-1 F600",
-            "G1 X20",
-            "G1 Y20",
-            "G0 Z2",
-        ] {
-            g.execute(l).unwrap();
-        }
-        for l in ["G0 X0 Y0", "G1 Z-0.3 F900", "G1 X5", "G0 Z2"] {
-            g.execute(l).unwrap();
-        }
+        run(
+            &mut g,
+            &[
+                "G21",
+                "G90",
+                "G94",
+                "G0 Z2",
+                "G0 X10 Y10",
+                "G1 Z-1 F600",
+                "G1 X20",
+                "G1 Y20",
+                "G0 Z2",
+            ],
+        );
+        run(&mut g, &["G0 X0 Y0", "G1 Z-0.3 F900", "G1 X5", "G0 Z2"]);
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "cut");
         assert_eq!(
@@ -555,20 +561,21 @@ mod tests {
         )
         .unwrap();
         let mut g = Grbl::new(&p);
-        for l in [
-            "G0 X1 Y1",
-            "M4 S200",
-            "G1 X2 F1500",
-            "G1 Y2",
-            "M5",
-            "G0 X5",
-            "M4 S1000",
-            "G0 X6",
-            "G1 X7 F300",
-            "M5",
-        ] {
-            g.execute(l).unwrap();
-        }
+        run(
+            &mut g,
+            &[
+                "G0 X1 Y1",
+                "M4 S200",
+                "G1 X2 F1500",
+                "G1 Y2",
+                "M5",
+                "G0 X5",
+                "M4 S1000",
+                "G0 X6",
+                "G1 X7 F300",
+                "M5",
+            ],
+        );
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "draw");
         assert_eq!(
