@@ -38,7 +38,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Largest write of the buffered protocol, bytes.
-pub const CHUNK: usize = 16;
+pub(crate) const CHUNK: usize = 16;
 
 /// How the stream behaves.
 #[derive(Debug, Clone)]
@@ -201,7 +201,7 @@ pub struct StreamReport {
 }
 
 /// Byte offsets where strokes start: HP-GL `PU` with coordinates, G-code `G0` with X or Y.
-pub fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
+pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
     let mut out = Vec::new();
     match language {
         Language::Hpgl => {

@@ -23,7 +23,7 @@ use glam::DVec2;
 use std::fmt::Write;
 
 /// Layer names.
-pub const LAYERS: [(&str, u8); 5] = [
+pub(crate) const LAYERS: [(&str, u8); 5] = [
     ("CUT", 7),
     ("BEND_UP", 1),
     ("BEND_DOWN", 5),

@@ -59,11 +59,11 @@ use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 
 /// Most characters on one line, newline not counted (GRBL's line buffer holds 79).
-pub const LINE_MAX: usize = 79;
+pub(crate) const LINE_MAX: usize = 79;
 /// Largest coordinate magnitude, mm.
-pub const LIMIT_MM: f64 = 100_000.0;
+pub(crate) const LIMIT_MM: f64 = 100_000.0;
 /// Seconds to wait after a servo move when the tool does not say.
-pub const DEFAULT_DWELL: f64 = 0.15;
+pub(crate) const DEFAULT_DWELL: f64 = 0.15;
 
 /// How a tool goes down and up, with its numbers formatted.
 #[derive(Debug, Clone, PartialEq)]
@@ -256,7 +256,7 @@ fn profile_line<'a>(
 }
 
 /// Encode one sheet's strokes (see the module documentation for the exact text).
-pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     if profile.dialect != "grbl" {
         return Err(OutputError::Dialect {
             profile: profile.name.clone(),

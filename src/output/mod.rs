@@ -23,7 +23,7 @@ use glam::DVec2;
 
 pub mod dxf;
 pub mod files;
-pub mod gcode;
+pub(crate) mod gcode;
 pub mod hpgl;
 pub mod obj;
 pub mod png;
@@ -231,7 +231,7 @@ pub fn to_device(profile: &Profile, sheet_w: f64, sheet_h: f64, p: DVec2) -> DVe
 
 /// Roles in drawing order, back to front: what is drawn later lies on top.
 /// The SVG layers follow this order too, after the sheet layer.
-pub const DRAW_ORDER: [StrokeRole; 9] = [
+pub(crate) const DRAW_ORDER: [StrokeRole; 9] = [
     StrokeRole::Label,
     StrokeRole::Mark,
     StrokeRole::Grain,
@@ -280,7 +280,7 @@ pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
 /// "-0": `12.5`, `0`, `3.142`. Rounding is Rust's `{:.3}` of the `f64`, so the text depends only
 /// on the value. A non-finite value prints as `0` so that a document stays well-formed
 /// (upstream stages only produce finite coordinates).
-pub fn fmt_mm(v: f64) -> String {
+pub(crate) fn fmt_mm(v: f64) -> String {
     if !v.is_finite() {
         return "0".to_string();
     }

@@ -20,7 +20,7 @@ use super::{fmt_mm, role_style, DRAW_ORDER};
 use crate::toolpath::{Job, Stroke, StrokeRole};
 
 /// Horizontal gap between neighbouring sheets in the document, mm.
-pub const SHEET_GAP_MM: f64 = 20.0;
+pub(crate) const SHEET_GAP_MM: f64 = 20.0;
 
 /// Stroke width of the sheet outlines, mm.
 const SHEET_OUTLINE_MM: f64 = 0.1;

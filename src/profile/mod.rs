@@ -25,7 +25,8 @@ mod tools;
 
 pub use read::parse;
 pub use serial::{FlowControl, Parity, Protocol, SerialSettings};
-pub use tools::{StrokeKind, Tool, DEFAULT_PERFORATION, TOOL_KINDS};
+pub use tools::{StrokeKind, Tool};
+pub(crate) use tools::{DEFAULT_PERFORATION, TOOL_KINDS};
 
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -66,8 +67,8 @@ pub const BUNDLED: &[(&str, &str)] = &[
 ];
 
 /// Dialects the output stage knows, per language.
-pub const HPGL_DIALECTS: &[&str] = &["hp-gl", "camm-gl2"];
-pub const GCODE_DIALECTS: &[&str] = &["grbl"];
+pub(crate) const HPGL_DIALECTS: &[&str] = &["hp-gl", "camm-gl2"];
+pub(crate) const GCODE_DIALECTS: &[&str] = &["grbl"];
 
 /// Machine language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -216,7 +217,7 @@ pub enum ProfileError {
 }
 
 /// The user's profile directory, if one can be named.
-pub fn user_dir() -> Option<PathBuf> {
+pub(crate) fn user_dir() -> Option<PathBuf> {
     let base = std::env::var_os("XDG_CONFIG_HOME")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)

@@ -28,7 +28,7 @@ impl StrokeKind {
 }
 
 /// Stroke kinds a tool table may name (see [`StrokeKind::name`]).
-pub const TOOL_KINDS: &[&str] = &["cut", "score", "perforate", "draw", "etch"];
+pub(crate) const TOOL_KINDS: &[&str] = &["cut", "score", "perforate", "draw", "etch"];
 
 /// How one kind of stroke is made. Which fields matter depends on the language:
 ///
@@ -67,7 +67,7 @@ pub struct Tool {
 
 /// Dashes of a perforated fold when the perforate tool does not say: 3 mm cut, 1 mm uncut
 /// (flatcut's choice: paper folds cleanly along it and still holds while it is handled).
-pub const DEFAULT_PERFORATION: [f64; 2] = [3.0, 1.0];
+pub(crate) const DEFAULT_PERFORATION: [f64; 2] = [3.0, 1.0];
 
 impl Tool {
     /// Times each stroke is made.

@@ -38,9 +38,9 @@ use crate::profile::{Profile, DEFAULT_PERFORATION};
 use glam::DVec2;
 
 /// Length of the alignment precut, mm.
-pub const PRECUT_MM: f64 = 5.0;
+pub(crate) const PRECUT_MM: f64 = 5.0;
 /// Largest angle of one step of a swivel arc, degrees.
-pub const ARC_STEP_DEG: f64 = 10.0;
+pub(crate) const ARC_STEP_DEG: f64 = 10.0;
 
 /// What the machine's tools need (filled from the device profile: [`MachineOptions::from_profile`]).
 #[derive(Debug, Clone, PartialEq)]

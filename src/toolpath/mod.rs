@@ -95,7 +95,7 @@ impl StrokeRole {
 /// The tool that makes folds on a device whose tool table has the kinds `has` accepts: the
 /// scoring tool, else the perforating one (folds cut as dashes, see [`knife`]), else the pen;
 /// `None`: the device cannot make folds and they are left out.
-pub fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+pub(crate) fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
     [StrokeKind::Score, StrokeKind::Perforate, StrokeKind::Draw]
         .into_iter()
         .find(|k| has(*k))
@@ -207,7 +207,7 @@ pub fn unordered(
 
 /// Order one sheet's strokes: by group (see [`group_of`]), piece by piece when `per_piece`,
 /// and inside each group for short travel ([`order::order`]). The pen starts at the origin.
-pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
+pub(crate) fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
     let mut pen = DVec2::ZERO;
     let mut out = Vec::with_capacity(strokes.len());
     if !per_piece {

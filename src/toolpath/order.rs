@@ -28,15 +28,15 @@ use super::Stroke;
 use glam::DVec2;
 
 /// Nearest stroke ends considered per end.
-pub const NEIGHBOURS: usize = 8;
+pub(crate) const NEIGHBOURS: usize = 8;
 /// Longest run of strokes one 2-opt move reverses.
-pub const WINDOW: usize = 1000;
+pub(crate) const WINDOW: usize = 1000;
 /// Sweeps over the sequence per round of 2-opt.
-pub const PASSES: usize = 30;
+pub(crate) const PASSES: usize = 30;
 /// Rounds of 2-opt + entry re-picking.
-pub const ROUNDS: usize = 4;
+pub(crate) const ROUNDS: usize = 4;
 /// Smallest gain (mm) a move must make.
-pub const EPS: f64 = 1e-9;
+pub(crate) const EPS: f64 = 1e-9;
 
 /// Order `strokes` for short pen-up travel from `pen`; `pen` ends at the last stroke's end.
 /// Returns the original order (untouched) when the optimised one is not shorter.
@@ -74,7 +74,7 @@ pub fn order_with(strokes: Vec<Stroke>, pen: &mut DVec2, rounds: usize) -> Vec<S
 }
 
 /// Pen-up travel of strokes taken as they are, from `pen`.
-pub fn travel_from(mut pen: DVec2, strokes: &[Stroke]) -> f64 {
+pub(crate) fn travel_from(mut pen: DVec2, strokes: &[Stroke]) -> f64 {
     let mut total = 0.0;
     for s in strokes {
         if let (Some(first), Some(last)) = (s.points.first(), s.points.last()) {

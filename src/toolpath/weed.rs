@@ -56,7 +56,7 @@ pub fn lines(layout: &Layout, sheet: &Sheet, opts: &WeedOptions) -> Vec<Stroke> 
 
 /// The weed lines around and between `rings` (outer contours, sheet mm) on a `width` × `height`
 /// sheet.
-pub fn weed_rings(
+pub(crate) fn weed_rings(
     rings: &[Vec<DVec2>],
     width: f64,
     height: f64,

@@ -25,7 +25,7 @@ use crate::profile::Profile;
 use glam::{DVec2, DVec3};
 
 /// Rapid (G0) rate, mm/min; GRBL's default `$110`/`$111` max rate is 500, cutters set more.
-pub const RAPID_MM_MIN: f64 = 6000.0;
+pub(crate) const RAPID_MM_MIN: f64 = 6000.0;
 
 #[derive(Debug, Clone)]
 enum ToolRule {
@@ -145,7 +145,7 @@ impl Grbl {
     }
 
     /// The tool that is down now (a laser counts while it is on).
-    pub fn tool_down_now(&self) -> Option<String> {
+    pub(crate) fn tool_down_now(&self) -> Option<String> {
         self.tool_down(true)
     }
 
@@ -159,7 +159,7 @@ impl Grbl {
     }
 
     /// Execute one line (without its line ending).
-    pub fn execute(&mut self, line: &str) -> Result<Effect, u32> {
+    pub(crate) fn execute(&mut self, line: &str) -> Result<Effect, u32> {
         if line.len() > crate::device::grbl::LINE_MAX {
             return Err(11);
         }

@@ -21,15 +21,17 @@ use glam::DVec2;
 use std::collections::BTreeMap;
 
 /// Pen-up speed, cm/s.
-pub const TRAVEL_CM_S: f64 = 50.0;
+pub(crate) const TRAVEL_CM_S: f64 = 50.0;
 /// Pen-down speed when neither the program nor the profile says, cm/s.
-pub const DEFAULT_CM_S: f64 = 20.0;
+pub(crate) const DEFAULT_CM_S: f64 = 20.0;
 
 /// For an instruction still arriving: the bytes at the front of `buf` that a plotter can
 /// already execute, and the mnemonic to put back in front of the rest. A plotter moves as
 /// coordinate pairs arrive; without this a host stopped by XOFF in the middle of a long `PD`
 /// would wait for XON while the device waited for the `;`.
-pub fn executable_prefix<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<(usize, [u8; 2])> {
+pub(crate) fn executable_prefix<'a>(
+    buf: impl IntoIterator<Item = &'a u8>,
+) -> Option<(usize, [u8; 2])> {
     let bytes: Vec<u8> = buf.into_iter().copied().take(4096).collect();
     let start = bytes.iter().position(|b| !b.is_ascii_whitespace())?;
     let op = bytes.get(start..start + 2)?;
@@ -146,7 +148,7 @@ impl Hpgl {
 
     /// Execute one instruction (its bytes, terminator optional). Returns the time its motion
     /// takes, seconds.
-    pub fn execute(&mut self, raw: &[u8]) -> f64 {
+    pub(crate) fn execute(&mut self, raw: &[u8]) -> f64 {
         let text = String::from_utf8_lossy(raw);
         let (op, args_text) = match instruction(&text) {
             None => return 0.0,
@@ -220,7 +222,7 @@ impl Hpgl {
     }
 
     /// The tool that is down now, if any.
-    pub fn tool_down(&self) -> Option<String> {
+    pub(crate) fn tool_down(&self) -> Option<String> {
         if self.down {
             self.tool_name()
         } else {

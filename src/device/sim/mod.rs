@@ -33,12 +33,12 @@
 //! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
 
 pub mod grbl;
-pub mod hpgl;
-pub mod record;
+pub(crate) mod hpgl;
+pub(crate) mod record;
 
 use crate::device::grbl as proto;
 use crate::profile::{FlowControl, Language, Profile};
-use record::SimPath;
+pub use record::SimPath;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{Read, Write};
@@ -52,11 +52,11 @@ pub const XON: u8 = 0x11;
 pub const XOFF: u8 = 0x13;
 
 /// Bytes the simulator still takes after asking the host to stop.
-pub const SKID: usize = 16;
+pub(crate) const SKID: usize = 16;
 /// Time a host has to react to XOFF or CTS before growth of its backlog counts as a violation.
 pub const STOP_GRACE: Duration = Duration::from_millis(250);
 /// GRBL planner blocks (`BLOCK_BUFFER_SIZE` 16, one kept free).
-pub const PLANNER_BLOCKS: usize = 15;
+pub(crate) const PLANNER_BLOCKS: usize = 15;
 
 /// Faults to inject.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -805,7 +805,7 @@ pub fn stream_job(
 
 /// Draw what the simulator cut, in the machine's axes (mm), and write `<stem>.png` and
 /// `<stem>.json` into `dir`. Returns the two paths.
-pub fn write_outputs(
+pub(crate) fn write_outputs(
     rep: &SimReport,
     profile: &Profile,
     dir: &Path,

@@ -64,13 +64,13 @@ pub use read::{parse, ParsedStroke};
 const PD_POINTS: usize = 32;
 
 /// Largest coordinate magnitude, plotter units, of plain HP-GL.
-pub const HPGL_LIMIT: i64 = (1 << 23) - 1;
+pub(crate) const HPGL_LIMIT: i64 = (1 << 23) - 1;
 /// Largest coordinate magnitude, plotter units, of Roland CAMM-GL (mode 2).
-pub const CAMM_LIMIT: i64 = (1 << 26) - 1;
+pub(crate) const CAMM_LIMIT: i64 = (1 << 26) - 1;
 
 /// The HP-GL dialects flatcut writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Dialect {
+pub(crate) enum Dialect {
     /// Plain HP-GL (`hp-gl`).
     Hpgl,
     /// Roland CAMM-GL mode 2 (`camm-gl2`).
@@ -164,7 +164,7 @@ fn profile_line(profile: &Profile, which: &'static str, line: &str) -> Result<St
 }
 
 /// Encode one sheet's strokes (see the module documentation for the exact text).
-pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     let dialect = Dialect::of(profile)?;
     let limit = dialect.limit();
     let mut out = String::from("IN;\n");

@@ -10,13 +10,13 @@
 //! the program); NUL bytes around an instruction are ignored.
 
 /// Whether `b` ends an HP-GL instruction: `;` or a line feed.
-pub fn ends_instruction(b: u8) -> bool {
+pub(crate) fn ends_instruction(b: u8) -> bool {
     b == b';' || b == b'\n'
 }
 
 /// Length of the complete instruction at the front of `buf` (terminator included), if the
 /// terminator has arrived.
-pub fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
+pub(crate) fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
     buf.into_iter()
         .position(|&b| ends_instruction(b))
         .map(|i| i + 1)
