@@ -8,9 +8,9 @@
 //! criterion, so the closing note can quote it.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use flatcut::device::profile::{self, Profile};
 use flatcut::device::sim::{self, SimConfig};
 use flatcut::device::stream;
+use flatcut::profile::{self, Profile};
 use std::time::Duration;
 
 fn hpgl(size: usize) -> Vec<u8> {

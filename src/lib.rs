@@ -18,6 +18,7 @@ pub mod nest;
 pub mod output;
 pub mod pattern;
 pub mod pipeline;
+pub mod profile;
 pub mod spec;
 pub mod surface;
 pub mod toolpath;
@@ -41,7 +42,7 @@ pub enum Error {
     #[error(transparent)]
     Output(#[from] output::OutputError),
     #[error(transparent)]
-    Profile(#[from] device::ProfileError),
+    Profile(#[from] profile::ProfileError),
     #[error(transparent)]
     Serial(#[from] device::serial::SerialError),
     /// Boxed: it carries the job position and is much larger than the other variants.

@@ -17,11 +17,12 @@
 //! command-line flags were checked by `cli` before they get here; warnings of the surface and
 //! flatten stages go to standard error unless `quiet`.
 
-use crate::device::profile::Profile;
 use crate::flatten::Flat;
 use crate::nest::Layout;
+pub use crate::output::files::{create_dir, write_atomic};
 use crate::output::report::{self, RunInfo};
 use crate::pattern::Piece;
+use crate::profile::Profile;
 use crate::spec::{MaterialKind, Spec};
 use crate::toolpath::{Job, StrokeKind, ToolpathOptions};
 use crate::Error;
@@ -126,7 +127,7 @@ pub fn device(
     folds: Option<Folds>,
     knife_offset: Option<f64>,
 ) -> Result<Profile, Error> {
-    let mut profile = crate::device::profile::find(name)?;
+    let mut profile = crate::profile::find(name)?;
     if let Some(v) = knife_offset {
         profile.knife_offset = v;
     }
@@ -211,7 +212,10 @@ pub fn plan(
 /// The job as the device makes it: folds as the profile's tools make them (perforation
 /// dashes), overcut, drag-knife compensation with its alignment precut in the sheet margin.
 pub fn machine_job(job: &Job, profile: &Profile, spec: &Spec) -> Job {
-    crate::toolpath::knife::prepare(job, &profile.machine_options(spec.sheet.margin))
+    crate::toolpath::knife::prepare(
+        job,
+        &crate::toolpath::knife::MachineOptions::from_profile(profile, spec.sheet.margin),
+    )
 }
 
 /// Default output directory for a job name.
@@ -408,8 +412,8 @@ pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let expected: &[&str] = match profile.language {
-        crate::device::Language::Hpgl => &["plt", "hpgl", "hpg"],
-        crate::device::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
+        crate::profile::Language::Hpgl => &["plt", "hpgl", "hpg"],
+        crate::profile::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
     };
     if !expected.contains(&ext.as_str()) {
         return Err(Error::Usage(format!(
@@ -459,7 +463,7 @@ fn write_report(
     };
     let rep = report::build(&info, flats, layout);
     let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
-    write_atomic(&dir.join("report.json"), text.as_bytes())
+    Ok(write_atomic(&dir.join("report.json"), text.as_bytes())?)
 }
 
 /// Write the surfaces' meshes into one OBJ file (`--surface-obj`), atomically.
@@ -479,7 +483,7 @@ pub fn write_surface_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
     }
     let comment = format!("flatcut surface mesh (mm): {}", names.join(", "));
     let text = crate::output::obj::write(&mesh, None, &comment).unwrap_or_default();
-    write_atomic(path, text.as_bytes())
+    Ok(write_atomic(path, text.as_bytes())?)
 }
 
 /// `--uv-obj FILE`: each surface's mesh with its flat layout (mm) as `vt`; with several
@@ -584,38 +588,4 @@ fn sheet_file(name: &str, i: usize, n: usize, ext: &str) -> String {
     } else {
         format!("{name}-{}.{ext}", i + 1)
     }
-}
-
-/// Write a file so that it is either complete or absent: write a hidden temporary file beside
-/// it, flush it to disk, then rename it over the final name.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    use std::io::Write;
-    let err = |source| Error::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(e));
-    }
-    Ok(())
-}
-
-/// Create the output directory.
-pub fn create_dir(dir: &Path) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-        path: dir.to_path_buf(),
-        source,
-    })
 }

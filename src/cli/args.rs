@@ -107,7 +107,7 @@ pub struct ToolpathArgs {
 
 impl ToolpathArgs {
     /// The device profile `name` as this job uses it (folds, knife offset from the flags).
-    pub fn device(&self, name: &str) -> Result<crate::device::Profile, Error> {
+    pub fn device(&self, name: &str) -> Result<crate::profile::Profile, Error> {
         if let Some(v) = self.knife_offset {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::Usage(format!(

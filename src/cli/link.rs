@@ -7,9 +7,9 @@
 //! written beside the program (`sim.png`, `sim.json`; `sim-<k>.*` per sheet when there are
 //! several) and their paths printed.
 
-use crate::device::profile::Profile;
 use crate::device::sim::{self, SimConfig};
 use crate::device::stream::{self, StreamOptions};
+use crate::profile::Profile;
 use crate::Error;
 use clap::Args;
 use std::path::Path;

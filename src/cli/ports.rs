@@ -14,12 +14,12 @@ pub fn ports() -> Result<(), Error> {
 }
 
 pub fn devices() -> Result<(), Error> {
-    let all = crate::device::profile::all()?;
+    let all = crate::profile::all()?;
     let w = all.iter().map(|p| p.name.len()).max().unwrap_or(0);
     for p in all {
         println!("{:w$}  {}", p.name, p.description);
     }
-    if let Some(d) = crate::device::profile::user_dir() {
+    if let Some(d) = crate::profile::user_dir() {
         println!("(your own profiles go in {})", d.display());
     }
     Ok(())

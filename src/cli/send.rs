@@ -26,7 +26,7 @@ pub struct SendArgs {
 }
 
 pub fn run(a: &SendArgs) -> Result<(), Error> {
-    let profile = crate::device::profile::find(&a.device)?;
+    let profile = crate::profile::find(&a.device)?;
     let bytes = crate::pipeline::read_program(&a.file, &profile)?;
     let dir = a
         .output

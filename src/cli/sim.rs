@@ -41,7 +41,7 @@ pub struct SimArgs {
 }
 
 pub fn run(a: &SimArgs) -> Result<(), Error> {
-    let profile = crate::device::profile::find(&a.device)?;
+    let profile = crate::profile::find(&a.device)?;
     if !(a.speed.is_finite() && a.speed >= 0.0) {
         return Err(Error::Usage(format!(
             "--speed must be 0 or positive, got {}",

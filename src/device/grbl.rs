@@ -10,19 +10,19 @@
 /// GRBL's serial receive buffer, bytes.
 pub const RX_BUFFER: usize = 128;
 /// Longest line GRBL accepts, characters (without the newline).
-pub const LINE_MAX: usize = 80;
+pub(crate) const LINE_MAX: usize = 80;
 
 /// Real-time commands: picked out of the byte stream as they arrive, never buffered.
-pub const STATUS_QUERY: u8 = b'?';
-pub const FEED_HOLD: u8 = b'!';
-pub const CYCLE_START: u8 = b'~';
-pub const SOFT_RESET: u8 = 0x18;
+pub(crate) const STATUS_QUERY: u8 = b'?';
+pub(crate) const FEED_HOLD: u8 = b'!';
+pub(crate) const CYCLE_START: u8 = b'~';
+pub(crate) const SOFT_RESET: u8 = 0x18;
 
 /// The welcome line GRBL prints after a reset.
-pub const WELCOME: &str = "Grbl 1.1h ['$' for help]";
+pub(crate) const WELCOME: &str = "Grbl 1.1h ['$' for help]";
 
 /// GRBL 1.1's meaning of `error:N`.
-pub fn error_meaning(code: u32) -> &'static str {
+pub(crate) fn error_meaning(code: u32) -> &'static str {
     match code {
         1 => "G-code words consist of a letter and a value; letter was not found",
         2 => "numeric value format is not valid or missing an expected value",
@@ -65,7 +65,7 @@ pub fn error_meaning(code: u32) -> &'static str {
 }
 
 /// GRBL 1.1's meaning of `ALARM:N`.
-pub fn alarm_meaning(code: u32) -> &'static str {
+pub(crate) fn alarm_meaning(code: u32) -> &'static str {
     match code {
         1 => "hard limit triggered; position lost, re-homing is highly recommended",
         2 => "soft limit alarm: motion target exceeds machine travel",
@@ -82,7 +82,7 @@ pub fn alarm_meaning(code: u32) -> &'static str {
 
 /// One line GRBL sends back.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Response {
+pub(crate) enum Response {
     Ok,
     Error(u32),
     Alarm(u32),
@@ -95,7 +95,7 @@ pub enum Response {
 }
 
 /// Parse one response line (without its line ending).
-pub fn parse_response(line: &str) -> Response {
+pub(crate) fn parse_response(line: &str) -> Response {
     let line = line.trim();
     if line == "ok" {
         return Response::Ok;

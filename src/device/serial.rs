@@ -12,7 +12,7 @@
 //!   lines; for the simulated cutter the transport reads the simulator's CTS flag instead
 //!   ([`Link::with_virtual_cts`]).
 
-use super::profile::{FlowControl, Parity, Profile};
+use crate::profile::{FlowControl, Parity, Profile};
 use serialport::SerialPort;
 use std::io::{Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -42,7 +42,7 @@ pub struct Link {
 }
 
 /// Poll interval of reads and writes; operations loop on it to watch deadlines and Ctrl-C.
-pub const POLL: Duration = Duration::from_millis(20);
+pub(crate) const POLL: Duration = Duration::from_millis(20);
 
 /// Open `port` with the profile's serial settings; `baud` overrides the profile's.
 pub fn open(profile: &Profile, port: &str, baud: Option<u32>) -> Result<Link, SerialError> {
@@ -113,7 +113,7 @@ impl Link {
     }
 
     /// Whether the device lets us send (always true unless the profile uses RTS/CTS).
-    pub fn clear_to_send(&mut self) -> bool {
+    pub(crate) fn clear_to_send(&mut self) -> bool {
         if self.flow != FlowControl::RtsCts {
             return true;
         }
@@ -140,7 +140,7 @@ impl Link {
     }
 
     /// Read what has arrived, waiting at most [`POLL`]; `Ok(0)` when nothing came.
-    pub fn read_some(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+    pub(crate) fn read_some(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         match self.port.read(buf) {
             Ok(0) => Err(std::io::Error::new(
                 std::io::ErrorKind::BrokenPipe,
@@ -152,7 +152,7 @@ impl Link {
     }
 
     /// Read what has already arrived without waiting.
-    pub fn read_ready(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+    pub(crate) fn read_ready(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = match self.port.bytes_to_read() {
             Ok(n) => n as usize,
             Err(e) => {
@@ -191,7 +191,7 @@ fn nothing_yet(e: std::io::Error) -> std::io::Result<usize> {
 }
 
 /// Serial ports on this machine: (path, description).
-pub fn list_ports() -> Vec<(String, String)> {
+pub(crate) fn list_ports() -> Vec<(String, String)> {
     // Without libudev, serialport reads /sys/class/tty and panics if it is absent.
     if cfg!(target_os = "linux") && !std::path::Path::new("/sys/class/tty").is_dir() {
         return Vec::new();

@@ -30,15 +30,15 @@
 #![allow(clippy::result_large_err)]
 
 use super::grbl::{self as proto, Response};
-use super::profile::{FlowControl, Language, Profile, Protocol};
 use super::serial::Link;
 use super::sim::{XOFF, XON};
+use crate::profile::{FlowControl, Language, Profile, Protocol};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Largest write of the buffered protocol, bytes.
-pub const CHUNK: usize = 16;
+pub(crate) const CHUNK: usize = 16;
 
 /// How the stream behaves.
 #[derive(Debug, Clone)]
@@ -201,7 +201,7 @@ pub struct StreamReport {
 }
 
 /// Byte offsets where strokes start: HP-GL `PU` with coordinates, G-code `G0` with X or Y.
-pub fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
+pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
     let mut out = Vec::new();
     match language {
         Language::Hpgl => {
@@ -309,6 +309,8 @@ fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
     }
 }
 
+/// Stream an HP-GL program under the profile's flow control (XON/XOFF, RTS/CTS, or none:
+/// paced by the program's own execution time), at the line rate.
 fn buffered(
     link: &mut Link,
     profile: &Profile,
@@ -357,23 +359,13 @@ fn buffered(
         }
         // Listen: XON/XOFF and anything else the device says.
         match link.read_ready(&mut input) {
-            Ok(n) => {
-                for &b in &input[..n] {
-                    match b {
-                        XOFF if flow == FlowControl::XonXoff => {
-                            if !stopped {
-                                rep.xoff_received += 1;
-                            }
-                            stopped = true;
-                        }
-                        XON if flow == FlowControl::XonXoff => {
-                            stopped = false;
-                            last_progress = Instant::now();
-                        }
-                        _ => rep.garbage_bytes += 1,
-                    }
-                }
-            }
+            Ok(n) => take_in(
+                &input[..n],
+                flow,
+                &mut rep,
+                &mut stopped,
+                &mut last_progress,
+            ),
             Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
         let cts = link.clear_to_send();
@@ -463,6 +455,32 @@ fn buffered(
     Ok(rep)
 }
 
+/// Take in bytes the device sent while a buffered program goes out: XOFF stops the sender and
+/// XON resumes it (under XON/XOFF flow control); anything else is counted as garbage.
+fn take_in(
+    bytes: &[u8],
+    flow: FlowControl,
+    rep: &mut StreamReport,
+    stopped: &mut bool,
+    last_progress: &mut Instant,
+) {
+    for &b in bytes {
+        match b {
+            XOFF if flow == FlowControl::XonXoff => {
+                if !*stopped {
+                    rep.xoff_received += 1;
+                }
+                *stopped = true;
+            }
+            XON if flow == FlowControl::XonXoff => {
+                *stopped = false;
+                *last_progress = Instant::now();
+            }
+            _ => rep.garbage_bytes += 1,
+        }
+    }
+}
+
 /// For each HP-GL instruction, where it ends in the program and a safe upper bound of when
 /// (seconds after the first byte) the device will have executed it: the line time of every byte
 /// up to it plus the motion time of every instruction up to it (from the speeds the program
@@ -473,7 +491,7 @@ fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
     let (mut at, mut motion) = (0usize, 0.0f64);
     let mut out = Vec::new();
     let mut rest = program;
-    while let Some(n) = super::sim::hpgl::next_instruction(rest) {
+    while let Some(n) = crate::output::hpgl::read::next_instruction(rest) {
         motion += m.execute(&rest[..n]);
         at += n;
         out.push((at, 1.1 * (motion + at as f64 / rate)));
@@ -841,7 +859,7 @@ impl<'a> Grbl<'a> {
         if alarm {
             up.push_str("$X\n");
         }
-        if let Some(t) = self.profile.tool(crate::toolpath::StrokeKind::Cut) {
+        if let Some(t) = self.profile.tool(crate::profile::StrokeKind::Cut) {
             if let Some(z) = t.z_up {
                 up.push_str(&format!("G0 Z{}\n", crate::output::fmt_mm(z)));
             } else if let Some(s) = t.servo_up {

@@ -23,7 +23,7 @@ use glam::DVec2;
 use std::fmt::Write;
 
 /// Layer names.
-pub const LAYERS: [(&str, u8); 5] = [
+pub(crate) const LAYERS: [(&str, u8); 5] = [
     ("CUT", 7),
     ("BEND_UP", 1),
     ("BEND_DOWN", 5),
@@ -48,6 +48,26 @@ impl Dxf {
         self.handle += 1;
         let h = format!("{:X}", self.handle);
         self.pair(5, h);
+    }
+    /// `0 SECTION`, `2 name`.
+    fn section(&mut self, name: &str) {
+        self.pair(0, "SECTION");
+        self.pair(2, name);
+    }
+    /// A symbol table's header: its name, handle and number of entries.
+    fn table(&mut self, name: &str, entries: usize) {
+        self.pair(0, "TABLE");
+        self.pair(2, name);
+        self.handle();
+        self.pair(100, "AcDbSymbolTable");
+        self.pair(70, entries);
+    }
+    /// The start of one record of a symbol table: `kind`, its handle and subclass markers.
+    fn record(&mut self, kind: &str, subclass: &str) {
+        self.pair(0, kind);
+        self.handle();
+        self.pair(100, "AcDbSymbolTableRecord");
+        self.pair(100, subclass);
     }
     fn entity(&mut self, kind: &str, layer: &str, subclass: &str) {
         self.pair(0, kind);
@@ -94,8 +114,7 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
         out: String::new(),
         handle: 0x10,
     };
-    d.pair(0, "SECTION");
-    d.pair(2, "HEADER");
+    d.section("HEADER");
     d.pair(9, "$ACADVER");
     d.pair(1, "AC1015");
     d.pair(9, "$INSUNITS");
@@ -104,17 +123,9 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
     d.pair(70, 1);
     d.pair(0, "ENDSEC");
 
-    d.pair(0, "SECTION");
-    d.pair(2, "TABLES");
-    d.pair(0, "TABLE");
-    d.pair(2, "LTYPE");
-    d.handle();
-    d.pair(100, "AcDbSymbolTable");
-    d.pair(70, 1);
-    d.pair(0, "LTYPE");
-    d.handle();
-    d.pair(100, "AcDbSymbolTableRecord");
-    d.pair(100, "AcDbLinetypeTableRecord");
+    d.section("TABLES");
+    d.table("LTYPE", 1);
+    d.record("LTYPE", "AcDbLinetypeTableRecord");
     d.pair(2, "CONTINUOUS");
     d.pair(70, 0);
     d.pair(3, "Solid line");
@@ -122,16 +133,9 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
     d.pair(73, 0);
     d.num(40, 0.0);
     d.pair(0, "ENDTAB");
-    d.pair(0, "TABLE");
-    d.pair(2, "LAYER");
-    d.handle();
-    d.pair(100, "AcDbSymbolTable");
-    d.pair(70, LAYERS.len());
+    d.table("LAYER", LAYERS.len());
     for (name, color) in LAYERS {
-        d.pair(0, "LAYER");
-        d.handle();
-        d.pair(100, "AcDbSymbolTableRecord");
-        d.pair(100, "AcDbLayerTableRecord");
+        d.record("LAYER", "AcDbLayerTableRecord");
         d.pair(2, name);
         d.pair(70, 0);
         d.pair(62, color);
@@ -140,8 +144,7 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
     d.pair(0, "ENDTAB");
     d.pair(0, "ENDSEC");
 
-    d.pair(0, "SECTION");
-    d.pair(2, "ENTITIES");
+    d.section("ENTITIES");
     if let Some(sh) = layout.sheets.get(sheet) {
         for &k in &sh.pieces {
             let (piece, place) = (&layout.pieces[k], &layout.placements[k]);

@@ -54,16 +54,16 @@
 //! - The end: the tool is up after the last stroke's lift; then `M5` (once), the profile's
 //!   `end` lines, `M2`.
 
-use super::{fmt_mm, line_error, to_device, tool_error, OutputError};
-use crate::device::{Profile, Tool};
+use super::{device_points, fmt_mm, line_error, one_line, stroke_tool, tool_error, OutputError};
+use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 
 /// Most characters on one line, newline not counted (GRBL's line buffer holds 79).
-pub const LINE_MAX: usize = 79;
+pub(crate) const LINE_MAX: usize = 79;
 /// Largest coordinate magnitude, mm.
-pub const LIMIT_MM: f64 = 100_000.0;
+pub(crate) const LIMIT_MM: f64 = 100_000.0;
 /// Seconds to wait after a servo move when the tool does not say.
-pub const DEFAULT_DWELL: f64 = 0.15;
+pub(crate) const DEFAULT_DWELL: f64 = 0.15;
 
 /// How a tool goes down and up, with its numbers formatted.
 #[derive(Debug, Clone, PartialEq)]
@@ -243,15 +243,7 @@ fn profile_line<'a>(
     which: &'static str,
     line: &'a str,
 ) -> Result<&'a str, OutputError> {
-    let t = line.trim();
-    if t.contains(['\n', '\r']) {
-        return Err(line_error(
-            profile,
-            which,
-            line,
-            "one block per line: split it into several lines".into(),
-        ));
-    }
+    let t = one_line(profile, which, line, "block")?;
     if t.chars().count() > LINE_MAX {
         return Err(line_error(
             profile,
@@ -264,7 +256,7 @@ fn profile_line<'a>(
 }
 
 /// Encode one sheet's strokes (see the module documentation for the exact text).
-pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     if profile.dialect != "grbl" {
         return Err(OutputError::Dialect {
             profile: profile.name.clone(),
@@ -285,31 +277,16 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
         }
     }
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
-            continue;
-        };
-        let Some(tool) = profile.tool(kind) else {
+        let Some((kind, tool)) = stroke_tool(profile, stroke.role) else {
             continue;
         };
         let tool = check_tool(profile, kind.name(), tool)?;
-        let mut pts: Vec<(String, String)> = Vec::with_capacity(stroke.points.len());
-        for q in &stroke.points {
-            let d = to_device(profile, sheet.width, sheet.height, *q);
-            for v in [d.x, d.y] {
-                if !(v.is_finite() && v.abs() <= LIMIT_MM) {
-                    return Err(OutputError::OutOfRange {
-                        sheet: None,
-                        stroke: index + 1,
-                        role: stroke.role.name(),
-                        value: v,
-                        limit: LIMIT_MM,
-                        units: "mm",
-                        profile: profile.name.clone(),
-                    });
-                }
-            }
-            pts.push((fmt_mm(d.x), fmt_mm(d.y)));
-        }
+        let fits = |v: f64| v.is_finite() && v.abs() <= LIMIT_MM;
+        let mut pts: Vec<(String, String)> =
+            device_points(profile, sheet, index, stroke, (LIMIT_MM, "mm"), fits)?
+                .iter()
+                .map(|d| (fmt_mm(d.x), fmt_mm(d.y)))
+                .collect();
         pts.dedup();
         let Some(start) = pts.first().cloned() else {
             continue;
@@ -350,8 +327,8 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::profile::parse as parse_profile;
-    use crate::output::fixtures::{sheet, stroke};
+    use crate::output::fixtures::{half_unit_steps, sheet, stroke};
+    use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
     use glam::DVec2;
 
@@ -451,7 +428,7 @@ mod tests {
             "{e}"
         );
         // Profiles are validated when read; a profile built in code still meets these checks.
-        let with = |f: &dyn Fn(&mut crate::device::Tool)| {
+        let with = |f: &dyn Fn(&mut crate::profile::Tool)| {
             let mut p = profile(KNIFE);
             if let Some(t) = p.tools.get_mut("cut") {
                 f(t);
@@ -579,17 +556,7 @@ mod tests {
 
     #[test]
     fn absolute_rounding_does_not_drift() {
-        let mut pts = Vec::new();
-        let mut x = 0.0;
-        for _ in 0..=8000 {
-            pts.push((x, 5.0));
-            x += 0.0125;
-        }
-        let job = SheetJob {
-            width: 200.0,
-            height: 10.0,
-            strokes: vec![stroke(StrokeRole::Cut, &pts)],
-        };
+        let (pts, job) = half_unit_steps(5.0);
         let p = profile("[tools.cut]\nz_down=-1.0\nz_up=2.0\nspeed=1200\n");
         let paths = down_paths(&text(&job, &p), &p);
         let got = &paths[0];

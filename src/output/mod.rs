@@ -2,7 +2,8 @@
 //! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
 //! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
-//! texture coordinates ([`obj`]).
+//! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
+//! run's files ([`files`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
@@ -16,12 +17,13 @@
 //!   tool that lacks what the language needs is an error ([`OutputError::Tool`]), as is a
 //!   position beyond what the language can address ([`OutputError::OutOfRange`]).
 
-use crate::device::{Language, Profile};
-use crate::toolpath::{SheetJob, StrokeRole};
+use crate::profile::{Language, Profile, StrokeKind, Tool};
+use crate::toolpath::{SheetJob, Stroke, StrokeRole};
 use glam::DVec2;
 
 pub mod dxf;
-pub mod gcode;
+pub mod files;
+pub(crate) mod gcode;
 pub mod hpgl;
 pub mod obj;
 pub mod png;
@@ -85,6 +87,12 @@ pub enum OutputError {
         units: &'static str,
         profile: String,
     },
+    /// A file of the run could not be written (or its directory made).
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
 }
 
 fn sheet_prefix(sheet: &Option<usize>) -> String {
@@ -127,6 +135,65 @@ pub(crate) fn line_error(
     }
 }
 
+/// An `init` or `end` line of `profile`, trimmed: one `what` (instruction, block) of the
+/// language; a line break inside it is an [`OutputError::ProfileLine`].
+pub(crate) fn one_line<'a>(
+    profile: &Profile,
+    which: &'static str,
+    line: &'a str,
+    what: &str,
+) -> Result<&'a str, OutputError> {
+    let t = line.trim();
+    if t.contains(['\n', '\r']) {
+        return Err(line_error(
+            profile,
+            which,
+            line,
+            format!("one {what} per line: split it into several lines"),
+        ));
+    }
+    Ok(t)
+}
+
+/// The tool that makes a stroke of `role` on `profile`, with its kind
+/// ([`crate::toolpath::tool_kind`]); `None`: the profile has none and the stroke is left out.
+pub(crate) fn stroke_tool(profile: &Profile, role: StrokeRole) -> Option<(StrokeKind, &Tool)> {
+    let kind = crate::toolpath::tool_kind(role, |k| profile.has(k))?;
+    Some((kind, profile.tool(kind)?))
+}
+
+/// The device positions ([`to_device`]) of the points of `stroke`, the sheet's stroke `index`
+/// (0-based), each coordinate checked with `fits`: the first that does not fit is an
+/// [`OutputError::OutOfRange`] that names `limit` in `units`.
+pub(crate) fn device_points(
+    profile: &Profile,
+    sheet: &SheetJob,
+    index: usize,
+    stroke: &Stroke,
+    (limit, units): (f64, &'static str),
+    fits: impl Fn(f64) -> bool,
+) -> Result<Vec<DVec2>, OutputError> {
+    let mut out = Vec::with_capacity(stroke.points.len());
+    for q in &stroke.points {
+        let d = to_device(profile, sheet.width, sheet.height, *q);
+        for v in [d.x, d.y] {
+            if !fits(v) {
+                return Err(OutputError::OutOfRange {
+                    sheet: None,
+                    stroke: index + 1,
+                    role: stroke.role.name(),
+                    value: v,
+                    limit,
+                    units,
+                    profile: profile.name.clone(),
+                });
+            }
+        }
+        out.push(d);
+    }
+    Ok(out)
+}
+
 /// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
 /// ([`hpgl::emit`]), or GRBL G-code ([`gcode::emit`]), by `profile.language` and
 /// `profile.dialect`.
@@ -164,7 +231,7 @@ pub fn to_device(profile: &Profile, sheet_w: f64, sheet_h: f64, p: DVec2) -> DVe
 
 /// Roles in drawing order, back to front: what is drawn later lies on top.
 /// The SVG layers follow this order too, after the sheet layer.
-pub const DRAW_ORDER: [StrokeRole; 9] = [
+pub(crate) const DRAW_ORDER: [StrokeRole; 9] = [
     StrokeRole::Label,
     StrokeRole::Mark,
     StrokeRole::Grain,
@@ -195,51 +262,25 @@ impl RoleStyle {
 /// marks green; labels dark green; notches black; sewing lines brown dashed; grain lines
 /// purple; weed lines grey.
 pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
-    match role {
-        StrokeRole::Cut => RoleStyle {
-            rgb: [0x00, 0x00, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::FoldMountain => RoleStyle {
-            rgb: [0xd0, 0x00, 0x00],
-            dash_mm: &[3.0, 1.0, 0.5, 1.0],
-        },
-        StrokeRole::FoldValley => RoleStyle {
-            rgb: [0x00, 0x50, 0xd0],
-            dash_mm: &[2.0, 1.0],
-        },
-        StrokeRole::Mark => RoleStyle {
-            rgb: [0x00, 0x80, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Label => RoleStyle {
-            rgb: [0x00, 0x60, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Notch => RoleStyle {
-            rgb: [0x00, 0x00, 0x00],
-            dash_mm: &[],
-        },
-        StrokeRole::Seam => RoleStyle {
-            rgb: [0x80, 0x40, 0x00],
-            dash_mm: &[4.0, 1.5],
-        },
-        StrokeRole::Grain => RoleStyle {
-            rgb: [0x60, 0x00, 0x80],
-            dash_mm: &[],
-        },
-        StrokeRole::Weed => RoleStyle {
-            rgb: [0x90, 0x90, 0x90],
-            dash_mm: &[],
-        },
-    }
+    let (rgb, dash_mm): ([u8; 3], &'static [f64]) = match role {
+        StrokeRole::Cut => ([0x00, 0x00, 0x00], &[]),
+        StrokeRole::FoldMountain => ([0xd0, 0x00, 0x00], &[3.0, 1.0, 0.5, 1.0]),
+        StrokeRole::FoldValley => ([0x00, 0x50, 0xd0], &[2.0, 1.0]),
+        StrokeRole::Mark => ([0x00, 0x80, 0x00], &[]),
+        StrokeRole::Label => ([0x00, 0x60, 0x00], &[]),
+        StrokeRole::Notch => ([0x00, 0x00, 0x00], &[]),
+        StrokeRole::Seam => ([0x80, 0x40, 0x00], &[4.0, 1.5]),
+        StrokeRole::Grain => ([0x60, 0x00, 0x80], &[]),
+        StrokeRole::Weed => ([0x90, 0x90, 0x90], &[]),
+    };
+    RoleStyle { rgb, dash_mm }
 }
 
 /// Formats a coordinate in mm with at most 3 decimals, without trailing zeros and without
 /// "-0": `12.5`, `0`, `3.142`. Rounding is Rust's `{:.3}` of the `f64`, so the text depends only
 /// on the value. A non-finite value prints as `0` so that a document stays well-formed
 /// (upstream stages only produce finite coordinates).
-pub fn fmt_mm(v: f64) -> String {
+pub(crate) fn fmt_mm(v: f64) -> String {
     if !v.is_finite() {
         return "0".to_string();
     }
@@ -279,6 +320,23 @@ pub(crate) mod fixtures {
             strokes,
         }
     }
+
+    /// A 200 × 10 mm sheet with one cut along y = `y` from x = 0 to 100 in 8000 steps of
+    /// 0.0125 mm (half a plotter unit: rounded increments would drift), and the cut's points.
+    pub fn half_unit_steps(y: f64) -> (Vec<(f64, f64)>, SheetJob) {
+        let mut pts = Vec::new();
+        let mut x = 0.0;
+        for _ in 0..=8000 {
+            pts.push((x, y));
+            x += 0.0125;
+        }
+        let sheet = SheetJob {
+            width: 200.0,
+            height: 10.0,
+            strokes: vec![stroke(StrokeRole::Cut, &pts)],
+        };
+        (pts, sheet)
+    }
 }
 
 #[cfg(test)]
@@ -305,7 +363,7 @@ mod tests {
             units_per_mm=40.0\n[tools.cut]\npen=1\n[axes]\n";
         let corners = [(0.0, 0.0), (300.0, 0.0), (300.0, 200.0), (0.0, 200.0)];
         let map = |axes: &str| -> Vec<(f64, f64)> {
-            let p = crate::device::profile::parse(&format!("{base}{axes}"), "test.toml").unwrap();
+            let p = crate::profile::parse(&format!("{base}{axes}"), "test.toml").unwrap();
             corners
                 .iter()
                 .map(|&(x, y)| {
@@ -339,11 +397,8 @@ mod tests {
             vec![(0.0, 12000.0), (0.0, 0.0), (8000.0, 0.0), (8000.0, 12000.0)]
         );
         // Swap then mirror X uses the sheet's height as X's extent; unrounded.
-        let p = crate::device::profile::parse(
-            &format!("{base}swap_xy=true\nflip_x=true\n"),
-            "test.toml",
-        )
-        .unwrap();
+        let p = crate::profile::parse(&format!("{base}swap_xy=true\nflip_x=true\n"), "test.toml")
+            .unwrap();
         let d = to_device(&p, 300.0, 200.0, DVec2::new(0.01, 0.0125));
         assert!((d.x - (200.0 - 0.0125) * 40.0).abs() < 1e-9);
         assert!((d.y - 0.4).abs() < 1e-12);
@@ -356,13 +411,13 @@ mod tests {
             height: 10.0,
             strokes: vec![],
         };
-        let hpgl = crate::device::profile::parse(
+        let hpgl = crate::profile::parse(
             "name='h'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n[tools.cut]\npen=1\n",
             "test.toml",
         )
         .unwrap();
         assert_eq!(program(&sheet, &hpgl).unwrap(), b"IN;\nPU;SP0;\n");
-        let gcode = crate::device::profile::parse(
+        let gcode = crate::profile::parse(
             "name='g'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nmax_power=1000\n[tools.cut]\npower=1\nspeed=1\n",
             "test.toml",
         )

@@ -27,16 +27,16 @@ use super::{role_style, OutputError, DRAW_ORDER};
 use crate::toolpath::SheetJob;
 
 /// Scale used when the caller has no preference: 4 px per mm (about 100 dpi).
-pub const DEFAULT_PX_PER_MM: f64 = 4.0;
+pub(crate) const DEFAULT_PX_PER_MM: f64 = 4.0;
 
 /// Longest side of a picture, px; larger pictures are drawn at a reduced scale.
-pub const MAX_SIDE_PX: u32 = 6000;
+pub(crate) const MAX_SIDE_PX: u32 = 6000;
 
 /// White border around the sheet, mm.
-pub const BORDER_MM: f64 = 2.0;
+pub(crate) const BORDER_MM: f64 = 2.0;
 
 /// Width of the stroke lines, mm (at least 1 px).
-pub const LINE_MM: f64 = 0.3;
+pub(crate) const LINE_MM: f64 = 0.3;
 
 /// Width of the sheet outline, mm (at least 1 px).
 const SHEET_OUTLINE_MM: f64 = 0.2;

@@ -108,7 +108,37 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             })
         })
         .collect();
-    let surfaces: Vec<Value> = flats
+    let surfaces = surfaces_json(flats);
+    let seams = seams_json(layout);
+    let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
+    json!({
+        "name": info.name,
+        "spec": info.spec,
+        "device": info.device,
+        "material": { "kind": info.material, "thickness_mm": info.thickness_mm },
+        "roll": layout.roll,
+        "roll_length_mm": layout.roll_length().map(r6),
+        "remnant_mm": layout.remnant.map(|(lo, hi)| [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)]),
+        "margin_mm": layout.margin,
+        "spacing_mm": layout.spacing,
+        "surfaces": surfaces,
+        "pieces": pieces,
+        "seams": seams,
+        "sheets": sheets,
+        "totals": {
+            "pieces": layout.pieces.len(),
+            "sheets": layout.sheets.len(),
+            "area_mm2": total(&|p| p.area),
+            "cut_length_mm": total(&|p| p.cut_length()),
+            "fold_length_mm": total(&|p| p.fold_length()),
+        },
+        "files": info.files,
+    })
+}
+
+/// The `surfaces` entries: one per surface, with the figures its source measured.
+fn surfaces_json(flats: &[Flat]) -> Vec<Value> {
+    flats
         .iter()
         .map(|f| {
             let mut v = json!({
@@ -120,8 +150,8 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "stretch": f.surface.charts.as_ref().map(|_| stretch_json(&crate::flatten::charts::stretch(f).1)),
             });
             // Figures the source measured (boundary surfaces: interior triangles, locally
-            // convex fraction, largest dihedral, iterations, seconds — the one entry that is
-            // not reproducible byte for byte).
+            // convex fraction, largest dihedral, iterations). No wall-clock time: two identical
+            // runs give byte-identical reports.
             if !f.surface.figures.is_empty() {
                 let figs: serde_json::Map<String, Value> = f
                     .surface
@@ -133,8 +163,11 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             }
             v
         })
-        .collect();
-    // Seams: side A and side B of every seam id.
+        .collect()
+}
+
+/// The `seams` entries, by seam id: side A and side B of every seam.
+fn seams_json(layout: &Layout) -> Vec<Value> {
     let mut seams: Vec<Value> = Vec::new();
     let sides = || {
         layout
@@ -164,30 +197,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         }));
     }
     seams.sort_by_key(|s| s["id"].as_u64());
-    let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
-    json!({
-        "name": info.name,
-        "spec": info.spec,
-        "device": info.device,
-        "material": { "kind": info.material, "thickness_mm": info.thickness_mm },
-        "roll": layout.roll,
-        "roll_length_mm": layout.roll_length().map(r6),
-        "remnant_mm": layout.remnant.map(|(lo, hi)| [r6(lo.x), r6(lo.y), r6(hi.x), r6(hi.y)]),
-        "margin_mm": layout.margin,
-        "spacing_mm": layout.spacing,
-        "surfaces": surfaces,
-        "pieces": pieces,
-        "seams": seams,
-        "sheets": sheets,
-        "totals": {
-            "pieces": layout.pieces.len(),
-            "sheets": layout.sheets.len(),
-            "area_mm2": total(&|p| p.area),
-            "cut_length_mm": total(&|p| p.cut_length()),
-            "fold_length_mm": total(&|p| p.fold_length()),
-        },
-        "files": info.files,
-    })
+    seams
 }
 
 /// Stretch figures (issue 7): L2 and L∞ (1 = isometric), triangles flipped.

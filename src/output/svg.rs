@@ -20,7 +20,7 @@ use super::{fmt_mm, role_style, DRAW_ORDER};
 use crate::toolpath::{Job, Stroke, StrokeRole};
 
 /// Horizontal gap between neighbouring sheets in the document, mm.
-pub const SHEET_GAP_MM: f64 = 20.0;
+pub(crate) const SHEET_GAP_MM: f64 = 20.0;
 
 /// Stroke width of the sheet outlines, mm.
 const SHEET_OUTLINE_MM: f64 = 0.1;
@@ -174,6 +174,16 @@ mod tests {
     use crate::toolpath::SheetJob;
     use glam::DVec2;
 
+    /// The layers every document has, bottom to top.
+    const LAYERS: [&str; 6] = [
+        "sheet",
+        "label",
+        "mark",
+        "fold-valley",
+        "fold-mountain",
+        "cut",
+    ];
+
     fn stroke(role: StrokeRole, pts: &[(f64, f64)], closed: bool, piece: Option<usize>) -> Stroke {
         Stroke {
             role,
@@ -301,20 +311,12 @@ mod tests {
         assert!(svg.contains("<title>test &lt;job&gt; &amp; &quot;co&quot;</title>"));
 
         // Layer order.
-        let names = [
-            "sheet",
-            "label",
-            "mark",
-            "fold-valley",
-            "fold-mountain",
-            "cut",
-        ];
-        let pos: Vec<usize> = names
+        let pos: Vec<usize> = LAYERS
             .iter()
             .map(|n| svg.find(&format!("id=\"layer-{n}\"")).expect("layer"))
             .collect();
         assert!(pos.windows(2).all(|w| w[0] < w[1]), "layer order {pos:?}");
-        for n in names {
+        for n in LAYERS {
             assert!(svg.contains(&format!("inkscape:label=\"{n}\"")));
         }
         assert!(layer(&svg, "sheet").contains("sodipodi:insensitive=\"true\""));
@@ -384,14 +386,7 @@ mod tests {
             sheets: Vec::new(),
         });
         check_well_formed(&svg);
-        for n in [
-            "sheet",
-            "label",
-            "mark",
-            "fold-valley",
-            "fold-mountain",
-            "cut",
-        ] {
+        for n in LAYERS {
             assert!(svg.contains(&format!("id=\"layer-{n}\"")));
         }
         assert_eq!(svg.matches("<path").count(), 0);

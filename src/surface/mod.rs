@@ -237,7 +237,6 @@ fn build_boundary(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             ("largest_dihedral_deg", f.largest_dihedral_deg),
             ("fairness_rad2", f.fairness),
             ("iterations", f.iterations as f64),
-            ("seconds", f.seconds),
         ],
         alternatives: out.alternatives,
         ..Default::default()

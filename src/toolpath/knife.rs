@@ -34,14 +34,15 @@
 //! and ending with whatever part of a cut is left at its end.
 
 use super::{Job, SheetJob, Stroke, StrokeKind, StrokeRole};
+use crate::profile::{Profile, DEFAULT_PERFORATION};
 use glam::DVec2;
 
 /// Length of the alignment precut, mm.
-pub const PRECUT_MM: f64 = 5.0;
+pub(crate) const PRECUT_MM: f64 = 5.0;
 /// Largest angle of one step of a swivel arc, degrees.
-pub const ARC_STEP_DEG: f64 = 10.0;
+pub(crate) const ARC_STEP_DEG: f64 = 10.0;
 
-/// What the machine's tools need (filled from the device profile: `Profile::machine_options`).
+/// What the machine's tools need (filled from the device profile: [`MachineOptions::from_profile`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MachineOptions {
     /// The tool kind that makes folds (`None`: folds are left out).
@@ -66,7 +67,7 @@ impl Default for MachineOptions {
     fn default() -> Self {
         MachineOptions {
             fold_kind: Some(StrokeKind::Score),
-            perforation: crate::device::profile::DEFAULT_PERFORATION,
+            perforation: DEFAULT_PERFORATION,
             knife_offset: 0.0,
             swivel_threshold_deg: 10.0,
             knife_kinds: Vec::new(),
@@ -78,6 +79,44 @@ impl Default for MachineOptions {
 }
 
 impl MachineOptions {
+    /// What a machine with `profile` needs ([`prepare`]); `margin` is the sheet margin (mm),
+    /// where the alignment precut goes.
+    pub fn from_profile(profile: &Profile, margin: f64) -> MachineOptions {
+        let fold_kind = super::fold_kind(|k| profile.has(k));
+        let kinds = [
+            StrokeKind::Cut,
+            StrokeKind::Score,
+            StrokeKind::Perforate,
+            StrokeKind::Draw,
+            StrokeKind::Etch,
+        ];
+        let m = if margin.is_finite() {
+            margin.max(0.0)
+        } else {
+            0.0
+        };
+        MachineOptions {
+            fold_kind,
+            perforation: profile
+                .tool(StrokeKind::Perforate)
+                .map(|t| t.perforation())
+                .unwrap_or(DEFAULT_PERFORATION),
+            knife_offset: profile.knife_offset,
+            swivel_threshold_deg: profile.swivel_threshold_deg,
+            knife_kinds: kinds
+                .into_iter()
+                .filter(|k| profile.is_drag_knife(*k))
+                .collect(),
+            multi_pass_kinds: kinds
+                .into_iter()
+                .filter(|k| profile.tool(*k).is_some_and(|t| t.passes() > 1))
+                .collect(),
+            overcut: profile.overcut,
+            // Half way into the margin, far enough right that the trailing tip stays on it.
+            precut_at: DVec2::new(0.5 * m + profile.knife_offset, 0.5 * m),
+        }
+    }
+
     /// The tool kind of a stroke of `role` (folds: [`MachineOptions::fold_kind`]).
     pub fn kind(&self, role: StrokeRole) -> Option<StrokeKind> {
         match role.kind() {

@@ -19,6 +19,7 @@
 //! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
 //! after every piece; everything is deterministic (counts, never clocks, bound the search).
 
+pub use crate::profile::StrokeKind;
 use glam::DVec2;
 use serde::Serialize;
 
@@ -94,7 +95,7 @@ impl StrokeRole {
 /// The tool that makes folds on a device whose tool table has the kinds `has` accepts: the
 /// scoring tool, else the perforating one (folds cut as dashes, see [`knife`]), else the pen;
 /// `None`: the device cannot make folds and they are left out.
-pub fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
+pub(crate) fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
     [StrokeKind::Score, StrokeKind::Perforate, StrokeKind::Draw]
         .into_iter()
         .find(|k| has(*k))
@@ -106,29 +107,6 @@ pub fn tool_kind(role: StrokeRole, has: impl Fn(StrokeKind) -> bool) -> Option<S
     match role.kind() {
         StrokeKind::Score => fold_kind(has),
         k => has(k).then_some(k),
-    }
-}
-
-/// Tool classes of a device's tool table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StrokeKind {
-    Cut,
-    Score,
-    Perforate,
-    Draw,
-    Etch,
-}
-
-impl StrokeKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            StrokeKind::Cut => "cut",
-            StrokeKind::Score => "score",
-            StrokeKind::Perforate => "perforate",
-            StrokeKind::Draw => "draw",
-            StrokeKind::Etch => "etch",
-        }
     }
 }
 
@@ -229,7 +207,7 @@ pub fn unordered(
 
 /// Order one sheet's strokes: by group (see [`group_of`]), piece by piece when `per_piece`,
 /// and inside each group for short travel ([`order::order`]). The pen starts at the origin.
-pub fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
+pub(crate) fn order_sheet(strokes: Vec<Stroke>, per_piece: bool) -> Vec<Stroke> {
     let mut pen = DVec2::ZERO;
     let mut out = Vec::with_capacity(strokes.len());
     if !per_piece {

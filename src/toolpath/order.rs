@@ -28,15 +28,15 @@ use super::Stroke;
 use glam::DVec2;
 
 /// Nearest stroke ends considered per end.
-pub const NEIGHBOURS: usize = 8;
+pub(crate) const NEIGHBOURS: usize = 8;
 /// Longest run of strokes one 2-opt move reverses.
-pub const WINDOW: usize = 1000;
+pub(crate) const WINDOW: usize = 1000;
 /// Sweeps over the sequence per round of 2-opt.
-pub const PASSES: usize = 30;
+pub(crate) const PASSES: usize = 30;
 /// Rounds of 2-opt + entry re-picking.
-pub const ROUNDS: usize = 4;
+pub(crate) const ROUNDS: usize = 4;
 /// Smallest gain (mm) a move must make.
-pub const EPS: f64 = 1e-9;
+pub(crate) const EPS: f64 = 1e-9;
 
 /// Order `strokes` for short pen-up travel from `pen`; `pen` ends at the last stroke's end.
 /// Returns the original order (untouched) when the optimised one is not shorter.
@@ -74,7 +74,7 @@ pub fn order_with(strokes: Vec<Stroke>, pen: &mut DVec2, rounds: usize) -> Vec<S
 }
 
 /// Pen-up travel of strokes taken as they are, from `pen`.
-pub fn travel_from(mut pen: DVec2, strokes: &[Stroke]) -> f64 {
+pub(crate) fn travel_from(mut pen: DVec2, strokes: &[Stroke]) -> f64 {
     let mut total = 0.0;
     for s in strokes {
         if let (Some(first), Some(last)) = (s.points.first(), s.points.last()) {
@@ -304,14 +304,11 @@ fn nearest_neighbour(strokes: &[Stroke], start: DVec2) -> Vec<Node> {
     nodes
 }
 
-/// Neighbour-list 2-opt over the route (see the module documentation).
-fn two_opt(strokes: &[Stroke], nodes: &mut [Node], start: DVec2) {
-    let n = nodes.len();
-    if n < 2 {
-        return;
-    }
-    // Ends of each stroke as the route holds them now: open strokes both ends, closed strokes
-    // their entry vertex. end id = 2 * stroke + (0: first point side, 1: last point side).
+/// Ends of each stroke as the route holds them now: open strokes both ends, closed strokes
+/// their entry vertex. Returns their points, their ids (end id = 2 * stroke + (0: first point
+/// side, 1: last point side)) and, per stroke, the indices of its (first, last) ends in them
+/// (`usize::MAX` for a stroke without ends).
+fn route_ends(strokes: &[Stroke], nodes: &[Node]) -> (Vec<DVec2>, Vec<usize>, Vec<(usize, usize)>) {
     let mut end_pts: Vec<DVec2> = Vec::with_capacity(2 * strokes.len());
     let mut end_ids: Vec<usize> = Vec::with_capacity(2 * strokes.len());
     let mut node_of = vec![usize::MAX; strokes.len()];
@@ -332,19 +329,6 @@ fn two_opt(strokes: &[Stroke], nodes: &mut [Node], start: DVec2) {
             end_ids.push(2 * k + 1);
         }
     }
-    let Some(grid) = Grid::new(&end_pts) else {
-        return;
-    };
-    // Neighbour lists: the nearest ends of other strokes.
-    let neighbours: Vec<Vec<usize>> = (0..end_pts.len())
-        .map(|i| {
-            let own = end_ids[i] / 2;
-            grid.nearest(&end_pts, end_pts[i], NEIGHBOURS, |j| end_ids[j] / 2 != own)
-                .into_iter()
-                .map(|(_, j)| j)
-                .collect()
-        })
-        .collect();
     // Index into end_pts of a stroke's (first, last) ends.
     let mut ends_of = vec![(usize::MAX, usize::MAX); strokes.len()];
     for (i, &id) in end_ids.iter().enumerate() {
@@ -358,6 +342,29 @@ fn two_opt(strokes: &[Stroke], nodes: &mut [Node], start: DVec2) {
             e.1 = i;
         }
     }
+    (end_pts, end_ids, ends_of)
+}
+
+/// Neighbour-list 2-opt over the route (see the module documentation).
+fn two_opt(strokes: &[Stroke], nodes: &mut [Node], start: DVec2) {
+    let n = nodes.len();
+    if n < 2 {
+        return;
+    }
+    let (end_pts, end_ids, ends_of) = route_ends(strokes, nodes);
+    let Some(grid) = Grid::new(&end_pts) else {
+        return;
+    };
+    // Neighbour lists: the nearest ends of other strokes.
+    let neighbours: Vec<Vec<usize>> = (0..end_pts.len())
+        .map(|i| {
+            let own = end_ids[i] / 2;
+            grid.nearest(&end_pts, end_pts[i], NEIGHBOURS, |j| end_ids[j] / 2 != own)
+                .into_iter()
+                .map(|(_, j)| j)
+                .collect()
+        })
+        .collect();
     let mut pos = vec![usize::MAX; strokes.len()];
     for (p, nd) in nodes.iter().enumerate() {
         pos[nd.stroke] = p;

@@ -56,7 +56,7 @@ pub fn lines(layout: &Layout, sheet: &Sheet, opts: &WeedOptions) -> Vec<Stroke> 
 
 /// The weed lines around and between `rings` (outer contours, sheet mm) on a `width` × `height`
 /// sheet.
-pub fn weed_rings(
+pub(crate) fn weed_rings(
     rings: &[Vec<DVec2>],
     width: f64,
     height: f64,
@@ -205,6 +205,10 @@ fn capsule_interval(a: DVec2, b: DVec2, g: f64, p: DVec2, dir: DVec2) -> Option<
 mod tests {
     use super::*;
 
+    fn ring(pts: &[(f64, f64)]) -> Vec<DVec2> {
+        pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect()
+    }
+
     fn square(x: f64, y: f64, s: f64) -> Vec<DVec2> {
         vec![
             DVec2::new(x, y),
@@ -219,27 +223,18 @@ mod tests {
     fn weed_lines_keep_clear_of_every_piece() {
         // A triangle, a square with a notch cut in and a diamond, spaced 3 mm and more.
         let rings = vec![
-            vec![
-                DVec2::new(5.0, 5.0),
-                DVec2::new(60.0, 5.0),
-                DVec2::new(30.0, 50.0),
-            ],
-            vec![
-                DVec2::new(63.0, 5.0),
-                DVec2::new(110.0, 5.0),
-                DVec2::new(110.0, 60.0),
-                DVec2::new(90.0, 60.0),
-                DVec2::new(90.0, 20.0),
-                DVec2::new(80.0, 20.0),
-                DVec2::new(80.0, 60.0),
-                DVec2::new(63.0, 60.0),
-            ],
-            vec![
-                DVec2::new(40.0, 55.0),
-                DVec2::new(55.0, 70.0),
-                DVec2::new(40.0, 85.0),
-                DVec2::new(25.0, 70.0),
-            ],
+            ring(&[(5.0, 5.0), (60.0, 5.0), (30.0, 50.0)]),
+            ring(&[
+                (63.0, 5.0),
+                (110.0, 5.0),
+                (110.0, 60.0),
+                (90.0, 60.0),
+                (90.0, 20.0),
+                (80.0, 20.0),
+                (80.0, 60.0),
+                (63.0, 60.0),
+            ]),
+            ring(&[(40.0, 55.0), (55.0, 70.0), (40.0, 85.0), (25.0, 70.0)]),
             square(70.0, 70.0, 20.0),
         ];
         let opts = WeedOptions::default();

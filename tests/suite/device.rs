@@ -5,10 +5,10 @@
 //! and a plain program using the kernel's XON/XOFF streaming into `flatcut sim`.
 
 use crate::common::*;
-use flatcut::device::profile::{self, Profile};
 use flatcut::device::serial;
 use flatcut::device::sim::{self, Faults, SimConfig, SimReport};
 use flatcut::device::stream::{self, StreamError, StreamOptions};
+use flatcut::profile::{self, Profile};
 use std::time::Duration;
 
 fn hpgl_profile(baud: u32, flow: &str, buffer: usize) -> Profile {
@@ -473,7 +473,7 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
         // With a drag knife the simulator records the trailing blade tip: what the design
         // asked for, not the holder's path. The precut comes first.
         let precut = usize::from(sheet.strokes.len() == design.sheets[0].strokes.len() + 1);
-        let hpgl = p.language == flatcut::device::Language::Hpgl;
+        let hpgl = p.language == flatcut::profile::Language::Hpgl;
         let round = |v: f64| {
             if hpgl {
                 v.round()
@@ -680,7 +680,7 @@ fn without_flow_control_the_buffer_paces_the_stream() {
     // 1.5 kB of 1 mm moves into a 512-byte device with no handshake, executing at the real
     // speed (20 cm/s): sending at the line rate would overrun it many times over.
     let mut p = hpgl_profile(9600, "none", 512);
-    p.serial.flow_control = flatcut::device::profile::FlowControl::None;
+    p.serial.flow_control = flatcut::profile::FlowControl::None;
     let (prog, moves) = big_hpgl(1500);
     let (r, rep) = run(&p, &prog, Some(1.0), Faults::default(), &opts(10.0));
     r.unwrap();

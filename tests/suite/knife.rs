@@ -2,9 +2,9 @@
 //! offset, `sim-dragknife`) through a real pseudo-terminal. With compensation the blade tip
 //! reaches every corner within 0.05 mm; without it the trailing tip rounds them off.
 
-use flatcut::device::profile;
 use flatcut::device::sim::{self, SimConfig};
 use flatcut::device::stream::StreamOptions;
+use flatcut::profile;
 use flatcut::toolpath::{knife, SheetJob, Stroke, StrokeRole};
 use glam::DVec2;
 use std::time::Duration;
@@ -28,7 +28,7 @@ fn cut_square(compensate: bool) -> Vec<Vec<DVec2>> {
             outer: true,
         }],
     };
-    let mut opts = p.machine_options(5.0);
+    let mut opts = flatcut::toolpath::knife::MachineOptions::from_profile(&p, 5.0);
     if !compensate {
         opts.knife_offset = 0.0;
     }

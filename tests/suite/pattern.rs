@@ -228,7 +228,7 @@ fn labels_are_inside_and_upright_marks_inside() {
     require_shared!();
     let dir = scratch("pattern-labels");
     let spec = load(&fandisk_spec(&dir), MaterialKind::Paper, None);
-    let profile = flatcut::device::profile::find("hpgl-pens").unwrap();
+    let profile = flatcut::profile::find("hpgl-pens").unwrap();
     let (_, layout, job) = flatcut::pipeline::plan_job(&spec, &profile, true).unwrap();
     let mut labels = 0;
     for sheet in &job.sheets {

@@ -21,11 +21,11 @@
 //! Motion time: `G1` at `F` (mm/min), `G0` at [`RAPID_MM_MIN`], `G4` its `P`.
 
 use super::record::Recorder;
-use crate::device::Profile;
+use crate::profile::Profile;
 use glam::{DVec2, DVec3};
 
 /// Rapid (G0) rate, mm/min; GRBL's default `$110`/`$111` max rate is 500, cutters set more.
-pub const RAPID_MM_MIN: f64 = 6000.0;
+pub(crate) const RAPID_MM_MIN: f64 = 6000.0;
 
 #[derive(Debug, Clone)]
 enum ToolRule {
@@ -145,7 +145,7 @@ impl Grbl {
     }
 
     /// The tool that is down now (a laser counts while it is on).
-    pub fn tool_down_now(&self) -> Option<String> {
+    pub(crate) fn tool_down_now(&self) -> Option<String> {
         self.tool_down(true)
     }
 
@@ -159,7 +159,7 @@ impl Grbl {
     }
 
     /// Execute one line (without its line ending).
-    pub fn execute(&mut self, line: &str) -> Result<Effect, u32> {
+    pub(crate) fn execute(&mut self, line: &str) -> Result<Effect, u32> {
         if line.len() > crate::device::grbl::LINE_MAX {
             return Err(11);
         }
@@ -167,158 +167,51 @@ impl Grbl {
         if let Some(cmd) = trimmed.strip_prefix('$') {
             return self.system(cmd);
         }
-        // Strip comments and blanks, upper-case.
-        let mut text = String::new();
-        let mut in_paren = false;
-        for c in trimmed.chars() {
-            match c {
-                '(' => in_paren = true,
-                ')' => in_paren = false,
-                ';' if !in_paren => break,
-                c if in_paren || c.is_whitespace() => {}
-                c => text.push(c.to_ascii_uppercase()),
-            }
-        }
+        let text = strip(trimmed);
         if text.is_empty() {
             return Ok(Effect::Motion(0.0));
         }
         if self.alarm {
             return Err(9);
         }
-        // Words.
-        let b = text.as_bytes();
-        let mut words: Vec<(u8, f64)> = Vec::new();
-        let mut i = 0;
-        while i < b.len() {
-            let letter = b[i];
-            if !letter.is_ascii_alphabetic() {
-                return Err(1);
-            }
-            let start = i + 1;
-            let mut j = start;
-            while j < b.len()
-                && (b[j].is_ascii_digit() || b[j] == b'.' || b[j] == b'-' || b[j] == b'+')
-            {
-                j += 1;
-            }
-            let v: f64 = text[start..j].parse().map_err(|_| 2u32)?;
-            words.push((letter, v));
-            i = j;
-        }
-        let mut motion: Option<bool> = None;
-        let mut dwell = false;
-        let (mut units, mut distance, mut spindle): (
-            Option<bool>,
-            Option<bool>,
-            Option<Option<bool>>,
-        ) = (None, None, None);
-        let mut end = false;
-        let mut seen = [false; 26];
-        let (mut x, mut y, mut z, mut f, mut s, mut p) = (None, None, None, None, None, None);
-        for &(l, v) in &words {
-            match l {
-                b'G' => {
-                    let code = (v * 10.0).round() as i64;
-                    match code {
-                        0 | 10 => {
-                            if motion.replace(code == 10).is_some() {
-                                return Err(21);
-                            }
-                        }
-                        40 => dwell = true,
-                        200 | 210 => {
-                            if units.replace(code == 200).is_some() {
-                                return Err(21);
-                            }
-                        }
-                        900 | 910 => {
-                            if distance.replace(code == 910).is_some() {
-                                return Err(21);
-                            }
-                        }
-                        170 | 540 | 940 => {}
-                        _ => return Err(20),
-                    }
-                }
-                b'M' => {
-                    let code = (v * 10.0).round() as i64;
-                    match code {
-                        20 | 300 => end = true,
-                        30 | 40 => {
-                            if spindle.replace(Some(true)).is_some() {
-                                return Err(21);
-                            }
-                        }
-                        50 => {
-                            if spindle.replace(Some(false)).is_some() {
-                                return Err(21);
-                            }
-                        }
-                        80 | 90 => {}
-                        _ => return Err(20),
-                    }
-                }
-                _ => {
-                    let k = (l - b'A') as usize;
-                    if seen[k] {
-                        return Err(25);
-                    }
-                    seen[k] = true;
-                    match l {
-                        b'X' => x = Some(v),
-                        b'Y' => y = Some(v),
-                        b'Z' => z = Some(v),
-                        b'F' => {
-                            if v < 0.0 {
-                                return Err(4);
-                            }
-                            f = Some(v)
-                        }
-                        b'S' => {
-                            if v < 0.0 {
-                                return Err(4);
-                            }
-                            s = Some(v)
-                        }
-                        b'P' => p = Some(v),
-                        b'N' => {}
-                        _ => return Err(20),
-                    }
-                }
-            }
-        }
+        let block = Block::parse(&words(&text)?)?;
+        self.apply(&block)
+    }
+
+    /// Carry out a parsed block: the effect of its words, in GRBL's order.
+    fn apply(&mut self, k: &Block) -> Result<Effect, u32> {
         // Apply in GRBL's order: feed, spindle speed, spindle, dwell, units, distance, motion.
-        if let Some(u) = units {
+        if let Some(u) = k.units {
             self.inches = u;
         }
         let scale = if self.inches { 25.4 } else { 1.0 };
-        if let Some(f) = f {
+        if let Some(f) = k.f {
             self.feed = Some(f * scale);
         }
-        if let Some(s) = s {
+        if let Some(s) = k.s {
             self.s = s;
         }
-        if let Some(sp) = spindle {
+        if let Some(sp) = k.spindle {
             self.spindle_on = sp.unwrap_or(false);
         }
         let mut seconds = 0.0;
-        if dwell {
-            let Some(p) = p else { return Err(28) };
+        if k.dwell {
+            let Some(p) = k.p else { return Err(28) };
             if p < 0.0 {
                 return Err(4);
             }
             seconds += p;
-        } else if p.is_some() {
+        } else if k.p.is_some() {
             return Err(36);
         }
-        if let Some(d) = distance {
+        if let Some(d) = k.distance {
             self.relative = d;
         }
-        if let Some(m) = motion {
+        if let Some(m) = k.motion {
             self.g1 = m;
         }
-        let axes = x.is_some() || y.is_some() || z.is_some();
-        if axes && !dwell {
+        let axes = k.x.is_some() || k.y.is_some() || k.z.is_some();
+        if axes && !k.dwell {
             if self.g1 && self.feed.is_none() {
                 return Err(22);
             }
@@ -328,9 +221,9 @@ impl Grbl {
                 None => cur,
             };
             let target = DVec3::new(
-                coord(x, self.pos.x),
-                coord(y, self.pos.y),
-                coord(z, self.pos.z),
+                coord(k.x, self.pos.x),
+                coord(k.y, self.pos.y),
+                coord(k.z, self.pos.z),
             );
             let rate = if self.g1 {
                 self.feed.unwrap_or(RAPID_MM_MIN)
@@ -342,7 +235,7 @@ impl Grbl {
             }
             self.move_to(target);
         }
-        if end {
+        if k.end {
             self.spindle_on = false;
             self.relative = false;
             self.rec.up();
@@ -441,12 +334,164 @@ impl Grbl {
     }
 }
 
+/// A line without its comments and blanks, upper-cased.
+fn strip(trimmed: &str) -> String {
+    let mut text = String::new();
+    let mut in_paren = false;
+    for c in trimmed.chars() {
+        match c {
+            '(' => in_paren = true,
+            ')' => in_paren = false,
+            ';' if !in_paren => break,
+            c if in_paren || c.is_whitespace() => {}
+            c => text.push(c.to_ascii_uppercase()),
+        }
+    }
+    text
+}
+
+/// The words of a stripped line: a letter and its number each (error 1: not a letter; 2: a
+/// bad number).
+fn words(text: &str) -> Result<Vec<(u8, f64)>, u32> {
+    let b = text.as_bytes();
+    let mut words: Vec<(u8, f64)> = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let letter = b[i];
+        if !letter.is_ascii_alphabetic() {
+            return Err(1);
+        }
+        let start = i + 1;
+        let mut j = start;
+        while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'.' || b[j] == b'-' || b[j] == b'+')
+        {
+            j += 1;
+        }
+        let v: f64 = text[start..j].parse().map_err(|_| 2u32)?;
+        words.push((letter, v));
+        i = j;
+    }
+    Ok(words)
+}
+
+/// The words of one block by modal group: `None` where the block does not set it.
+#[derive(Debug, Default)]
+struct Block {
+    /// G0 (false) or G1 (true).
+    motion: Option<bool>,
+    /// G4.
+    dwell: bool,
+    /// G20 (true: inches) or G21.
+    units: Option<bool>,
+    /// G90 or G91 (true: relative).
+    distance: Option<bool>,
+    /// M3/M4 (`Some(true)`) or M5 (`Some(false)`).
+    spindle: Option<Option<bool>>,
+    /// M2 or M30.
+    end: bool,
+    x: Option<f64>,
+    y: Option<f64>,
+    z: Option<f64>,
+    f: Option<f64>,
+    s: Option<f64>,
+    p: Option<f64>,
+}
+
+impl Block {
+    /// Sort the words into modal groups, with GRBL's error numbers for two words of one
+    /// group (21), an unsupported command (20), a repeated letter (25), a negative value (4).
+    fn parse(words: &[(u8, f64)]) -> Result<Block, u32> {
+        let mut blk = Block::default();
+        let mut seen = [false; 26];
+        for &(l, v) in words {
+            match l {
+                b'G' => {
+                    let code = (v * 10.0).round() as i64;
+                    match code {
+                        0 | 10 => {
+                            if blk.motion.replace(code == 10).is_some() {
+                                return Err(21);
+                            }
+                        }
+                        40 => blk.dwell = true,
+                        200 | 210 => {
+                            if blk.units.replace(code == 200).is_some() {
+                                return Err(21);
+                            }
+                        }
+                        900 | 910 => {
+                            if blk.distance.replace(code == 910).is_some() {
+                                return Err(21);
+                            }
+                        }
+                        170 | 540 | 940 => {}
+                        _ => return Err(20),
+                    }
+                }
+                b'M' => {
+                    let code = (v * 10.0).round() as i64;
+                    match code {
+                        20 | 300 => blk.end = true,
+                        30 | 40 => {
+                            if blk.spindle.replace(Some(true)).is_some() {
+                                return Err(21);
+                            }
+                        }
+                        50 => {
+                            if blk.spindle.replace(Some(false)).is_some() {
+                                return Err(21);
+                            }
+                        }
+                        80 | 90 => {}
+                        _ => return Err(20),
+                    }
+                }
+                _ => {
+                    let k = (l - b'A') as usize;
+                    if seen[k] {
+                        return Err(25);
+                    }
+                    seen[k] = true;
+                    match l {
+                        b'X' => blk.x = Some(v),
+                        b'Y' => blk.y = Some(v),
+                        b'Z' => blk.z = Some(v),
+                        b'F' => {
+                            if v < 0.0 {
+                                return Err(4);
+                            }
+                            blk.f = Some(v)
+                        }
+                        b'S' => {
+                            if v < 0.0 {
+                                return Err(4);
+                            }
+                            blk.s = Some(v)
+                        }
+                        b'P' => blk.p = Some(v),
+                        b'N' => {}
+                        _ => return Err(20),
+                    }
+                }
+            }
+        }
+        Ok(blk)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Execute `lines`, each of which must be accepted.
+    fn run(g: &mut Grbl, lines: &[&str]) {
+        for l in lines {
+            g.execute(l).unwrap();
+        }
+    }
+
     fn knife() -> Profile {
-        crate::device::profile::parse(
+        crate::profile::parse(
             "name='k'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nbuffer=128\n\
              [tools.cut]\nz_down=-1\nz_up=2\nspeed=600\n[tools.score]\nz_down=-0.3\nz_up=2\nspeed=900\n",
             "k.toml",
@@ -457,22 +502,21 @@ mod tests {
     #[test]
     fn knife_paths_and_errors() {
         let mut g = Grbl::new(&knife());
-        for l in [
-            "G21",
-            "G90",
-            "G94",
-            "G0 Z2",
-            "G0 X10 Y10",
-            "G1 Z-1 F600",
-            "G1 X20",
-            "G1 Y20",
-            "G0 Z2",
-        ] {
-            g.execute(l).unwrap();
-        }
-        for l in ["G0 X0 Y0", "G1 Z-0.3 F900", "G1 X5", "G0 Z2"] {
-            g.execute(l).unwrap();
-        }
+        run(
+            &mut g,
+            &[
+                "G21",
+                "G90",
+                "G94",
+                "G0 Z2",
+                "G0 X10 Y10",
+                "G1 Z-1 F600",
+                "G1 X20",
+                "G1 Y20",
+                "G0 Z2",
+            ],
+        );
+        run(&mut g, &["G0 X0 Y0", "G1 Z-0.3 F900", "G1 X5", "G0 Z2"]);
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "cut");
         assert_eq!(
@@ -510,27 +554,28 @@ mod tests {
 
     #[test]
     fn laser_burns_only_on_g1() {
-        let p = crate::device::profile::parse(
+        let p = crate::profile::parse(
             "name='l'\ndescription='d'\nlanguage='gcode'\ndialect='grbl'\nunits_per_mm=1\nprotocol='grbl-character-counting'\nmax_power=1000\n\
              [tools.cut]\npower=1000\nspeed=300\n[tools.draw]\npower=200\nspeed=1500\n",
             "l.toml",
         )
         .unwrap();
         let mut g = Grbl::new(&p);
-        for l in [
-            "G0 X1 Y1",
-            "M4 S200",
-            "G1 X2 F1500",
-            "G1 Y2",
-            "M5",
-            "G0 X5",
-            "M4 S1000",
-            "G0 X6",
-            "G1 X7 F300",
-            "M5",
-        ] {
-            g.execute(l).unwrap();
-        }
+        run(
+            &mut g,
+            &[
+                "G0 X1 Y1",
+                "M4 S200",
+                "G1 X2 F1500",
+                "G1 Y2",
+                "M5",
+                "G0 X5",
+                "M4 S1000",
+                "G0 X6",
+                "G1 X7 F300",
+                "M5",
+            ],
+        );
         assert_eq!(g.rec.paths.len(), 2);
         assert_eq!(g.rec.paths[0].tool, "draw");
         assert_eq!(

@@ -1,41 +1,37 @@
 //! The simulated cutter's HP-GL interpreter: the subset that flatcut's encoders and common
 //! cutter drivers send — `IN`, `DF`, `SP`, `PU`, `PD`, `PA`, `PR`, `VS`, `FS` — executed as a
-//! plotter would (and Roland's `!FS` force); anything else is ignored and counted by name, as HP-GL devices do with
-//! instructions they do not know (HP 7475A Interfacing and Programming Manual, ch. 14: an
-//! unknown instruction sets error 1 and is skipped).
+//! plotter would (and Roland's `!FS` force); anything else is ignored and counted by name, as
+//! HP-GL devices do with instructions they do not know (HP 7475A Interfacing and Programming
+//! Manual, ch. 14: an unknown instruction sets error 1 and is skipped).
 //!
 //! Instructions end with `;` or a line feed. Parameters are numbers separated by commas or
-//! spaces; `PU`/`PD` take coordinate pairs, absolute after `PA` (the default after `IN`),
-//! relative after `PR`. Roland's `!`-prefixed instructions (`!PZ`, `!ST`, …) are named with
-//! their three characters. A stray odd coordinate is ignored, as a plotter does.
+//! spaces, read by the crate's one HP-GL lexer (`output::hpgl::read`); `PU`/`PD` take
+//! coordinate pairs, absolute after `PA` (the default after `IN`), relative after `PR`.
+//! Roland's `!`-prefixed instructions (`!PZ`, `!ST`, …) are named with their three characters.
+//! A stray odd coordinate is ignored, as a plotter does.
 //!
 //! Motion time: pen-down moves at the `VS` speed (cm/s; the profile's tool speed when the
 //! program sets none), pen-up moves at [`TRAVEL_CM_S`]. This is what paces the simulated
 //! buffer's draining.
 
 use super::record::Recorder;
-use crate::device::Profile;
+use crate::output::hpgl::read::{instruction, numbers};
+use crate::profile::Profile;
 use glam::DVec2;
 use std::collections::BTreeMap;
 
 /// Pen-up speed, cm/s.
-pub const TRAVEL_CM_S: f64 = 50.0;
+pub(crate) const TRAVEL_CM_S: f64 = 50.0;
 /// Pen-down speed when neither the program nor the profile says, cm/s.
-pub const DEFAULT_CM_S: f64 = 20.0;
-
-/// Length of the complete instruction at the front of `buf` (terminator included), if the
-/// terminator has arrived.
-pub fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
-    buf.into_iter()
-        .position(|&b| b == b';' || b == b'\n')
-        .map(|i| i + 1)
-}
+pub(crate) const DEFAULT_CM_S: f64 = 20.0;
 
 /// For an instruction still arriving: the bytes at the front of `buf` that a plotter can
 /// already execute, and the mnemonic to put back in front of the rest. A plotter moves as
 /// coordinate pairs arrive; without this a host stopped by XOFF in the middle of a long `PD`
 /// would wait for XON while the device waited for the `;`.
-pub fn executable_prefix<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<(usize, [u8; 2])> {
+pub(crate) fn executable_prefix<'a>(
+    buf: impl IntoIterator<Item = &'a u8>,
+) -> Option<(usize, [u8; 2])> {
     let bytes: Vec<u8> = buf.into_iter().copied().take(4096).collect();
     let start = bytes.iter().position(|b| !b.is_ascii_whitespace())?;
     let op = bytes.get(start..start + 2)?;
@@ -152,25 +148,17 @@ impl Hpgl {
 
     /// Execute one instruction (its bytes, terminator optional). Returns the time its motion
     /// takes, seconds.
-    pub fn execute(&mut self, raw: &[u8]) -> f64 {
+    pub(crate) fn execute(&mut self, raw: &[u8]) -> f64 {
         let text = String::from_utf8_lossy(raw);
-        let text = text.trim_matches(|c: char| c == ';' || c.is_whitespace() || c == '\0');
-        if text.is_empty() {
-            return 0.0;
-        }
-        let split = if text.starts_with('!') { 3 } else { 2 };
-        let Some(op) = text.get(..split.min(text.len())) else {
-            *self.ignored.entry("?".into()).or_default() += 1;
-            return 0.0;
+        let (op, args_text) = match instruction(&text) {
+            None => return 0.0,
+            Some(Err(())) => {
+                *self.ignored.entry("?".into()).or_default() += 1;
+                return 0.0;
+            }
+            Some(Ok(it)) => it,
         };
-        let op = op.to_ascii_uppercase();
-        let args_text = &text[op.len()..];
-        let nums: Option<Vec<f64>> = args_text
-            .split(|c: char| c == ',' || c.is_whitespace())
-            .filter(|s| !s.is_empty())
-            .map(|s| s.parse::<f64>().ok().filter(|v| v.is_finite()))
-            .collect();
-        let Some(nums) = nums else {
+        let Ok(nums) = numbers(args_text) else {
             *self
                 .ignored
                 .entry(format!("{op} (bad parameters)"))
@@ -234,7 +222,7 @@ impl Hpgl {
     }
 
     /// The tool that is down now, if any.
-    pub fn tool_down(&self) -> Option<String> {
+    pub(crate) fn tool_down(&self) -> Option<String> {
         if self.down {
             self.tool_name()
         } else {
@@ -268,9 +256,10 @@ impl Hpgl {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::hpgl::read::next_instruction;
 
     fn profile() -> Profile {
-        crate::device::profile::find("hpgl-pens").unwrap()
+        crate::profile::find("hpgl-pens").unwrap()
     }
 
     #[test]

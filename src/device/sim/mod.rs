@@ -33,12 +33,12 @@
 //! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
 
 pub mod grbl;
-pub mod hpgl;
-pub mod record;
+pub(crate) mod hpgl;
+pub(crate) mod record;
 
 use crate::device::grbl as proto;
-use crate::device::profile::{FlowControl, Language, Profile};
-use record::SimPath;
+use crate::profile::{FlowControl, Language, Profile};
+pub use record::SimPath;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
 use std::io::{Read, Write};
@@ -52,11 +52,11 @@ pub const XON: u8 = 0x11;
 pub const XOFF: u8 = 0x13;
 
 /// Bytes the simulator still takes after asking the host to stop.
-pub const SKID: usize = 16;
+pub(crate) const SKID: usize = 16;
 /// Time a host has to react to XOFF or CTS before growth of its backlog counts as a violation.
 pub const STOP_GRACE: Duration = Duration::from_millis(250);
 /// GRBL planner blocks (`BLOCK_BUFFER_SIZE` 16, one kept free).
-pub const PLANNER_BLOCKS: usize = 15;
+pub(crate) const PLANNER_BLOCKS: usize = 15;
 
 /// Faults to inject.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -494,7 +494,9 @@ impl Device {
     /// no further byte will complete once the host is done).
     fn has_complete_input(&self) -> bool {
         match self.interp {
-            Interp::Hpgl(_) => hpgl::next_instruction(self.rx.iter()).is_some(),
+            Interp::Hpgl(_) => {
+                crate::output::hpgl::read::next_instruction(self.rx.iter()).is_some()
+            }
             Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
         }
     }
@@ -611,7 +613,9 @@ impl Device {
                     if !self.motion.is_empty() {
                         return;
                     }
-                    let instr: Vec<u8> = if let Some(n) = hpgl::next_instruction(self.rx.iter()) {
+                    let instr: Vec<u8> = if let Some(n) =
+                        crate::output::hpgl::read::next_instruction(self.rx.iter())
+                    {
                         self.rx.drain(..n).collect()
                     } else if let Some((n, op)) = hpgl::executable_prefix(self.rx.iter()) {
                         let part = self.rx.drain(..n).collect();
@@ -801,7 +805,7 @@ pub fn stream_job(
 
 /// Draw what the simulator cut, in the machine's axes (mm), and write `<stem>.png` and
 /// `<stem>.json` into `dir`. Returns the two paths.
-pub fn write_outputs(
+pub(crate) fn write_outputs(
     rep: &SimReport,
     profile: &Profile,
     dir: &Path,
@@ -845,8 +849,8 @@ pub fn write_outputs(
     let png = crate::output::png::render(&sheet, 0, px)?;
     let png_path = dir.join(format!("{stem}.png"));
     let json_path = dir.join(format!("{stem}.json"));
-    crate::pipeline::write_atomic(&png_path, &png)?;
+    crate::output::files::write_atomic(&png_path, &png)?;
     let text = serde_json::to_string_pretty(rep).unwrap_or_default() + "\n";
-    crate::pipeline::write_atomic(&json_path, text.as_bytes())?;
+    crate::output::files::write_atomic(&json_path, text.as_bytes())?;
     Ok((png_path, json_path))
 }

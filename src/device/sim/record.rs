@@ -39,7 +39,7 @@ impl SimPath {
 }
 
 /// Heading change of the blade tip (degrees) after which the recorder keeps a point.
-pub const HEADING_TOL_DEG: f64 = 0.5;
+pub(crate) const HEADING_TOL_DEG: f64 = 0.5;
 
 /// A trailing blade (see the module documentation).
 #[derive(Debug, Clone, Default)]
@@ -67,8 +67,8 @@ pub struct Recorder {
 
 impl Recorder {
     /// A recorder for a machine: with a trailing blade when the profile has a knife offset.
-    pub fn for_profile(profile: &crate::device::Profile) -> Recorder {
-        use crate::toolpath::StrokeKind;
+    pub(crate) fn for_profile(profile: &crate::profile::Profile) -> Recorder {
+        use crate::profile::StrokeKind;
         let knives: Vec<String> = [StrokeKind::Cut, StrokeKind::Score, StrokeKind::Perforate]
             .into_iter()
             .filter(|k| profile.is_drag_knife(*k))
@@ -119,7 +119,7 @@ impl Recorder {
     }
 
     /// The tool of the path being drawn, if one is open.
-    pub fn open_tool(&self) -> Option<&str> {
+    pub(crate) fn open_tool(&self) -> Option<&str> {
         if self.open {
             self.paths.last().map(|p| p.tool.as_str())
         } else {
@@ -133,7 +133,7 @@ impl Recorder {
     }
 
     /// A straight move; `tool` is the tool that is down, if any.
-    pub fn travel_to(&mut self, from: DVec2, to: DVec2, tool: Option<&str>) {
+    pub(crate) fn travel_to(&mut self, from: DVec2, to: DVec2, tool: Option<&str>) {
         if self.drag.is_some() {
             let knife = tool.filter(|t| self.is_knife(t));
             match knife {
@@ -217,7 +217,7 @@ mod tests {
     use super::*;
 
     fn drag() -> Recorder {
-        let p = crate::device::profile::find("sim-dragknife").unwrap();
+        let p = crate::profile::find("sim-dragknife").unwrap();
         Recorder::for_profile(&p)
     }
 
@@ -255,7 +255,7 @@ mod tests {
         let start = DVec2::from(r.paths[1].points[0]);
         assert!(start.distance(DVec2::new(0.0, 790.0)) < 0.01, "{start}");
         // A recorder for a machine without an offset records the holder.
-        let mut plain = Recorder::for_profile(&crate::device::profile::find("sim").unwrap());
+        let mut plain = Recorder::for_profile(&crate::profile::find("sim").unwrap());
         plain.down("cut", a);
         plain.travel_to(a, b, Some("cut"));
         assert_eq!(plain.paths[0].points, vec![[0.0, 0.0], [400.0, 0.0]]);

@@ -52,22 +52,25 @@
 //!   is an error, as is a coordinate beyond ±(2^23 − 1) plotter units in plain HP-GL (a
 //!   conservative bound: HP-GL devices differ, 2^23 units is 209 m at 40 per mm).
 
-use super::{line_error, to_device, tool_error, OutputError};
-use crate::device::{Profile, Tool};
+use super::{device_points, one_line, stroke_tool, tool_error, OutputError};
+use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
+
+pub mod read;
+pub use read::{parse, ParsedStroke};
 
 /// Points per `PD` instruction.
 const PD_POINTS: usize = 32;
 
 /// Largest coordinate magnitude, plotter units, of plain HP-GL.
-pub const HPGL_LIMIT: i64 = (1 << 23) - 1;
+pub(crate) const HPGL_LIMIT: i64 = (1 << 23) - 1;
 /// Largest coordinate magnitude, plotter units, of Roland CAMM-GL (mode 2).
-pub const CAMM_LIMIT: i64 = (1 << 26) - 1;
+pub(crate) const CAMM_LIMIT: i64 = (1 << 26) - 1;
 
 /// The HP-GL dialects flatcut writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Dialect {
+pub(crate) enum Dialect {
     /// Plain HP-GL (`hp-gl`).
     Hpgl,
     /// Roland CAMM-GL mode 2 (`camm-gl2`).
@@ -152,15 +155,7 @@ fn check_tool(profile: &Profile, kind: &str, tool: &Tool) -> Result<HpglTool, Ou
 
 /// An `init`/`end` line as one terminated instruction line.
 fn profile_line(profile: &Profile, which: &'static str, line: &str) -> Result<String, OutputError> {
-    let t = line.trim();
-    if t.contains(['\n', '\r']) {
-        return Err(line_error(
-            profile,
-            which,
-            line,
-            "one instruction per line: split it into several lines".into(),
-        ));
-    }
+    let t = one_line(profile, which, line, "instruction")?;
     Ok(if t.ends_with(';') {
         t.to_string()
     } else {
@@ -169,7 +164,7 @@ fn profile_line(profile: &Profile, which: &'static str, line: &str) -> Result<St
 }
 
 /// Encode one sheet's strokes (see the module documentation for the exact text).
-pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
+pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     let dialect = Dialect::of(profile)?;
     let limit = dialect.limit();
     let mut out = String::from("IN;\n");
@@ -183,34 +178,16 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
     let mut speed: Option<String> = None;
     let mut force: Option<String> = None;
     for (index, stroke) in sheet.strokes.iter().enumerate() {
-        let Some(kind) = crate::toolpath::tool_kind(stroke.role, |k| profile.has(k)) else {
-            continue;
-        };
-        let Some(tool) = profile.tool(kind) else {
+        let Some((kind, tool)) = stroke_tool(profile, stroke.role) else {
             continue;
         };
         let tool = check_tool(profile, kind.name(), tool)?;
-        let mut pts: Vec<(i64, i64)> = Vec::with_capacity(stroke.points.len());
-        for q in &stroke.points {
-            let d = to_device(profile, sheet.width, sheet.height, *q);
-            let mut unit = [0i64; 2];
-            for (u, v) in unit.iter_mut().zip([d.x, d.y]) {
-                let r = v.round();
-                if !(r.is_finite() && r.abs() <= limit as f64) {
-                    return Err(OutputError::OutOfRange {
-                        sheet: None,
-                        stroke: index + 1,
-                        role: stroke.role.name(),
-                        value: v,
-                        limit: limit as f64,
-                        units: "plotter units",
-                        profile: profile.name.clone(),
-                    });
-                }
-                *u = r as i64;
-            }
-            pts.push((unit[0], unit[1]));
-        }
+        let range = (limit as f64, "plotter units");
+        let fits = |v: f64| v.round().is_finite() && v.round().abs() <= limit as f64;
+        let mut pts: Vec<(i64, i64)> = device_points(profile, sheet, index, stroke, range, fits)?
+            .iter()
+            .map(|d| (d.x.round() as i64, d.y.round() as i64))
+            .collect();
         pts.dedup();
         let Some(&(x0, y0)) = pts.first() else {
             continue;
@@ -266,114 +243,11 @@ pub fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError>
     Ok(out.into_bytes())
 }
 
-/// A stroke read back from an HP-GL program: pen number, the velocity and force in effect
-/// (as written after `VS` and `FS`/`!FS`; `None` when none was set since `IN`) and the points
-/// in plotter units.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParsedStroke {
-    pub pen: u32,
-    pub speed: Option<f64>,
-    pub force: Option<f64>,
-    pub points: Vec<(i64, i64)>,
-}
-
-/// Read back the pen-down paths of a program made by [`emit`]: absolute `PU`/`PD`/`PA`, `SP`,
-/// `VS`, `FS` and Roland's `!FS`; `IN` resets pen, velocity and force. Other instructions
-/// (a profile's `init` and `end` lines) are skipped, except `PR`, whose relative moves this
-/// reader does not follow. For tests and reports; the full interpreter is the simulated
-/// cutter's.
-pub fn parse(program: &str) -> Result<Vec<ParsedStroke>, String> {
-    let mut strokes: Vec<ParsedStroke> = Vec::new();
-    let mut pen = 0u32;
-    let mut speed: Option<f64> = None;
-    let mut force: Option<f64> = None;
-    let mut at = (0i64, 0i64);
-    let mut down = false;
-    for (n, cmd) in program.split(';').enumerate() {
-        let cmd = cmd.trim();
-        let roland = cmd.starts_with('!');
-        let cmd_body = if roland { &cmd[1..] } else { cmd };
-        if cmd_body.len() < 2 || !cmd_body.is_char_boundary(2) {
-            continue;
-        }
-        let (op, args) = cmd_body.split_at(2);
-        let op = op.to_ascii_uppercase();
-        let understood = if roland {
-            op == "FS"
-        } else {
-            matches!(
-                op.as_str(),
-                "IN" | "SP" | "PU" | "PD" | "PA" | "PR" | "VS" | "FS"
-            )
-        };
-        if !understood {
-            continue;
-        }
-        let nums: Vec<f64> = if args.trim().is_empty() {
-            Vec::new()
-        } else {
-            args.split(',')
-                .map(|v| v.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|e| format!("instruction {} `{cmd}`: {e}", n + 1))?
-        };
-        match op.as_str() {
-            "IN" => {
-                pen = 0;
-                speed = None;
-                force = None;
-                down = false;
-            }
-            "SP" => pen = nums.first().copied().unwrap_or(0.0) as u32,
-            "VS" => speed = nums.first().copied(),
-            "FS" => force = nums.first().copied(),
-            "PR" if !nums.is_empty() => {
-                return Err(format!(
-                    "instruction {} `{cmd}`: relative moves are not read",
-                    n + 1
-                ))
-            }
-            "PR" => {}
-            _ => {
-                // PU, PD, PA: pen state (PA keeps it), then absolute moves.
-                let pd = match op.as_str() {
-                    "PU" => false,
-                    "PD" => true,
-                    _ => down,
-                };
-                if nums.len() % 2 != 0 {
-                    return Err(format!("instruction {} `{cmd}`: odd coordinates", n + 1));
-                }
-                for xy in nums.chunks(2) {
-                    let (x, y) = (xy[0].round() as i64, xy[1].round() as i64);
-                    if pd {
-                        if !down {
-                            strokes.push(ParsedStroke {
-                                pen,
-                                speed,
-                                force,
-                                points: vec![at],
-                            });
-                        }
-                        if let Some(s) = strokes.last_mut() {
-                            s.points.push((x, y));
-                        }
-                    }
-                    down = pd;
-                    at = (x, y);
-                }
-                down = pd;
-            }
-        }
-    }
-    Ok(strokes)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::profile::parse as parse_profile;
-    use crate::output::fixtures::{sheet, stroke};
+    use crate::output::fixtures::{half_unit_steps, sheet, stroke};
+    use crate::profile::parse as parse_profile;
     use crate::toolpath::StrokeRole;
 
     /// The bundled `hpgl-pens` profile as it was when the exact text below was pinned: pens
@@ -414,7 +288,7 @@ mod tests {
 
     #[test]
     fn bundled_hpgl_pens_keeps_its_frame() {
-        let profile = crate::device::profile::find("hpgl-pens").unwrap();
+        let profile = crate::profile::find("hpgl-pens").unwrap();
         let text = String::from_utf8(emit(&small_job(), &profile).unwrap()).unwrap();
         assert!(text.starts_with("IN;\n"), "{text}");
         assert!(text.ends_with("PU;SP0;\n"), "{text}");
@@ -549,17 +423,7 @@ mod tests {
     fn absolute_rounding_does_not_drift() {
         // 8000 steps of 0.0125 mm (half a plotter unit): rounded increments would lose or
         // gain up to half a unit per step.
-        let mut pts = Vec::new();
-        let mut x = 0.0;
-        for _ in 0..=8000 {
-            pts.push((x, 0.0));
-            x += 0.0125;
-        }
-        let sheet = SheetJob {
-            width: 200.0,
-            height: 10.0,
-            strokes: vec![stroke(StrokeRole::Cut, &pts)],
-        };
+        let (pts, sheet) = half_unit_steps(0.0);
         let t = text(&sheet, PENS);
         let back = parse(&t).unwrap();
         let got = &back[0].points;
