@@ -50,11 +50,6 @@ pub enum Error {
     Stream(Box<device::stream::StreamError>),
     #[error(transparent)]
     Sim(#[from] device::sim::SimError),
-    #[error("{}: cannot write: {source}", path.display())]
-    Write {
-        path: std::path::PathBuf,
-        source: std::io::Error,
-    },
     #[error("{}: {source}", file.display())]
     In {
         file: std::path::PathBuf,
