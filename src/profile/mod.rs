@@ -268,6 +268,22 @@ pub fn find(name: &str) -> Result<Profile, ProfileError> {
         })
 }
 
+/// What is wrong with a profile, and where: `table` is `""` for top-level keys, `key` is `""`
+/// when the whole table is at fault.
+struct Problem {
+    table: String,
+    key: String,
+    message: String,
+}
+
+fn problem(table: &str, key: &str, message: impl Into<String>) -> Problem {
+    Problem {
+        table: table.to_string(),
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

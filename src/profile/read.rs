@@ -2,7 +2,7 @@
 //! rely on, with errors that name the file, the line and the key.
 
 use super::tools::check_tool;
-use super::{Language, Profile, ProfileError, Protocol, GCODE_DIALECTS, HPGL_DIALECTS, TOOL_KINDS};
+use super::{problem, Language, Problem, Profile, ProfileError, Protocol, GCODE_DIALECTS, HPGL_DIALECTS, TOOL_KINDS};
 
 /// Parse one profile and check it. Errors name `source_name` and the key at fault, with its
 /// line when the key is written as `key = value` under its table header.
@@ -36,22 +36,6 @@ pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
     })?;
     p.source = source_name.to_string();
     Ok(p)
-}
-
-/// What is wrong with a profile, and where: `table` is `""` for top-level keys, `key` is `""`
-/// when the whole table is at fault.
-pub(super) struct Problem {
-    table: String,
-    key: String,
-    message: String,
-}
-
-pub(super) fn problem(table: &str, key: &str, message: impl Into<String>) -> Problem {
-    Problem {
-        table: table.to_string(),
-        key: key.to_string(),
-        message: message.into(),
-    }
 }
 
 pub(super) fn positive(v: f64) -> bool {

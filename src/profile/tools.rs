@@ -1,6 +1,6 @@
 //! The tool table: which tool makes each kind of stroke, and the checks of one tool.
 
-use super::read::{problem, Problem};
+use super::{problem, Problem};
 use serde::{Deserialize, Serialize};
 
 /// Tool classes of a device's tool table.
