@@ -4,10 +4,10 @@
 //! [`super::unfold()`] for the CLI.
 //!
 //! **Cuts inside a chart** ([`Surface::cuts`], thesis §5.2.3): a chart is opened along its cut
-//! edges before it is parameterised: [`crate::surface::dcharts::open`] gives one vertex per
+//! edges before it is parameterised: [`crate::geom::cut::open`] gives one vertex per
 //! wedge of faces around each mesh vertex, so the vertices along a seam are split, and the
 //! opened chart is laid flat as a mesh of its own. A chart that is still not a disk gets the
-//! cuts of [`crate::surface::dcharts::disk_cuts`] (a tube the shortest seam between its rims,
+//! cuts of [`crate::geom::cut::disk_cuts`] (a tube the shortest seam between its rims,
 //! a chart with handles its shortest system of loops as well);
 //! cuts a split leaves useless are dropped and found again. A cut edge is never `joined`, so
 //! the pattern stage draws it as a cut line with seam marks on both sides, like a seam
@@ -28,7 +28,7 @@
 //!   that part has at most [`CUT_OFF_AREA`] of the chart's area; the part cut off is a chart
 //!   of its own, re-attached at the end to a neighbour where it fits ([`reattach`]). A larger
 //!   overlap splits the chart between the two overlapping faces
-//!   ([`crate::surface::dcharts::split_between`]: each face goes with the nearer of the two,
+//!   (`split_between` of [`crate::geom::cut`]: each face goes with the nearer of the two,
 //!   through the chart); a chart that needed seams to be a disk (a tube whose layout
 //!   spirals over itself) is halved along the bisector instead;
 //! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts` below: up
@@ -39,7 +39,7 @@
 //!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
 //!
 //! and is split along the bisector of its two most distant faces
-//! ([`crate::surface::dcharts::bisect`]) when
+//! (`bisect` of [`crate::geom::cut`]) when
 //! - it has a flipped triangle,
 //! - the parameteriser refuses it (no cut makes it a disk),
 //! - or its L2 stretch is still over the tolerance — at most [`FlattenOptions::max_splits`]
@@ -61,10 +61,11 @@
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
 use super::{unfold, Flat, FlattenError, UnfoldOptions};
+use crate::geom::cut::{self, bisect, disk_cuts, open, split_between, Graph};
 use crate::geom::mesh::{Face, Mesh, Topology};
 use crate::geom::polygon;
+use crate::geom::proxy;
 use crate::spec::MaterialKind;
-use crate::surface::dcharts::{self, bisect, disk_cuts, open, split_between, Graph};
 use crate::surface::Surface;
 use glam::DVec2;
 
@@ -88,8 +89,8 @@ pub struct FlattenOptions {
     pub gussets: usize,
     /// Merging threshold `η` for re-attaching a cut-off gusset to an adjacent piece: the mean
     /// cylinder fitting error of the gusset and two face rings of the piece around their common
-    /// boundary ([`dcharts::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
-    /// [`dcharts::DChartsOptions::eta`].
+    /// boundary ([`proxy::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
+    /// `η` (`surface::dcharts::DChartsOptions::eta`).
     pub reattach_eta: f64,
 }
 
@@ -806,8 +807,8 @@ fn dart_path(
         .max_by(|&a, &b| field[a].total_cmp(&field[b]).then(b.cmp(&a)))?;
     // Shortest path from the boundary to the tip.
     let sources: Vec<usize> = (0..nv).filter(|&v| in_chart[v] && boundary[v]).collect();
-    let w = |e: usize| dcharts::cut_weight(mesh, topo, ctx.graph, e);
-    let path = dcharts::path_to(&adj, &w, &sources, tip, topo)?;
+    let w = |e: usize| cut::cut_weight(mesh, topo, ctx.graph, e);
+    let path = cut::path_to(&adj, &w, &sources, tip, topo)?;
     (!path.is_empty()).then_some((tip, path))
 }
 
@@ -1157,7 +1158,7 @@ fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64)
                 region.extend(&next);
                 front = next;
             }
-            match dcharts::cylinder_error(ctx.graph, &region) {
+            match proxy::cylinder_error(&ctx.graph.moments(region.iter().copied())) {
                 Some(err) if err < opts.reattach_eta => {}
                 _ => continue,
             }

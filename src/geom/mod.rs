@@ -5,7 +5,11 @@
 
 pub mod boolean;
 pub mod curve;
+pub mod cut;
 pub mod font;
+pub mod heap;
 pub mod hull;
 pub mod mesh;
 pub mod polygon;
+pub mod proxy;
+pub mod unionfind;
