@@ -481,7 +481,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         let [(f, i), (g, j)] = edge.uses[..] else {
             continue;
         };
-        dihedral[e] = bend(mesh, f, i, g);
+        dihedral[e] = mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
         if face_island[f] == face_island[g] && !is_cut[e] {
             let (p, q) = (face_2d[f][i], face_2d[f][(i + 1) % face_2d[f].len()]);
             let (q0, p0) = (face_2d[g][j], face_2d[g][(j + 1) % face_2d[g].len()]);
@@ -533,24 +533,6 @@ pub fn stretch(flat: &Flat) -> (Vec<Stretch>, Stretch) {
         .collect();
     let whole = distortion::combine(&per);
     (per, whole)
-}
-
-/// Signed bend angle at the edge of corner `i` of face `f` shared with face `g` (as
-/// [`super::unfold`] has it: positive where convex).
-fn bend(mesh: &crate::geom::mesh::Mesh, f: usize, i: usize, g: usize) -> f64 {
-    let nf = mesh.face_normal(f);
-    let ng = mesh.face_normal(g);
-    let (a, b) = Topology::corner_verts(mesh, f, i);
-    let dir = mesh.vertices[b] - mesh.vertices[a];
-    let angle = nf.angle_between(ng);
-    if !angle.is_finite() {
-        return 0.0;
-    }
-    if nf.cross(ng).dot(dir) >= 0.0 {
-        angle
-    } else {
-        -angle
-    }
 }
 
 /// Two faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`, if

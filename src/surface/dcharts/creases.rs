@@ -4,7 +4,7 @@
 //! enough to be scored as fold lines (the thesis' §5.3 pattern keeps chart boundaries as cuts
 //! and says nothing of creases inside a chart: they are flatcut's choice, see [`CREASE_DEG`]).
 
-use crate::geom::mesh::{Mesh, Topology};
+use crate::geom::mesh::Mesh;
 use crate::surface::Bend;
 
 /// Whether a mesh is smooth, i.e. better segmented into charts than unfolded face by face:
@@ -43,19 +43,12 @@ pub fn creases(mesh: &Mesh, chart: &[usize], min_deg: f64) -> Vec<Bend> {
         if chart.get(f) != chart.get(g) {
             continue;
         }
-        let nf = mesh.face_normal(f);
-        let ng = mesh.face_normal(g);
-        let angle = nf.angle_between(ng);
-        if !angle.is_finite() || angle.to_degrees() <= min_deg {
+        let Some(signed) = mesh.signed_dihedral(f, i, g) else {
+            continue;
+        };
+        if signed.abs().to_degrees() <= min_deg {
             continue;
         }
-        let (a, b) = Topology::corner_verts(mesh, f, i);
-        let dir = mesh.vertices[b] - mesh.vertices[a];
-        let signed = if nf.cross(ng).dot(dir) >= 0.0 {
-            angle
-        } else {
-            -angle
-        };
         out.push(Bend {
             verts: e.verts,
             angle_deg: signed.to_degrees(),
