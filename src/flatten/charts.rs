@@ -255,11 +255,220 @@ impl Charts<'_> {
             .filter(|&e| self.topo.edges[e].uses.iter().all(|u| inside[u.0]))
             .collect()
     }
+
+    /// The charts of `chart_of` to lay flat, each with the surface's cuts inside it, the
+    /// first chart last (it is popped first).
+    fn initial(&self, chart_of: &[usize], surface_cuts: &[usize]) -> Vec<Todo> {
+        let count = chart_of.iter().copied().max().map_or(0, |m| m + 1);
+        let mut groups: Vec<Vec<usize>> = vec![Vec::new(); count];
+        for (f, &c) in chart_of.iter().enumerate() {
+            groups[c].push(f);
+        }
+        let mut todo: Vec<Todo> = groups
+            .into_iter()
+            .filter(|g| !g.is_empty())
+            .map(|faces| Todo {
+                cuts: self.cuts_within(&faces, surface_cuts),
+                faces,
+                splits: 0,
+                cut_off: false,
+            })
+            .collect();
+        todo.reverse();
+        todo
+    }
+
+    /// Lay one chart flat (see the module doc): cut into a disk and laid; split or cut where
+    /// it overlaps itself or flips; darts, gussets and splits while over the tolerance. Halves
+    /// and parts cut off go back onto `todo`, the chart laid and its gussets onto `done`.
+    fn lay_one(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        mut t: Todo,
+        todo: &mut Vec<Todo>,
+        done: &mut Vec<Laid>,
+        degenerate: &dyn Fn(usize) -> FlattenError,
+    ) -> Result<(), FlattenError> {
+        let Some(cuts) = self.disk(&t.faces, &t.cuts) else {
+            return self.split_or_fail(todo, &t, degenerate);
+        };
+        t.cuts = cuts;
+        let nf = self.mesh.faces.len();
+        let layout = self.lay(&t.faces, &t.cuts).map_err(|e| match e {
+            param::ParamError::Degenerate { face, .. } => degenerate(face.min(nf - 1)),
+            _ => degenerate(t.faces[0]),
+        })?;
+        let (uv, stretch) = match layout {
+            Layout::Laid(uv, s) => (uv, s),
+            Layout::Refused => return self.split_or_fail(todo, &t, degenerate),
+        };
+        if t.faces.len() > 1 {
+            // Overlapping parts go to different pieces: split between the two faces.
+            if let Some(pair) = self_overlap(&uv, eps) {
+                if self.part_overlap(todo, &t, &uv, pair, eps) {
+                    return Ok(());
+                }
+            }
+            if stretch.flipped > 0 && self.split_in_two(todo, &t, t.splits) {
+                return Ok(());
+            }
+        }
+        self.relieve(opts, eps, t, uv, stretch, todo, done)
+    }
+
+    /// Split a chart that cannot be laid flat in two, or fail on a single face (or a chart
+    /// that does not split).
+    fn split_or_fail(
+        &self,
+        todo: &mut Vec<Todo>,
+        t: &Todo,
+        degenerate: &dyn Fn(usize) -> FlattenError,
+    ) -> Result<(), FlattenError> {
+        if t.faces.len() == 1 || !self.split_in_two(todo, t, t.splits) {
+            return Err(degenerate(t.faces[0]));
+        }
+        Ok(())
+    }
+
+    /// Push the two halves of a chart (cuts kept where they fall inside a half).
+    fn push_halves(
+        &self,
+        todo: &mut Vec<Todo>,
+        a: Vec<usize>,
+        b: Vec<usize>,
+        t: &Todo,
+        splits: usize,
+    ) {
+        let (ca, cb) = (self.cuts_within(&a, &t.cuts), self.cuts_within(&b, &t.cuts));
+        todo.push(Todo {
+            faces: b,
+            splits,
+            cuts: cb,
+            cut_off: false,
+        });
+        todo.push(Todo {
+            faces: a,
+            splits,
+            cuts: ca,
+            cut_off: false,
+        });
+    }
+
+    /// Push the halves of a chart split along the bisector of its two most distant faces;
+    /// false when it does not split.
+    fn split_in_two(&self, todo: &mut Vec<Todo>, t: &Todo, splits: usize) -> bool {
+        let (a, b) = bisect(self.graph, &t.faces);
+        if a.is_empty() || b.is_empty() {
+            return false;
+        }
+        self.push_halves(todo, a, b, t, splits);
+        true
+    }
+
+    /// A chart whose layout `uv` overlaps itself at faces `(x, y)` (indices into its faces):
+    /// halved when it was cut open into a disk (a tube, as a whole), else a small overlapping
+    /// region cut off (§5.3, to be re-attached elsewhere), else split between the two faces.
+    /// True when the parts went onto `todo`.
+    fn part_overlap(
+        &self,
+        todo: &mut Vec<Todo>,
+        t: &Todo,
+        uv: &[Vec<DVec2>],
+        (x, y): (usize, usize),
+        eps: f64,
+    ) -> bool {
+        // A chart cut open into a disk (a tube) is halved instead, as a whole.
+        if !t.cuts.is_empty() && self.split_in_two(todo, t, t.splits) {
+            return true;
+        }
+        // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
+        let pairs = overlaps(uv, eps, OVERLAP_PAIRS);
+        let (fx, fy) = (t.faces[x], t.faces[y]);
+        if let Some((rest, parts)) = cut_off(self, &t.faces, &t.cuts, &[fx], &[fy], &pairs, uv, eps)
+        {
+            let area = |fs: &[usize]| fs.iter().map(|&f| self.graph.area[f]).sum::<f64>();
+            let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
+            if off <= CUT_OFF_AREA * area(&t.faces) {
+                for p in parts.into_iter().rev() {
+                    todo.push(Todo {
+                        faces: p.faces,
+                        splits: t.splits,
+                        cuts: p.cuts,
+                        cut_off: true,
+                    });
+                }
+                todo.push(Todo {
+                    faces: rest.faces,
+                    splits: t.splits,
+                    cuts: rest.cuts,
+                    cut_off: t.cut_off,
+                });
+                return true;
+            }
+        }
+        let (a, b) = split_between(self.graph, &t.faces, t.faces[x], t.faces[y]);
+        if !a.is_empty() && !b.is_empty() {
+            self.push_halves(todo, a, b, t, t.splits);
+            return true;
+        }
+        false
+    }
+
+    /// A chart laid flat as `uv` with `stretch`, over the tolerance: darts first, then
+    /// gussets (onto `done`), then a split for stretch (its darts dropped: each half gets its
+    /// own) while [`FlattenOptions::max_splits`] allows; else it is done as it is.
+    #[allow(clippy::too_many_arguments)]
+    fn relieve(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        t: Todo,
+        uv: Vec<Vec<DVec2>>,
+        stretch: Stretch,
+        todo: &mut Vec<Todo>,
+        done: &mut Vec<Laid>,
+    ) -> Result<(), FlattenError> {
+        let inherited = t.cuts.clone();
+        let mut laid = Laid {
+            faces: t.faces,
+            cuts: t.cuts,
+            uv,
+            stretch,
+            gusset: t.cut_off,
+        };
+        if laid.stretch.l2 > opts.tolerance && opts.darts > 0 && laid.faces.len() >= DART_MIN_FACES
+        {
+            darts(self, &mut laid, opts, eps)?;
+        }
+        if laid.stretch.l2 > opts.tolerance
+            && opts.gussets > 0
+            && laid.faces.len() >= DART_MIN_FACES
+        {
+            let gussets = gussets(self, &mut laid, opts, eps);
+            done.extend(gussets);
+        }
+        if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
+            // Darts are dropped: each half gets its own.
+            let t = Todo {
+                faces: laid.faces,
+                splits: t.splits,
+                cuts: inherited,
+                cut_off: t.cut_off,
+            };
+            if self.split_in_two(todo, &t, t.splits + 1) {
+                return Ok(());
+            }
+            laid.faces = t.faces;
+        }
+        done.push(laid);
+        Ok(())
+    }
 }
 
 /// Lay each chart flat as one island (cutting and splitting where needed, see the module
 /// doc).
-pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
     let mesh = &surface.mesh;
     let nf = mesh.faces.len();
     let chart_of = match &surface.charts {
@@ -274,35 +483,8 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         graph: &graph,
         method: opts.method,
     };
-    // The surface's cuts as edge ids (pairs that are not edges of the mesh are ignored).
-    let mut edge_of: std::collections::HashMap<[usize; 2], usize> = Default::default();
-    for (e, edge) in topology.edges.iter().enumerate() {
-        let [a, b] = edge.verts;
-        edge_of.insert([a.min(b), a.max(b)], e);
-    }
-    let mut surface_cuts: Vec<usize> = surface
-        .cuts
-        .iter()
-        .filter_map(|&[a, b]| edge_of.get(&[a.min(b), a.max(b)]).copied())
-        .collect();
-    surface_cuts.sort_unstable();
-    surface_cuts.dedup();
-    let count = chart_of.iter().copied().max().map_or(0, |m| m + 1);
-    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); count];
-    for (f, &c) in chart_of.iter().enumerate() {
-        groups[c].push(f);
-    }
-    let mut todo: Vec<Todo> = groups
-        .into_iter()
-        .filter(|g| !g.is_empty())
-        .map(|faces| Todo {
-            cuts: ctx.cuts_within(&faces, &surface_cuts),
-            faces,
-            splits: 0,
-            cut_off: false,
-        })
-        .collect();
-    todo.reverse();
+    let surface_cuts = edge_ids(&topology, &surface.cuts);
+    let mut todo = ctx.initial(&chart_of, &surface_cuts);
     let mut done: Vec<Laid> = Vec::new();
     // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
     let mean_edge = topology
@@ -312,145 +494,46 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         .sum::<f64>()
         / topology.edges.len().max(1) as f64;
     let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge);
-    let mut over: Vec<(usize, f64)> = Vec::new();
     let degenerate = |f: usize| FlattenError::Degenerate {
         surface: surface.name.clone(),
         face: f + 1,
         line: mesh.faces[f].line,
     };
-    let lay = |faces: &[usize], cuts: &[usize]| -> Result<Layout, FlattenError> {
-        ctx.lay(faces, cuts).map_err(|e| match e {
-            param::ParamError::Degenerate { face, .. } => degenerate(face.min(nf - 1)),
-            _ => degenerate(faces[0]),
-        })
-    };
-    // Push the two halves of a chart (cuts kept where they fall inside a half).
-    let push_halves = |todo: &mut Vec<Todo>, a: Vec<usize>, b: Vec<usize>, t: &Todo, splits| {
-        let (ca, cb) = (ctx.cuts_within(&a, &t.cuts), ctx.cuts_within(&b, &t.cuts));
-        todo.push(Todo {
-            faces: b,
-            splits,
-            cuts: cb,
-            cut_off: false,
-        });
-        todo.push(Todo {
-            faces: a,
-            splits,
-            cuts: ca,
-            cut_off: false,
-        });
-    };
-    let split_it = |todo: &mut Vec<Todo>, t: &Todo, splits: usize| {
-        let (a, b) = bisect(&graph, &t.faces);
-        if a.is_empty() || b.is_empty() {
-            return false;
-        }
-        push_halves(todo, a, b, t, splits);
-        true
-    };
-    while let Some(mut t) = todo.pop() {
-        let Some(cuts) = ctx.disk(&t.faces, &t.cuts) else {
-            if t.faces.len() == 1 || !split_it(&mut todo, &t, t.splits) {
-                return Err(degenerate(t.faces[0]));
-            }
-            continue;
-        };
-        t.cuts = cuts;
-        let (uv, stretch) = match lay(&t.faces, &t.cuts)? {
-            Layout::Laid(uv, s) => (uv, s),
-            Layout::Refused => {
-                if t.faces.len() == 1 || !split_it(&mut todo, &t, t.splits) {
-                    return Err(degenerate(t.faces[0]));
-                }
-                continue;
-            }
-        };
-        if t.faces.len() > 1 {
-            // Overlapping parts go to different pieces: split between the two faces.
-            if let Some((x, y)) = self_overlap(&uv, overlap_eps) {
-                // A chart cut open into a disk (a tube) is halved instead, as a whole.
-                if !t.cuts.is_empty() && split_it(&mut todo, &t, t.splits) {
-                    continue;
-                }
-                // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
-                let pairs = overlaps(&uv, overlap_eps, OVERLAP_PAIRS);
-                let (fx, fy) = (t.faces[x], t.faces[y]);
-                if let Some((rest, parts)) = cut_off(
-                    &ctx,
-                    &t.faces,
-                    &t.cuts,
-                    &[fx],
-                    &[fy],
-                    &pairs,
-                    &uv,
-                    overlap_eps,
-                ) {
-                    let area = |fs: &[usize]| fs.iter().map(|&f| graph.area[f]).sum::<f64>();
-                    let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
-                    if off <= CUT_OFF_AREA * area(&t.faces) {
-                        for p in parts.into_iter().rev() {
-                            todo.push(Todo {
-                                faces: p.faces,
-                                splits: t.splits,
-                                cuts: p.cuts,
-                                cut_off: true,
-                            });
-                        }
-                        todo.push(Todo {
-                            faces: rest.faces,
-                            splits: t.splits,
-                            cuts: rest.cuts,
-                            cut_off: t.cut_off,
-                        });
-                        continue;
-                    }
-                }
-                let (a, b) = split_between(&graph, &t.faces, t.faces[x], t.faces[y]);
-                if !a.is_empty() && !b.is_empty() {
-                    push_halves(&mut todo, a, b, &t, t.splits);
-                    continue;
-                }
-            }
-            if stretch.flipped > 0 && split_it(&mut todo, &t, t.splits) {
-                continue;
-            }
-        }
-        let inherited = t.cuts.clone();
-        let mut laid = Laid {
-            faces: t.faces,
-            cuts: t.cuts,
-            uv,
-            stretch,
-            gusset: t.cut_off,
-        };
-        if laid.stretch.l2 > opts.tolerance && opts.darts > 0 && laid.faces.len() >= DART_MIN_FACES
-        {
-            darts(&ctx, &mut laid, opts, overlap_eps)?;
-        }
-        if laid.stretch.l2 > opts.tolerance
-            && opts.gussets > 0
-            && laid.faces.len() >= DART_MIN_FACES
-        {
-            let gussets = gussets(&ctx, &mut laid, opts, overlap_eps);
-            done.extend(gussets);
-        }
-        if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
-            // Darts are dropped: each half gets its own.
-            let t = Todo {
-                faces: laid.faces,
-                splits: t.splits,
-                cuts: inherited,
-                cut_off: t.cut_off,
-            };
-            if split_it(&mut todo, &t, t.splits + 1) {
-                continue;
-            }
-            laid.faces = t.faces;
-        }
-        done.push(laid);
+    while let Some(t) = todo.pop() {
+        ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
     }
     reattach(&ctx, &mut done, opts, overlap_eps);
+    Ok(assemble(surface, topology, done, opts))
+}
 
+/// The surface's cuts as edge ids (pairs that are not edges of the mesh are ignored), sorted.
+fn edge_ids(topology: &Topology, pairs: &[[usize; 2]]) -> Vec<usize> {
+    let mut edge_of: std::collections::HashMap<[usize; 2], usize> = Default::default();
+    for (e, edge) in topology.edges.iter().enumerate() {
+        let [a, b] = edge.verts;
+        edge_of.insert([a.min(b), a.max(b)], e);
+    }
+    let mut ids: Vec<usize> = pairs
+        .iter()
+        .filter_map(|&[a, b]| edge_of.get(&[a.min(b), a.max(b)]).copied())
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids
+}
+
+/// The laid charts as islands (numbered by smallest face) of a [`Flat`]; the surface gets a
+/// warning per piece over the tolerance, the cuts that stayed inside pieces and the islands
+/// as its charts.
+fn assemble(
+    mut surface: Surface,
+    topology: Topology,
+    mut done: Vec<Laid>,
+    opts: &FlattenOptions,
+) -> Flat {
+    let mesh = &surface.mesh;
+    let nf = mesh.faces.len();
+    let mut over: Vec<(usize, f64)> = Vec::new();
     // Islands numbered by smallest face.
     done.sort_by_key(|l| l.faces.iter().copied().min().unwrap_or(0));
     let mut face_2d: Vec<Vec<DVec2>> = vec![Vec::new(); nf];
@@ -509,7 +592,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
     cuts.sort_unstable();
     surface.cuts = cuts;
     surface.charts = Some(face_island.clone());
-    Ok(Flat {
+    Flat {
         surface,
         topology,
         face_2d,
@@ -518,7 +601,7 @@ pub fn charts(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
         joined,
         dihedral,
         tolerance: opts.unfold.tolerance.min(0.01 * mean),
-    })
+    }
 }
 
 /// Stretch of each island of a flat, and of the whole (area-weighted), from its layout.

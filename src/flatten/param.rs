@@ -227,10 +227,7 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
     let nv = lt.pos.len();
     let mut loops = boundary_loops(mesh, faces, &lt, &edge_uses)?;
     let LocalTriangles {
-        pos,
-        tris,
-        corners,
-        ..
+        pos, tris, corners, ..
     } = lt;
     let euler = nv as i64 - edge_uses.len() as i64 + tris.len() as i64;
     if euler != 1 {
@@ -255,7 +252,6 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
         nfaces: faces.len(),
     })
 }
-
 
 /// A chart's faces over local vertices, before its topology is checked.
 struct LocalTriangles {
@@ -908,7 +904,11 @@ impl<'a> Abf<'a> {
         let mut local_r1 = vec![0.0f64; nt];
         let mut local_d = vec![0.0f64; nt];
         for (t, tri) in chart.tris.iter().enumerate() {
-            let js = [self.jac(cot, t, 0), self.jac(cot, t, 1), self.jac(cot, t, 2)];
+            let js = [
+                self.jac(cot, t, 0),
+                self.jac(cot, t, 1),
+                self.jac(cot, t, 2),
+            ];
             let inv = lam_diag[t].map(|x| 1.0 / x);
             let d = inv[0] + inv[1] + inv[2];
             let mut bt = [0.0f64; 6];
