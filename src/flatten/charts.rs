@@ -994,26 +994,55 @@ fn cut_off(
     uv: &[Vec<DVec2>],
     eps: f64,
 ) -> Option<(Laid, Vec<Laid>)> {
-    let nf = ctx.mesh.faces.len();
-    let mut inside = vec![false; nf];
-    for &f in faces {
-        inside[f] = true;
+    let within = Within::new(ctx, faces, cuts);
+    let mut sides = Sides::new(&within, a, b);
+    let mut off = sides.first_cut(faces, pairs, uv, ctx.mesh.faces.len());
+    let rest = within.rest(&sides, &mut off, eps)?;
+    let pieces = within.pieces(&off, eps)?;
+    Some((rest, pieces))
+}
+
+/// A chart's faces joined through its uncut edges.
+struct Within<'a> {
+    ctx: &'a Charts<'a>,
+    faces: &'a [usize],
+    cuts: &'a [usize],
+    /// Per mesh face: in the chart.
+    inside: Vec<bool>,
+}
+
+impl<'a> Within<'a> {
+    fn new(ctx: &'a Charts<'a>, faces: &'a [usize], cuts: &'a [usize]) -> Self {
+        let mut inside = vec![false; ctx.mesh.faces.len()];
+        for &f in faces {
+            inside[f] = true;
+        }
+        Within {
+            ctx,
+            faces,
+            cuts,
+            inside,
+        }
     }
-    let is_cut = |e: usize| cuts.binary_search(&e).is_ok();
-    // Faces joined through uncut chart edges.
-    let neighbours = |f: usize, within: &[bool]| -> Vec<usize> {
-        ctx.topo.face_edges[f]
+
+    /// Faces joined to `f` through uncut chart edges, where `within` holds.
+    fn neighbours(&self, f: usize, within: &[bool]) -> Vec<usize> {
+        let is_cut = |e: usize| self.cuts.binary_search(&e).is_ok();
+        self.ctx.topo.face_edges[f]
             .iter()
             .filter(|&&e| !is_cut(e))
-            .filter_map(|&e| match ctx.topo.edges[e].uses[..] {
+            .filter_map(|&e| match self.ctx.topo.edges[e].uses[..] {
                 [(x, _), (y, _)] if x != y => Some(if x == f { y } else { x }),
                 _ => None,
             })
             .filter(|&h| within[h])
             .collect()
-    };
-    let steps = |seeds: &[usize]| -> Vec<usize> {
-        let mut d = vec![usize::MAX; nf];
+    }
+
+    /// Face steps from `seeds` through the chart (`usize::MAX` where not reached).
+    fn steps(&self, seeds: &[usize]) -> Vec<usize> {
+        let inside = &self.inside;
+        let mut d = vec![usize::MAX; inside.len()];
         let mut queue = std::collections::VecDeque::new();
         for &s in seeds {
             if inside[s] && d[s] == usize::MAX {
@@ -1022,7 +1051,7 @@ fn cut_off(
             }
         }
         while let Some(f) = queue.pop_front() {
-            for h in neighbours(f, &inside) {
+            for h in self.neighbours(f, inside) {
                 if d[h] == usize::MAX {
                     d[h] = d[f] + 1;
                     queue.push_back(h);
@@ -1030,117 +1059,16 @@ fn cut_off(
             }
         }
         d
-    };
-    let (da, db) = (steps(a), steps(b));
-    let on_a = |f: usize| da[f] <= db[f];
-    let area2 = |k: usize| polygon::signed_area(&uv[k]).abs();
-    let (mut sa, mut sb) = (0.0, 0.0);
-    let mut fa: Vec<usize> = Vec::new();
-    let mut fb: Vec<usize> = Vec::new();
-    for &(x, y) in pairs {
-        for k in [x, y] {
-            let f = faces[k];
-            if on_a(f) {
-                sa += area2(k);
-                fa.push(f);
-            } else {
-                sb += area2(k);
-                fb.push(f);
-            }
-        }
     }
-    let take_a = !fa.is_empty() && (fb.is_empty() || sa <= sb);
-    let side = |f: usize| on_a(f) == take_a;
-    let mut off = vec![false; nf];
-    for f in if take_a { fa } else { fb } {
-        off[f] = true;
-    }
-    let mut rest_laid: Option<Laid> = None;
-    for _ in 0..8 {
-        // The rest is the largest connected part left (by area, ties: smallest face); the
-        // other parts go with the cut-off faces.
-        let mut keep = vec![false; nf];
-        let mut best: Option<(f64, Vec<usize>)> = None;
-        let mut seen = vec![false; nf];
-        for &f0 in faces {
-            if off[f0] || seen[f0] {
-                continue;
-            }
-            let mut comp = vec![f0];
-            seen[f0] = true;
-            let mut k = 0;
-            while k < comp.len() {
-                for h in neighbours(comp[k], &inside) {
-                    if !off[h] && !seen[h] {
-                        seen[h] = true;
-                        comp.push(h);
-                    }
-                }
-                k += 1;
-            }
-            let area: f64 = comp.iter().map(|&f| ctx.graph.area[f]).sum();
-            if best.as_ref().is_none_or(|(a, _)| area > *a) {
-                best = Some((area, comp));
-            }
-        }
-        let (_, main) = best?;
-        for &f in &main {
-            keep[f] = true;
-        }
-        for &f in faces {
-            if !keep[f] {
-                off[f] = true;
-            }
-        }
-        let rest: Vec<usize> = faces.iter().copied().filter(|&f| !off[f]).collect();
-        if rest.is_empty() {
-            return None;
-        }
-        let rc = ctx.disk(&rest, &ctx.cuts_within(&rest, cuts))?;
-        let Ok(Layout::Laid(ruv, rs)) = ctx.lay(&rest, &rc) else {
-            return None;
-        };
-        if rs.flipped > 0 {
-            return None;
-        }
-        let more = overlaps(&ruv, eps, OVERLAP_PAIRS);
-        if more.is_empty() {
-            rest_laid = Some(Laid {
-                faces: rest,
-                cuts: rc,
-                uv: ruv,
-                stretch: rs,
-                gusset: false,
-            });
-            break;
-        }
-        let mut grew = false;
-        for (x, y) in more {
-            for k in [x, y] {
-                let f = rest[k];
-                if side(f) && !off[f] {
-                    off[f] = true;
-                    grew = true;
-                }
-            }
-        }
-        if !grew {
-            return None;
-        }
-    }
-    let rest = rest_laid?;
-    // The cut-off faces, by connected piece (face order: ascending).
-    let mut seen = vec![false; nf];
-    let mut pieces = Vec::new();
-    for &f0 in faces {
-        if !off[f0] || seen[f0] {
-            continue;
-        }
+
+    /// The connected part of the faces where `within` holds that `f0` is in (breadth first,
+    /// marking `seen`).
+    fn flood(&self, f0: usize, within: &[bool], seen: &mut [bool]) -> Vec<usize> {
         let mut comp = vec![f0];
         seen[f0] = true;
         let mut k = 0;
         while k < comp.len() {
-            for h in neighbours(comp[k], &off) {
+            for h in self.neighbours(comp[k], within) {
                 if !seen[h] {
                     seen[h] = true;
                     comp.push(h);
@@ -1148,23 +1076,170 @@ fn cut_off(
             }
             k += 1;
         }
-        comp.sort_unstable();
-        let pc = ctx.disk(&comp, &ctx.cuts_within(&comp, cuts))?;
-        let Ok(Layout::Laid(puv, ps)) = ctx.lay(&comp, &pc) else {
-            return None;
-        };
-        if ps.flipped > 0 || (comp.len() > 1 && self_overlap(&puv, eps).is_some()) {
-            return None;
-        }
-        pieces.push(Laid {
-            faces: comp,
-            cuts: pc,
-            uv: puv,
-            stretch: ps,
-            gusset: true,
-        });
+        comp
     }
-    Some((rest, pieces))
+
+    /// The rest of the chart once the faces `off` are cut off: its largest connected part,
+    /// laid flat; while it still overlaps, its overlapping faces on the side cut off go too
+    /// (at most 8 rounds). `None` when it cannot be laid flat without a flip or an overlap.
+    fn rest(&self, sides: &Sides, off: &mut [bool], eps: f64) -> Option<Laid> {
+        let (ctx, faces, cuts) = (self.ctx, self.faces, self.cuts);
+        let nf = off.len();
+        for _ in 0..8 {
+            // The rest is the largest connected part left (by area, ties: smallest face); the
+            // other parts go with the cut-off faces.
+            let mut keep = vec![false; nf];
+            let mut best: Option<(f64, Vec<usize>)> = None;
+            let mut seen = vec![false; nf];
+            let free: Vec<bool> = (0..nf).map(|f| self.inside[f] && !off[f]).collect();
+            for &f0 in faces {
+                if off[f0] || seen[f0] {
+                    continue;
+                }
+                let comp = self.flood(f0, &free, &mut seen);
+                let area: f64 = comp.iter().map(|&f| ctx.graph.area[f]).sum();
+                if best.as_ref().is_none_or(|(a, _)| area > *a) {
+                    best = Some((area, comp));
+                }
+            }
+            let (_, main) = best?;
+            for &f in &main {
+                keep[f] = true;
+            }
+            for &f in faces {
+                if !keep[f] {
+                    off[f] = true;
+                }
+            }
+            let rest: Vec<usize> = faces.iter().copied().filter(|&f| !off[f]).collect();
+            if rest.is_empty() {
+                return None;
+            }
+            let rc = ctx.disk(&rest, &ctx.cuts_within(&rest, cuts))?;
+            let Ok(Layout::Laid(ruv, rs)) = ctx.lay(&rest, &rc) else {
+                return None;
+            };
+            if rs.flipped > 0 {
+                return None;
+            }
+            let more = overlaps(&ruv, eps, OVERLAP_PAIRS);
+            if more.is_empty() {
+                return Some(Laid {
+                    faces: rest,
+                    cuts: rc,
+                    uv: ruv,
+                    stretch: rs,
+                    gusset: false,
+                });
+            }
+            let mut grew = false;
+            for (x, y) in more {
+                for k in [x, y] {
+                    let f = rest[k];
+                    if sides.side(f) && !off[f] {
+                        off[f] = true;
+                        grew = true;
+                    }
+                }
+            }
+            if !grew {
+                return None;
+            }
+        }
+        None
+    }
+
+    /// The faces cut off, by connected piece (face order: ascending), each laid flat (cut
+    /// into a disk where needed); `None` when one flips or overlaps itself.
+    fn pieces(&self, off: &[bool], eps: f64) -> Option<Vec<Laid>> {
+        let (ctx, cuts) = (self.ctx, self.cuts);
+        let mut seen = vec![false; off.len()];
+        let mut pieces = Vec::new();
+        for &f0 in self.faces {
+            if !off[f0] || seen[f0] {
+                continue;
+            }
+            let mut comp = self.flood(f0, off, &mut seen);
+            comp.sort_unstable();
+            let pc = ctx.disk(&comp, &ctx.cuts_within(&comp, cuts))?;
+            let Ok(Layout::Laid(puv, ps)) = ctx.lay(&comp, &pc) else {
+                return None;
+            };
+            if ps.flipped > 0 || (comp.len() > 1 && self_overlap(&puv, eps).is_some()) {
+                return None;
+            }
+            pieces.push(Laid {
+                faces: comp,
+                cuts: pc,
+                uv: puv,
+                stretch: ps,
+                gusset: true,
+            });
+        }
+        Some(pieces)
+    }
+}
+
+/// The two sides of an overlap: each face of the chart goes with the nearer of `a` and `b`
+/// (in face steps through the opened chart; ties to `a`).
+struct Sides {
+    da: Vec<usize>,
+    db: Vec<usize>,
+    /// The side cut off is `a`'s.
+    take_a: bool,
+}
+
+impl Sides {
+    fn new(within: &Within, a: &[usize], b: &[usize]) -> Self {
+        let (da, db) = (within.steps(a), within.steps(b));
+        Sides {
+            da,
+            db,
+            take_a: false,
+        }
+    }
+
+    fn on_a(&self, f: usize) -> bool {
+        self.da[f] <= self.db[f]
+    }
+
+    /// Whether face `f` is on the side cut off.
+    fn side(&self, f: usize) -> bool {
+        self.on_a(f) == self.take_a
+    }
+
+    /// The faces of the overlapping `pairs` (indices into `faces` and `uv`) on the side with
+    /// less overlapping area: that side is cut off (chosen here); per mesh face, cut off.
+    fn first_cut(
+        &mut self,
+        faces: &[usize],
+        pairs: &[(usize, usize)],
+        uv: &[Vec<DVec2>],
+        nf: usize,
+    ) -> Vec<bool> {
+        let area2 = |k: usize| polygon::signed_area(&uv[k]).abs();
+        let (mut sa, mut sb) = (0.0, 0.0);
+        let mut fa: Vec<usize> = Vec::new();
+        let mut fb: Vec<usize> = Vec::new();
+        for &(x, y) in pairs {
+            for k in [x, y] {
+                let f = faces[k];
+                if self.on_a(f) {
+                    sa += area2(k);
+                    fa.push(f);
+                } else {
+                    sb += area2(k);
+                    fb.push(f);
+                }
+            }
+        }
+        self.take_a = !fa.is_empty() && (fb.is_empty() || sa <= sb);
+        let mut off = vec![false; nf];
+        for f in if self.take_a { fa } else { fb } {
+            off[f] = true;
+        }
+        off
+    }
 }
 
 /// Re-attach each gusset (and each part cut off for overlapping) to an adjacent piece when
