@@ -654,7 +654,7 @@ mod tests {
             a: chain[1],
             b: DVec2::new(15.0, 5.0),
             kind: FoldKind::Mountain,
-            angle_deg: 10.0,
+            angle: 10f64.to_radians(),
             edge: 0,
             tab: false,
         });
