@@ -123,7 +123,7 @@ impl FlattenOptions {
 }
 
 /// Largest L2 stretch of a piece, by material (see the module doc).
-pub fn material_tolerance(kind: MaterialKind) -> f64 {
+fn material_tolerance(kind: MaterialKind) -> f64 {
     match kind {
         MaterialKind::Paper => 1.003,
         MaterialKind::Fabric => 1.03,

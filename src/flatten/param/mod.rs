@@ -72,16 +72,16 @@ mod abf;
 use abf::abf_angles;
 
 /// Smallest triangle angle accepted (radians).
-pub const MIN_ANGLE: f64 = 1e-3;
+pub(crate) const MIN_ANGLE: f64 = 1e-3;
 /// `Best` keeps an LSCM layout without running ABF++ when its L2 stretch is within this of 1.
-pub const ISOMETRIC: f64 = 1e-9;
+pub(crate) const ISOMETRIC: f64 = 1e-9;
 /// Boundary size up to which the pins are the exact farthest pair.
-pub const EXACT_PIN_LIMIT: usize = 4000;
+pub(crate) const EXACT_PIN_LIMIT: usize = 4000;
 /// Newton steps ABF++ may take.
-pub const ABF_MAX_ITER: usize = 50;
+pub(crate) const ABF_MAX_ITER: usize = 50;
 /// ABF++ stops when the gradient of the Lagrangian (with the constraint values) is below this
 /// times √(triangles), or when it stalls below 1e-7 times √(triangles).
-pub const ABF_TOLERANCE: f64 = 1e-10;
+pub(crate) const ABF_TOLERANCE: f64 = 1e-10;
 
 /// Which parameterisation to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -835,7 +835,7 @@ pub fn parameterize(
 }
 
 /// Sweeps of the stretch minimisation that `Best` runs on the kept layout.
-pub const STRETCH_SWEEPS: usize = 60;
+pub(crate) const STRETCH_SWEEPS: usize = 60;
 
 /// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4) from a flip-free layout: a
 /// nonlinear Gauss–Seidel over the vertices, each moved by a backtracking line search down the

@@ -33,7 +33,7 @@ pub fn is_smooth(mesh: &Mesh) -> bool {
 /// Edges inside a chart that bend by more than `min_deg` degrees: the creases a pattern should
 /// score (the smooth bends in between need no fold line). Signed angle in degrees, positive for
 /// a mountain (convex seen from the printed side).
-pub fn creases(mesh: &Mesh, chart: &[usize], min_deg: f64) -> Vec<Bend> {
+pub(super) fn creases(mesh: &Mesh, chart: &[usize], min_deg: f64) -> Vec<Bend> {
     let topo = mesh.topology();
     let mut out = Vec::new();
     for e in &topo.edges {
@@ -59,4 +59,4 @@ pub fn creases(mesh: &Mesh, chart: &[usize], min_deg: f64) -> Vec<Bend> {
 
 /// Bends above this many degrees inside a chart are creases, scored as fold lines; gentler
 /// ones are the smooth bending of the material.
-pub const CREASE_DEG: f64 = 20.0;
+pub(super) const CREASE_DEG: f64 = 20.0;

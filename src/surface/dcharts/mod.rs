@@ -36,7 +36,8 @@ mod holes;
 mod merge;
 mod straighten;
 
-pub use creases::{creases, is_smooth, CREASE_DEG};
+pub use creases::is_smooth;
+use creases::{creases, CREASE_DEG};
 pub use straighten::boundary_length;
 
 use super::dcs;
