@@ -11,8 +11,8 @@
 //! against a uniform grid of the larger island.
 //!
 //! Tolerance: real meshes are stored with rounded coordinates, so "planar" regions have tiny
-//! angle defects and an exact test would cut at almost every vertex (fandisk: 78 islands at 1e-7
-//! of the edge length, 6 at 0.02 mm). Faces may therefore overlap by less than
+//! angle defects and an exact test would cut at almost every vertex. Faces may therefore overlap
+//! by less than
 //! [`UnfoldOptions::tolerance`] (0.02 mm, under one HP-GL plotter unit, capped at 1 % of the mean
 //! edge length); faces that merely touch along a fold or at a vertex never count. After the
 //! forest is built, cut edges whose two copies coincide within that distance inside one island

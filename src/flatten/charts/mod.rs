@@ -56,7 +56,7 @@
 //! The two sides of a seam (a cut inside a piece, or the edge a gusset shares with its
 //! chart) have the same 3D length; laid flat they are as long as the parameterisation makes
 //! them, equal only where it is isometric: on a non-developable piece they differ by up to
-//! its stretch (the torus of the tests: 4.8 % on one seam), which sewing takes up as ease.
+//! its stretch, which sewing takes up as ease.
 
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
