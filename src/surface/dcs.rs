@@ -215,12 +215,30 @@ fn glue(
     if nfree == 0 {
         return;
     }
-    // Rows: Σ_k coef_k · x_{vk} = rhs (per coordinate), weight w.
-    struct Row {
-        coef: [(usize, f64); 3],
-        rhs: DVec3,
-        w: f64,
+    let rows = gluing_rows(mesh, targets);
+    let ne = NormalEquations::new(mesh, &rows, &var, nfree, original, ell);
+    let x0: Vec<DVec3> = (0..nv)
+        .filter(|&v| var[v] != usize::MAX)
+        .map(|v| mesh.vertices[v])
+        .collect();
+    let x = ne.solve(x0);
+    for v in 0..nv {
+        if var[v] != usize::MAX && x[var[v]].is_finite() {
+            mesh.vertices[v] = x[var[v]];
+        }
     }
+}
+
+/// One row of the gluing problem: Σ_k coef_k · x_{vk} = rhs (per coordinate), weight w.
+struct Row {
+    coef: [(usize, f64); 3],
+    rhs: DVec3,
+    w: f64,
+}
+
+/// The rows of eq. 6.3: three per target triangle (one per column of `(Ṽ − V) W`), weighted
+/// by the triangle's area over the mean area.
+fn gluing_rows(mesh: &Mesh, targets: &[(usize, [DVec3; 3], DVec3, f64)]) -> Vec<Row> {
     let mut rows: Vec<Row> = Vec::with_capacity(targets.len() * 3);
     let mut total_area = 0.0;
     for (_, _, _, a) in targets {
@@ -255,113 +273,144 @@ fn glue(
             });
         }
     }
-    // Normal equations A = Σ w aᵀa + μ I, b = Σ w aᵀ rhs + μ v⁰ (fixed moved to the right).
-    let mu = 1e-3 / (ell * ell);
-    let mut diag = vec![mu; nfree];
-    let mut b = vec![DVec3::ZERO; nfree];
-    for v in 0..nv {
-        if var[v] != usize::MAX {
-            b[var[v]] = original[v] * mu;
-        }
-    }
-    let mut trip: Vec<(usize, usize, f64)> = Vec::new();
-    for r in &rows {
-        let mut rhs = r.rhs;
-        for &(v, c) in &r.coef {
-            if var[v] == usize::MAX {
-                rhs -= mesh.vertices[v] * c;
+    rows
+}
+
+/// The normal equations `A x = b` of the gluing rows over the free vertices, `A` as its
+/// diagonal and its off-diagonal entries row by row.
+struct NormalEquations {
+    nfree: usize,
+    diag: Vec<f64>,
+    b: Vec<DVec3>,
+    /// Row `i`'s entries are `cols[start[i]..start[i + 1]]`, `vals[..]`.
+    start: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+}
+
+impl NormalEquations {
+    /// `A = Σ w aᵀa + μ I`, `b = Σ w aᵀ rhs + μ v⁰`, fixed vertices moved to the right.
+    fn new(
+        mesh: &Mesh,
+        rows: &[Row],
+        var: &[usize],
+        nfree: usize,
+        original: &[DVec3],
+        ell: f64,
+    ) -> Self {
+        let nv = mesh.vertices.len();
+        let mu = 1e-3 / (ell * ell);
+        let mut diag = vec![mu; nfree];
+        let mut b = vec![DVec3::ZERO; nfree];
+        for v in 0..nv {
+            if var[v] != usize::MAX {
+                b[var[v]] = original[v] * mu;
             }
         }
-        for &(vi, ci) in &r.coef {
-            let i = var[vi];
-            if i == usize::MAX {
-                continue;
+        let mut trip: Vec<(usize, usize, f64)> = Vec::new();
+        for r in rows {
+            let mut rhs = r.rhs;
+            for &(v, c) in &r.coef {
+                if var[v] == usize::MAX {
+                    rhs -= mesh.vertices[v] * c;
+                }
             }
-            b[i] += rhs * (r.w * ci);
-            for &(vj, cj) in &r.coef {
-                let j = var[vj];
-                if j == usize::MAX {
+            for &(vi, ci) in &r.coef {
+                let i = var[vi];
+                if i == usize::MAX {
                     continue;
                 }
-                if i == j {
-                    diag[i] += r.w * ci * cj;
-                } else {
-                    trip.push((i, j, r.w * ci * cj));
+                b[i] += rhs * (r.w * ci);
+                for &(vj, cj) in &r.coef {
+                    let j = var[vj];
+                    if j == usize::MAX {
+                        continue;
+                    }
+                    if i == j {
+                        diag[i] += r.w * ci * cj;
+                    } else {
+                        trip.push((i, j, r.w * ci * cj));
+                    }
                 }
             }
         }
-    }
-    trip.sort_unstable_by_key(|t| (t.0, t.1));
-    let mut start = vec![0usize; nfree + 1];
-    let mut cols: Vec<usize> = Vec::new();
-    let mut vals: Vec<f64> = Vec::new();
-    let mut rows_of: Vec<usize> = Vec::new();
-    for (i, j, x) in trip {
-        if rows_of.last() == Some(&i) && cols.last() == Some(&j) {
-            if let Some(last) = vals.last_mut() {
-                *last += x;
+        trip.sort_unstable_by_key(|t| (t.0, t.1));
+        let mut start = vec![0usize; nfree + 1];
+        let mut cols: Vec<usize> = Vec::new();
+        let mut vals: Vec<f64> = Vec::new();
+        let mut rows_of: Vec<usize> = Vec::new();
+        for (i, j, x) in trip {
+            if rows_of.last() == Some(&i) && cols.last() == Some(&j) {
+                if let Some(last) = vals.last_mut() {
+                    *last += x;
+                }
+                continue;
             }
-            continue;
+            rows_of.push(i);
+            cols.push(j);
+            vals.push(x);
         }
-        rows_of.push(i);
-        cols.push(j);
-        vals.push(x);
-    }
-    for &i in &rows_of {
-        start[i + 1] += 1;
-    }
-    for i in 0..nfree {
-        start[i + 1] += start[i];
-    }
-    let apply = |x: &[DVec3], out: &mut [DVec3]| {
+        for &i in &rows_of {
+            start[i + 1] += 1;
+        }
         for i in 0..nfree {
-            let mut s = x[i] * diag[i];
-            for k in start[i]..start[i + 1] {
-                s += x[cols[k]] * vals[k];
+            start[i + 1] += start[i];
+        }
+        NormalEquations {
+            nfree,
+            diag,
+            b,
+            start,
+            cols,
+            vals,
+        }
+    }
+
+    /// Jacobi-preconditioned conjugate gradients from `x`, the three coordinates at once.
+    fn solve(&self, mut x: Vec<DVec3>) -> Vec<DVec3> {
+        let (nfree, diag, b) = (self.nfree, &self.diag, &self.b);
+        let (start, cols, vals) = (&self.start, &self.cols, &self.vals);
+        let apply = |x: &[DVec3], out: &mut [DVec3]| {
+            for i in 0..nfree {
+                let mut s = x[i] * diag[i];
+                for k in start[i]..start[i + 1] {
+                    s += x[cols[k]] * vals[k];
+                }
+                out[i] = s;
             }
-            out[i] = s;
+        };
+        let mut ax = vec![DVec3::ZERO; nfree];
+        apply(&x, &mut ax);
+        let mut r: Vec<DVec3> = b.iter().zip(&ax).map(|(b, a)| *b - *a).collect();
+        let z = |r: &[DVec3]| -> Vec<DVec3> { r.iter().zip(diag).map(|(r, d)| *r / *d).collect() };
+        let mut zk = z(&r);
+        let mut p = zk.clone();
+        let dot = |a: &[DVec3], b: &[DVec3]| -> DVec3 {
+            a.iter().zip(b).fold(DVec3::ZERO, |s, (x, y)| s + *x * *y)
+        };
+        let mut rz = dot(&r, &zk);
+        let b_norm = dot(&b, &b).max_element().sqrt().max(1e-300);
+        let mut ap = vec![DVec3::ZERO; nfree];
+        for _ in 0..(4 * nfree).clamp(100, 5000) {
+            apply(&p, &mut ap);
+            let pap = dot(&p, &ap);
+            let alpha = DVec3::select(pap.cmpgt(DVec3::ZERO), rz / pap, DVec3::ZERO);
+            for i in 0..nfree {
+                x[i] += p[i] * alpha;
+                r[i] -= ap[i] * alpha;
+            }
+            let rn = dot(&r, &r).max_element().sqrt();
+            if rn <= 1e-13 * b_norm {
+                break;
+            }
+            zk = z(&r);
+            let rz_new = dot(&r, &zk);
+            let beta = DVec3::select(rz.cmpgt(DVec3::ZERO), rz_new / rz, DVec3::ZERO);
+            for i in 0..nfree {
+                p[i] = zk[i] + p[i] * beta;
+            }
+            rz = rz_new;
         }
-    };
-    // Jacobi-preconditioned conjugate gradients, the three coordinates at once.
-    let mut x: Vec<DVec3> = (0..nv)
-        .filter(|&v| var[v] != usize::MAX)
-        .map(|v| mesh.vertices[v])
-        .collect();
-    let mut ax = vec![DVec3::ZERO; nfree];
-    apply(&x, &mut ax);
-    let mut r: Vec<DVec3> = b.iter().zip(&ax).map(|(b, a)| *b - *a).collect();
-    let z = |r: &[DVec3]| -> Vec<DVec3> { r.iter().zip(&diag).map(|(r, d)| *r / *d).collect() };
-    let mut zk = z(&r);
-    let mut p = zk.clone();
-    let dot = |a: &[DVec3], b: &[DVec3]| -> DVec3 {
-        a.iter().zip(b).fold(DVec3::ZERO, |s, (x, y)| s + *x * *y)
-    };
-    let mut rz = dot(&r, &zk);
-    let b_norm = dot(&b, &b).max_element().sqrt().max(1e-300);
-    let mut ap = vec![DVec3::ZERO; nfree];
-    for _ in 0..(4 * nfree).clamp(100, 5000) {
-        apply(&p, &mut ap);
-        let pap = dot(&p, &ap);
-        let alpha = DVec3::select(pap.cmpgt(DVec3::ZERO), rz / pap, DVec3::ZERO);
-        for i in 0..nfree {
-            x[i] += p[i] * alpha;
-            r[i] -= ap[i] * alpha;
-        }
-        let rn = dot(&r, &r).max_element().sqrt();
-        if rn <= 1e-13 * b_norm {
-            break;
-        }
-        zk = z(&r);
-        let rz_new = dot(&r, &zk);
-        let beta = DVec3::select(rz.cmpgt(DVec3::ZERO), rz_new / rz, DVec3::ZERO);
-        for i in 0..nfree {
-            p[i] = zk[i] + p[i] * beta;
-        }
-        rz = rz_new;
-    }
-    for v in 0..nv {
-        if var[v] != usize::MAX && x[var[v]].is_finite() {
-            mesh.vertices[v] = x[var[v]];
-        }
+        x
     }
 }
