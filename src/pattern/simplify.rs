@@ -261,7 +261,7 @@ fn collapse_all(
         }
         let ok =
             c.at.iter()
-                .all(|&at| collapsible(rings, &folds, at, tolerance))
+                .all(|&at| collapsible(rings, folds, at, tolerance))
                 && !crossing_each_other(rings, c.at);
         if !ok {
             continue;

@@ -389,7 +389,7 @@ impl NormalEquations {
             a.iter().zip(b).fold(DVec3::ZERO, |s, (x, y)| s + *x * *y)
         };
         let mut rz = dot(&r, &zk);
-        let b_norm = dot(&b, &b).max_element().sqrt().max(1e-300);
+        let b_norm = dot(b, b).max_element().sqrt().max(1e-300);
         let mut ap = vec![DVec3::ZERO; nfree];
         for _ in 0..(4 * nfree).clamp(100, 5000) {
             apply(&p, &mut ap);

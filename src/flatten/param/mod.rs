@@ -256,6 +256,9 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
     })
 }
 
+/// Per edge over the triangles: its uses as (triangle, directed a -> b).
+type EdgeUses = Vec<Vec<(usize, usize, usize)>>;
+
 /// A chart's faces over local vertices, before its topology is checked.
 struct LocalTriangles {
     /// Local vertex → 3D position.
@@ -358,10 +361,7 @@ fn local_triangles(mesh: &Mesh, faces: &[usize]) -> Result<LocalTriangles, Param
 
 /// Edges over the triangles, each with its uses as (triangle, directed a -> b), in order of
 /// first use; refuses an edge used by more than two triangles.
-fn edge_uses(
-    mesh: &Mesh,
-    lt: &LocalTriangles,
-) -> Result<Vec<Vec<(usize, usize, usize)>>, ParamError> {
+fn edge_uses(mesh: &Mesh, lt: &LocalTriangles) -> Result<EdgeUses, ParamError> {
     let line = |f: usize| mesh.faces[f].line;
     let (tris, tri_face, global) = (&lt.tris, &lt.tri_face, &lt.global);
     let mut edge_index: HashMap<(usize, usize), usize> = HashMap::with_capacity(tris.len() * 2);
