@@ -50,7 +50,7 @@ pub struct Stretch {
 /// Triangles of a face as corner-index triples (indices into `mesh.faces[f].verts`), in the
 /// face's winding: a triangle is itself; a polygon is ear-clipped in its best-fit plane (Newell
 /// normal). Fewer than three corners: none.
-pub fn face_triangles(mesh: &Mesh, f: usize) -> Vec<[usize; 3]> {
+pub(crate) fn face_triangles(mesh: &Mesh, f: usize) -> Vec<[usize; 3]> {
     let Some(face) = mesh.faces.get(f) else {
         return Vec::new();
     };
@@ -194,7 +194,7 @@ pub fn stretch(mesh: &Mesh, faces: &[usize], uv: &[Vec<DVec2>]) -> Stretch {
 /// Whole-surface figures from per-chart figures: L2 stretch and shear combined in quadrature
 /// weighted by each chart's 3D area, L∞ the maximum, flips and areas summed. No parts (or no
 /// area): all zero but the sums.
-pub fn combine(parts: &[Stretch]) -> Stretch {
+pub(crate) fn combine(parts: &[Stretch]) -> Stretch {
     let mut out = Stretch::default();
     let (mut l2, mut shear) = (0.0, 0.0);
     for p in parts {

@@ -11,8 +11,8 @@
 //! against a uniform grid of the larger island.
 //!
 //! Tolerance: real meshes are stored with rounded coordinates, so "planar" regions have tiny
-//! angle defects and an exact test would cut at almost every vertex (fandisk: 78 islands at 1e-7
-//! of the edge length, 6 at 0.02 mm). Faces may therefore overlap by less than
+//! angle defects and an exact test would cut at almost every vertex. Faces may therefore overlap
+//! by less than
 //! [`UnfoldOptions::tolerance`] (0.02 mm, under one HP-GL plotter unit, capped at 1 % of the mean
 //! edge length); faces that merely touch along a fold or at a vertex never count. After the
 //! forest is built, cut edges whose two copies coincide within that distance inside one island
@@ -120,24 +120,6 @@ fn face_in_plane(surface: &Surface, f: usize) -> Result<Vec<DVec2>, FlattenError
         .collect())
 }
 
-/// Signed bend angle at an edge used by corner `i` of face `f` and by face `g`.
-fn bend(surface: &Surface, f: usize, i: usize, g: usize) -> f64 {
-    let mesh = &surface.mesh;
-    let nf = mesh.face_normal(f);
-    let ng = mesh.face_normal(g);
-    let v = &mesh.faces[f].verts;
-    let dir = mesh.vertices[v[(i + 1) % v.len()]] - mesh.vertices[v[i]];
-    let angle = nf.angle_between(ng);
-    if !angle.is_finite() {
-        return 0.0;
-    }
-    if nf.cross(ng).dot(dir) >= 0.0 {
-        angle
-    } else {
-        -angle
-    }
-}
-
 /// Islands being built: face positions, island membership and a grid per island.
 struct Unfolder {
     pos: Vec<Vec<DVec2>>,
@@ -233,7 +215,7 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         lengths[e] =
             surface.mesh.vertices[edge.verts[0]].distance(surface.mesh.vertices[edge.verts[1]]);
         if let [(f, i), (g, _)] = edge.uses[..] {
-            dihedral[e] = bend(&surface, f, i, g);
+            dihedral[e] = surface.mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
         }
     }
     let longest = lengths

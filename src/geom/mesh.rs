@@ -109,6 +109,26 @@ impl Mesh {
         };
         it.fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
+
+    /// Signed bend angle (radians) at the edge of corner `i` of face `f`, shared with face
+    /// `g`: the angle between their normals, positive where the surface is convex (a mountain
+    /// fold seen from the printed side, i.e. `n_f × n_g` along the edge as `f` runs it);
+    /// `None` when a normal is degenerate.
+    pub fn signed_dihedral(&self, f: usize, i: usize, g: usize) -> Option<f64> {
+        let nf = self.face_normal(f);
+        let ng = self.face_normal(g);
+        let (a, b) = Topology::corner_verts(self, f, i);
+        let dir = self.vertices[b] - self.vertices[a];
+        let angle = nf.angle_between(ng);
+        if !angle.is_finite() {
+            return None;
+        }
+        Some(if nf.cross(ng).dot(dir) >= 0.0 {
+            angle
+        } else {
+            -angle
+        })
+    }
 }
 
 impl Topology {

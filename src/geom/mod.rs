@@ -5,9 +5,13 @@
 
 pub mod boolean;
 pub mod curve;
+pub mod cut;
 pub mod font;
+pub mod heap;
 pub mod hull;
 pub mod mesh;
 pub mod polygon;
+pub mod proxy;
 pub mod rng;
 pub mod segment;
+pub mod unionfind;

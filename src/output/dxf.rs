@@ -177,7 +177,7 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
                     0.5 * (a + b),
                     h,
                     ang,
-                    &format!("{:.1}%%d {word}", f.angle_deg),
+                    &format!("{:.1}%%d {word}", f.angle.to_degrees()),
                 );
             }
             for m in &piece.marks {

@@ -65,7 +65,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                 "folds": { "mountain": count(FoldKind::Mountain), "valley": count(FoldKind::Valley) },
                 "fold_lines": p.folds.iter().filter(|f| !f.tab).map(|f| json!({
                     "kind": f.kind,
-                    "angle_deg": r6(f.angle_deg),
+                    "angle_deg": r6(f.angle.to_degrees()),
                     "length_mm": r6(f.a.distance(f.b)),
                 })).collect::<Vec<_>>(),
                 "tabs": p.seams.iter().filter(|s| s.tab).count(),

@@ -182,7 +182,7 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
                     a: s.points[k],
                     b: s.points[k + 1],
                     kind: FoldKind::Mountain,
-                    angle_deg: flat.dihedral[e].abs().to_degrees(),
+                    angle: flat.dihedral[e].abs(),
                     edge: e,
                     tab: true,
                 });

@@ -385,7 +385,7 @@ pub(super) fn finish(flat: &Flat, p: &mut Piece, opts: &PatternOptions) {
                 FoldKind::Mountain => "DOWN",
                 FoldKind::Valley => "UP",
             };
-            let text = format!("{:.0}° {way}", f.angle_deg);
+            let text = format!("{:.0}° {way}", f.angle.to_degrees());
             // Beside the bend on either side, smaller if need be, but always on the piece: a
             // note that sticks out of the outline would be drawn off the blank (and off the
             // sheet, where the nest leaves no room for it). None fits: no note; the bend line

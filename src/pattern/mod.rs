@@ -171,8 +171,9 @@ pub struct Fold {
     pub a: DVec2,
     pub b: DVec2,
     pub kind: FoldKind,
-    /// Bend angle in degrees (0 = flat).
-    pub angle_deg: f64,
+    /// Bend angle in radians (0 = flat), unsigned: `kind` says which way; printed in
+    /// degrees (the fold label, DXF, `report.json`).
+    pub angle: f64,
     /// Mesh edge it comes from.
     pub edge: usize,
     /// The fold of a glue tab (along a seam), not of the surface.
@@ -443,7 +444,7 @@ fn net(
                     } else {
                         FoldKind::Valley
                     },
-                    angle_deg: d.abs().to_degrees(),
+                    angle: d.abs(),
                     edge: e,
                     tab: false,
                 });
@@ -490,7 +491,10 @@ mod tests {
         assert!((p.cut_length() - 1400.0).abs() < 1e-6);
         assert!((p.fold_length() - 500.0).abs() < 1e-9);
         assert!(p.folds.iter().all(|f| f.kind == FoldKind::Mountain));
-        assert!(p.folds.iter().all(|f| (f.angle_deg - 90.0).abs() < 1e-9));
+        assert!(p
+            .folds
+            .iter()
+            .all(|f| (f.angle.to_degrees() - 90.0).abs() < 1e-9));
         assert!((p.area - 60000.0).abs() < 1e-6);
         assert!(polygon::signed_area(&p.outline[0]) > 0.0);
         assert!(polygon::is_simple_ring(&p.outline[0]));

@@ -42,9 +42,9 @@
 //! - Ties in cost break on the order of seams and of vertices along side A: deterministic.
 
 use super::{Piece, SeamSide};
+use crate::geom::heap::Lowest;
 use crate::geom::polygon;
 use glam::DVec2;
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Largest difference (mm) simplification may bring between the lengths of a seam's two sides,
@@ -102,25 +102,6 @@ struct Cand {
     alive: bool,
 }
 
-#[derive(PartialEq)]
-struct Entry {
-    cost: f64,
-    id: usize,
-    version: u32,
-}
-impl Eq for Entry {}
-impl Ord for Entry {
-    /// Reversed: the heap pops the least cost, then the least id.
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.cost.total_cmp(&self.cost).then(o.id.cmp(&self.id))
-    }
-}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-
 /// Simplifies the seams of one flat's pieces (whose seams [`super::marks::find`] found, before
 /// their marks are placed) within `tolerance` mm, and records [`Simplified`] on each piece.
 /// Does nothing for a tolerance that is not a positive number.
@@ -128,7 +109,24 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
     if tolerance.is_nan() || tolerance <= 0.0 {
         return;
     }
-    let mut rings: Vec<Vec<Ring>> = pieces
+    let mut rings = rings_of(pieces);
+    let before: Vec<usize> = pieces
+        .iter()
+        .map(|p| p.border.iter().map(|r| r.len()).sum())
+        .collect();
+    let folds: Vec<Vec<(DVec2, DVec2)>> = pieces
+        .iter()
+        .map(|p| p.folds.iter().map(|f| (f.a, f.b)).collect())
+        .collect();
+    let pairs = super::marks::pairs(pieces);
+    let mut cs = candidates(pieces, &rings, &folds, &pairs);
+    collapse_all(&mut rings, &folds, &mut cs, tolerance);
+    rebuild(pieces, &rings, &pairs, &cs.lengths, &before, tolerance);
+}
+
+/// The border rings of every piece, all vertices alive.
+fn rings_of(pieces: &[Piece]) -> Vec<Vec<Ring>> {
+    pieces
         .iter()
         .map(|p| {
             p.border
@@ -145,19 +143,28 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
                 })
                 .collect()
         })
-        .collect();
-    let before: Vec<usize> = pieces
-        .iter()
-        .map(|p| p.border.iter().map(|r| r.len()).sum())
-        .collect();
-    let folds: Vec<Vec<(DVec2, DVec2)>> = pieces
-        .iter()
-        .map(|p| p.folds.iter().map(|f| (f.a, f.b)).collect())
-        .collect();
-    let pairs = super::marks::pairs(pieces);
+        .collect()
+}
 
-    // Candidates: interior vertices of every chain, side A's index `i` being side B's
-    // `count − i`; fixed where a fold line ends.
+/// The vertices that may be collapsed, and the seams' lengths.
+struct Candidates {
+    cands: Vec<Cand>,
+    /// Per piece, ring and vertex: its candidate.
+    cand_at: Vec<Vec<Vec<Option<usize>>>>,
+    /// Per seam pair: the lengths of its two sides.
+    lengths: Vec<[f64; 2]>,
+    /// Per seam pair: the largest mismatch allowed.
+    allowed: Vec<f64>,
+}
+
+/// Candidates: interior vertices of every chain, side A's index `i` being side B's
+/// `count − i`; fixed where a fold line ends.
+fn candidates(
+    pieces: &[Piece],
+    rings: &[Vec<Ring>],
+    folds: &[Vec<(DVec2, DVec2)>],
+    pairs: &[[(usize, usize); 2]],
+) -> Candidates {
     let mut cands: Vec<Cand> = Vec::new();
     let mut cand_at: Vec<Vec<Vec<Option<usize>>>> = rings
         .iter()
@@ -199,26 +206,46 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
         }
     }
 
-    let area = |rings: &Vec<Vec<Ring>>, (p, r, i): (usize, usize, usize)| {
+    Candidates {
+        cands,
+        cand_at,
+        lengths,
+        allowed,
+    }
+}
+
+/// Collapse vertices cheapest first while they may go (see the module doc).
+fn collapse_all(
+    rings: &mut [Vec<Ring>],
+    folds: &[Vec<(DVec2, DVec2)>],
+    cs: &mut Candidates,
+    tolerance: f64,
+) {
+    let Candidates {
+        cands,
+        cand_at,
+        lengths,
+        allowed,
+    } = cs;
+    let area = |rings: &[Vec<Ring>], (p, r, i): (usize, usize, usize)| {
         let ring = &rings[p][r];
         let (a, v, b) = (ring.pts[ring.prev[i]], ring.pts[i], ring.pts[ring.next[i]]);
         0.5 * (v - a).perp_dot(b - a).abs()
     };
-    let cost =
-        |rings: &Vec<Vec<Ring>>, c: &Cand| area(rings, c.at[0]) + area(rings, c.at[1]) + c.acc;
-    let mut heap: BinaryHeap<Entry> = cands
+    let cost = |rings: &[Vec<Ring>], c: &Cand| area(rings, c.at[0]) + area(rings, c.at[1]) + c.acc;
+    let mut heap: BinaryHeap<Lowest<u32>> = cands
         .iter()
         .enumerate()
-        .map(|(id, c)| Entry {
-            cost: cost(&rings, c),
+        .map(|(id, c)| Lowest {
+            key: cost(rings, c),
             id,
-            version: 0,
+            data: 0,
         })
         .collect();
 
     while let Some(e) = heap.pop() {
         let c = &cands[e.id];
-        if !c.alive || c.version != e.version {
+        if !c.alive || c.version != e.data {
             continue;
         }
         // The length each side loses, and the mismatch it leaves.
@@ -234,13 +261,13 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
         }
         let ok =
             c.at.iter()
-                .all(|&at| collapsible(&rings, &folds, at, tolerance))
-                && !crossing_each_other(&rings, c.at);
+                .all(|&at| collapsible(rings, folds, at, tolerance))
+                && !crossing_each_other(rings, c.at);
         if !ok {
             continue;
         }
         lengths[k] = new_len;
-        let full = e.cost;
+        let full = e.key;
         let at = c.at;
         cands[e.id].alive = false;
         let mut touched: Vec<usize> = Vec::new();
@@ -270,15 +297,24 @@ pub(super) fn apply(pieces: &mut [Piece], tolerance: f64) {
                 continue;
             }
             cands[n].version += 1;
-            heap.push(Entry {
-                cost: cost(&rings, &cands[n]),
+            heap.push(Lowest {
+                key: cost(rings, &cands[n]),
                 id: n,
-                version: cands[n].version,
+                data: cands[n].version,
             });
         }
     }
+}
 
-    // Rebuild the pieces from what is left.
+/// Rebuild the pieces from what is left of their rings, and record [`Simplified`].
+fn rebuild(
+    pieces: &mut [Piece],
+    rings: &[Vec<Ring>],
+    pairs: &[[(usize, usize); 2]],
+    lengths: &[[f64; 2]],
+    before: &[usize],
+    tolerance: f64,
+) {
     let mut mismatch = vec![0.0f64; pieces.len()];
     for (k, &[(pa, _), (pb, _)]) in pairs.iter().enumerate() {
         let d = (lengths[k][0] - lengths[k][1]).abs();
@@ -618,7 +654,7 @@ mod tests {
             a: chain[1],
             b: DVec2::new(15.0, 5.0),
             kind: FoldKind::Mountain,
-            angle_deg: 10.0,
+            angle: 10f64.to_radians(),
             edge: 0,
             tab: false,
         });

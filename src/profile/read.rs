@@ -2,7 +2,10 @@
 //! rely on, with errors that name the file, the line and the key.
 
 use super::tools::check_tool;
-use super::{problem, Language, Problem, Profile, ProfileError, Protocol, GCODE_DIALECTS, HPGL_DIALECTS, TOOL_KINDS};
+use super::{
+    problem, Language, Problem, Profile, ProfileError, Protocol, GCODE_DIALECTS, HPGL_DIALECTS,
+    TOOL_KINDS,
+};
 
 /// Parse one profile and check it. Errors name `source_name` and the key at fault, with its
 /// line when the key is written as `key = value` under its table header.

@@ -8,6 +8,7 @@
 use crate::common::*;
 use flatcut::flatten::charts::{self as fcharts, FlattenOptions};
 use flatcut::flatten::{distortion, param, Flat};
+use flatcut::geom::cut;
 use flatcut::geom::mesh::{Face, Mesh};
 use flatcut::surface::dcharts::{self, DChartsOptions};
 use flatcut::surface::dcs::{self, ApproximateOptions};
@@ -831,7 +832,7 @@ fn assert_disks(mesh: &Mesh, chart: &[usize], cuts: &[[usize; 2]]) {
     let count = chart.iter().max().map_or(0, |m| m + 1);
     for c in 0..count {
         let faces: Vec<usize> = (0..chart.len()).filter(|&f| chart[f] == c).collect();
-        let op = dcharts::open(mesh, &topo, &faces, &|e| ids.binary_search(&e).is_ok());
+        let op = cut::open(mesh, &topo, &faces, &|e| ids.binary_search(&e).is_ok());
         assert!(op.connected && !op.nonmanifold, "chart {c}");
         assert_eq!((op.euler, op.loops), (1, 1), "chart {c} opened");
     }
@@ -882,9 +883,9 @@ fn torus_is_cut_open_along_two_loops() {
     let mesh = torus(60.0, 20.0, 48, 24);
     let n = mesh.faces.len();
     let topo = mesh.topology();
-    let g = dcharts::Graph::new(&mesh, &topo);
+    let g = cut::Graph::new(&mesh, &topo);
     let all: Vec<usize> = (0..n).collect();
-    let cuts = dcharts::disk_cuts(&mesh, &topo, &g, &all, &|_| false).expect("a torus opens");
+    let cuts = cut::disk_cuts(&mesh, &topo, &g, &all, &|_| false).expect("a torus opens");
     let pairs: Vec<[usize; 2]> = cuts
         .iter()
         .map(|&e| {
@@ -959,9 +960,9 @@ fn torus_with_a_hole_and_genus_two_are_cut_into_disks() {
     holed.faces.drain(100..104);
     let n = holed.faces.len();
     let topo = holed.topology();
-    let g = dcharts::Graph::new(&holed, &topo);
+    let g = cut::Graph::new(&holed, &topo);
     let all: Vec<usize> = (0..n).collect();
-    let cuts = dcharts::disk_cuts(&holed, &topo, &g, &all, &|_| false).expect("opens");
+    let cuts = cut::disk_cuts(&holed, &topo, &g, &all, &|_| false).expect("opens");
     let pairs: Vec<[usize; 2]> = cuts
         .iter()
         .map(|&e| {
@@ -977,9 +978,9 @@ fn torus_with_a_hole_and_genus_two_are_cut_into_disks() {
     assert!(topo2.edges.iter().all(|e| e.uses.len() == 2));
     let chi = mesh.vertices.len() as i64 - topo2.edges.len() as i64 + n2 as i64;
     assert_eq!(chi, -2, "genus 2");
-    let g2 = dcharts::Graph::new(&mesh, &topo2);
+    let g2 = cut::Graph::new(&mesh, &topo2);
     let all2: Vec<usize> = (0..n2).collect();
-    let cuts2 = dcharts::disk_cuts(&mesh, &topo2, &g2, &all2, &|_| false).expect("opens");
+    let cuts2 = cut::disk_cuts(&mesh, &topo2, &g2, &all2, &|_| false).expect("opens");
     let pairs2: Vec<[usize; 2]> = cuts2
         .iter()
         .map(|&e| {

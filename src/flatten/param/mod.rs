@@ -59,25 +59,29 @@
 
 use super::distortion::{self, corner_angle, face_triangles, Stretch};
 use crate::geom::mesh::Mesh;
+use crate::geom::unionfind::UnionFind;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 use glam::{DMat2, DVec2, DVec3};
 use std::collections::HashMap;
-use std::f64::consts::PI;
+
+mod abf;
+
+use abf::abf_angles;
 
 /// Smallest triangle angle accepted (radians).
-pub const MIN_ANGLE: f64 = 1e-3;
+pub(crate) const MIN_ANGLE: f64 = 1e-3;
 /// `Best` keeps an LSCM layout without running ABF++ when its L2 stretch is within this of 1.
-pub const ISOMETRIC: f64 = 1e-9;
+pub(crate) const ISOMETRIC: f64 = 1e-9;
 /// Boundary size up to which the pins are the exact farthest pair.
-pub const EXACT_PIN_LIMIT: usize = 4000;
+pub(crate) const EXACT_PIN_LIMIT: usize = 4000;
 /// Newton steps ABF++ may take.
-pub const ABF_MAX_ITER: usize = 50;
+pub(crate) const ABF_MAX_ITER: usize = 50;
 /// ABF++ stops when the gradient of the Lagrangian (with the constraint values) is below this
 /// times √(triangles), or when it stalls below 1e-7 times √(triangles).
-pub const ABF_TOLERANCE: f64 = 1e-10;
+pub(crate) const ABF_TOLERANCE: f64 = 1e-10;
 
 /// Which parameterisation to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -213,10 +217,66 @@ impl Chart {
     }
 }
 
+/// The chart of `faces`, checked (see the module doc's "Refused"): its local vertices and
+/// triangles, its edges, one component, one boundary loop and a disk's Euler characteristic.
 fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
     if faces.is_empty() {
         return Err(ParamError::Empty);
     }
+    let line = |f: usize| mesh.faces[f].line;
+    let lt = local_triangles(mesh, faces)?;
+    let edge_uses = edge_uses(mesh, &lt)?;
+    check_components(mesh, &lt, &edge_uses)?;
+    let nv = lt.pos.len();
+    let mut loops = boundary_loops(mesh, faces, &lt, &edge_uses)?;
+    let LocalTriangles {
+        pos, tris, corners, ..
+    } = lt;
+    let euler = nv as i64 - edge_uses.len() as i64 + tris.len() as i64;
+    if euler != 1 {
+        let f = faces[0];
+        return Err(ParamError::Handles {
+            euler,
+            face: f,
+            line: line(f),
+        });
+    }
+    let mut boundary = vec![false; nv];
+    for &v in &loops[0] {
+        boundary[v] = true;
+    }
+    Ok(Chart {
+        pos,
+        tris,
+        corners,
+        boundary,
+        boundary_loop: loops.swap_remove(0),
+        first: (faces[0], line(faces[0])),
+        nfaces: faces.len(),
+    })
+}
+
+/// Per edge over the triangles: its uses as (triangle, directed a -> b).
+type EdgeUses = Vec<Vec<(usize, usize, usize)>>;
+
+/// A chart's faces over local vertices, before its topology is checked.
+struct LocalTriangles {
+    /// Local vertex → 3D position.
+    pos: Vec<DVec3>,
+    /// Triangles over local vertices (face winding).
+    tris: Vec<[usize; 3]>,
+    /// Chart face of each triangle.
+    tri_face: Vec<usize>,
+    /// Per chart face: local vertex of each corner.
+    corners: Vec<Vec<usize>>,
+    /// Local vertex → mesh vertex.
+    global: Vec<usize>,
+}
+
+/// Local vertices (by first appearance in `faces` order) and the faces' triangles over them;
+/// refuses a face out of range or repeated, a vertex out of range or not finite, and a
+/// triangle with an angle below [`MIN_ANGLE`].
+fn local_triangles(mesh: &Mesh, faces: &[usize]) -> Result<LocalTriangles, ParamError> {
     let line = |f: usize| mesh.faces[f].line;
     let mut seen: HashMap<usize, usize> = HashMap::with_capacity(faces.len());
     let mut local: HashMap<usize, usize> = HashMap::new();
@@ -290,7 +350,20 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
         g
     };
 
-    // Edges over triangles: uses as (triangle, directed a -> b).
+    Ok(LocalTriangles {
+        pos,
+        tris,
+        tri_face,
+        corners,
+        global,
+    })
+}
+
+/// Edges over the triangles, each with its uses as (triangle, directed a -> b), in order of
+/// first use; refuses an edge used by more than two triangles.
+fn edge_uses(mesh: &Mesh, lt: &LocalTriangles) -> Result<EdgeUses, ParamError> {
+    let line = |f: usize| mesh.faces[f].line;
+    let (tris, tri_face, global) = (&lt.tris, &lt.tri_face, &lt.global);
     let mut edge_index: HashMap<(usize, usize), usize> = HashMap::with_capacity(tris.len() * 2);
     let mut edge_uses: Vec<Vec<(usize, usize, usize)>> = Vec::new();
     for (t, tri) in tris.iter().enumerate() {
@@ -314,16 +387,20 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
             }
         }
     }
-    // Components (union-find over triangles sharing an edge), orientation.
-    let mut parent: Vec<usize> = (0..tris.len()).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for uses in &edge_uses {
+    Ok(edge_uses)
+}
+
+/// Refuses two faces wound against each other and several connected components (union-find
+/// over triangles sharing an edge).
+fn check_components(
+    mesh: &Mesh,
+    lt: &LocalTriangles,
+    edge_uses: &[Vec<(usize, usize, usize)>],
+) -> Result<(), ParamError> {
+    let line = |f: usize| mesh.faces[f].line;
+    let (tris, tri_face, global) = (&lt.tris, &lt.tri_face, &lt.global);
+    let mut sets = UnionFind::new(tris.len());
+    for uses in edge_uses {
         if let [(t, a, b), (u, a2, _)] = uses[..] {
             if a == a2 {
                 let f = tri_face[u];
@@ -334,17 +411,14 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
                     b: global[b],
                 });
             }
-            let (rt, ru) = (find(&mut parent, t), find(&mut parent, u));
-            if rt != ru {
-                parent[rt.max(ru)] = rt.min(ru);
-            }
+            sets.union(t, u);
         }
     }
-    let root0 = find(&mut parent, 0);
+    let root0 = sets.find(0);
     let mut roots = Vec::new();
     let mut other = None;
     for t in 0..tris.len() {
-        let r = find(&mut parent, t);
+        let r = sets.find(t);
         if r == t {
             roots.push(r);
         }
@@ -360,13 +434,26 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
             line: line(f),
         });
     }
-    // Boundary: directed edges used once; one out- and one in-edge per boundary vertex.
-    let nv = pos.len();
+    Ok(())
+}
+
+/// The boundary loops (local vertices in loop order): directed edges used once, one out- and
+/// one in-edge per boundary vertex; refuses a vertex where two boundary fans meet, a closed
+/// chart and several loops (holes).
+fn boundary_loops(
+    mesh: &Mesh,
+    faces: &[usize],
+    lt: &LocalTriangles,
+    edge_uses: &[Vec<(usize, usize, usize)>],
+) -> Result<Vec<Vec<usize>>, ParamError> {
+    let line = |f: usize| mesh.faces[f].line;
+    let (tri_face, global) = (&lt.tri_face, &lt.global);
+    let nv = lt.pos.len();
     let mut next: Vec<Option<usize>> = vec![None; nv];
     let mut has_in = vec![false; nv];
     let mut boundary_face: Vec<usize> = vec![0; nv];
     let mut nb = 0usize;
-    for uses in &edge_uses {
+    for uses in edge_uses {
         if let [(t, a, b)] = uses[..] {
             let f = tri_face[t];
             if next[a].is_some() || has_in[b] {
@@ -417,28 +504,7 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
             line: line(f),
         });
     }
-    let euler = nv as i64 - edge_uses.len() as i64 + tris.len() as i64;
-    if euler != 1 {
-        let f = faces[0];
-        return Err(ParamError::Handles {
-            euler,
-            face: f,
-            line: line(f),
-        });
-    }
-    let mut boundary = vec![false; nv];
-    for &v in &loops[0] {
-        boundary[v] = true;
-    }
-    Ok(Chart {
-        pos,
-        tris,
-        corners,
-        boundary,
-        boundary_loop: loops.swap_remove(0),
-        first: (faces[0], line(faces[0])),
-        nfaces: faces.len(),
-    })
+    Ok(loops)
 }
 
 /// The two pinned vertices (local ids): the farthest pair of boundary vertices (see the module
@@ -640,200 +706,6 @@ fn lscm_solve(
         .collect())
 }
 
-/// ABF++: optimal angles per triangle.
-fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
-    const M: &str = "ABF++";
-    let nt = chart.tris.len();
-    let nv = chart.pos.len();
-    // 3D angles and targets.
-    let mut phi = vec![[0.0f64; 3]; nt];
-    let mut sum = vec![0.0f64; nv];
-    for (t, tri) in chart.tris.iter().enumerate() {
-        let p = tri.map(|v| chart.pos[v]);
-        for c in 0..3 {
-            phi[t][c] = corner_angle(p[c], p[(c + 1) % 3], p[(c + 2) % 3]);
-            sum[tri[c]] += phi[t][c];
-        }
-    }
-    // Interior vertex -> row pair (V = 2i, L = 2i + 1).
-    let mut row: Vec<Option<usize>> = vec![None; nv];
-    let mut ni = 0;
-    for (slot, &on_boundary) in row.iter_mut().zip(&chart.boundary) {
-        if !on_boundary {
-            *slot = Some(ni);
-            ni += 1;
-        }
-    }
-    let mut beta = phi.clone();
-    for (t, tri) in chart.tris.iter().enumerate() {
-        for c in 0..3 {
-            if row[tri[c]].is_some() {
-                beta[t][c] *= 2.0 * PI / sum[tri[c]];
-            }
-        }
-    }
-    let lam_diag: Vec<[f64; 3]> = beta.iter().map(|b| b.map(|x| 2.0 / (x * x))).collect();
-    let mut alpha = beta.clone();
-    let mut lam_t = vec![0.0f64; nt];
-    let mut lam2 = vec![0.0f64; 2 * ni];
-    let m2 = 2 * ni;
-    let mut converged = false;
-    let mut symbolic = None;
-    let mut last_norm = f64::INFINITY;
-    for _iter in 0..ABF_MAX_ITER {
-        // Gradient of the Lagrangian and constraint values.
-        let mut c2 = vec![0.0f64; m2];
-        for i in 0..ni {
-            c2[2 * i] = -2.0 * PI;
-        }
-        let mut b1 = vec![[0.0f64; 3]; nt];
-        let mut c1 = vec![0.0f64; nt];
-        let mut cot = vec![[0.0f64; 3]; nt];
-        for (t, tri) in chart.tris.iter().enumerate() {
-            c1[t] = alpha[t][0] + alpha[t][1] + alpha[t][2] - PI;
-            for c in 0..3 {
-                let a = alpha[t][c];
-                cot[t][c] = a.cos() / a.sin();
-                let mut g = lam_diag[t][c] * (a - beta[t][c]) + lam_t[t];
-                if let Some(r) = row[tri[c]] {
-                    g += lam2[2 * r];
-                    c2[2 * r] += a;
-                }
-                // This corner is "next" for the vertex at corner c+2, "prev" for c+1.
-                if let Some(r) = row[tri[(c + 2) % 3]] {
-                    g += lam2[2 * r + 1] * cot[t][c];
-                    c2[2 * r + 1] += a.sin().ln();
-                }
-                if let Some(r) = row[tri[(c + 1) % 3]] {
-                    g -= lam2[2 * r + 1] * cot[t][c];
-                    c2[2 * r + 1] -= a.sin().ln();
-                }
-                b1[t][c] = g;
-            }
-        }
-        let norm = b1
-            .iter()
-            .flat_map(|b| b.iter())
-            .chain(c1.iter())
-            .chain(c2.iter())
-            .map(|x| x * x)
-            .sum::<f64>()
-            .sqrt();
-        if !norm.is_finite() {
-            return Err(chart.solver_error(M, "the Newton iteration diverged"));
-        }
-        let scale = (nt as f64).sqrt().max(1.0);
-        // Converged; or stalled at round-off level (Newton no longer halves the residual)
-        // with a residual that is still far below any visible angle error.
-        if norm < ABF_TOLERANCE * scale || (norm > 0.5 * last_norm && norm < 1e-7 * scale) {
-            converged = true;
-            break;
-        }
-        last_norm = norm;
-        // Reduced system over the vertex and wheel multipliers.
-        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(nt * 21);
-        let mut rhs = c2.clone();
-        let mut local_b = vec![[0.0f64; 6]; nt];
-        let mut local_r1 = vec![0.0f64; nt];
-        let mut local_d = vec![0.0f64; nt];
-        // Local slots: 2k = V row of corner k's vertex, 2k + 1 = its L row.
-        let jac = |t: usize, c: usize| -> [f64; 6] {
-            let tri = chart.tris[t];
-            let mut j = [0.0; 6];
-            if row[tri[c]].is_some() {
-                j[2 * c] = 1.0;
-            }
-            let cn = (c + 2) % 3;
-            if row[tri[cn]].is_some() {
-                j[2 * cn + 1] += cot[t][c];
-            }
-            let cp = (c + 1) % 3;
-            if row[tri[cp]].is_some() {
-                j[2 * cp + 1] -= cot[t][c];
-            }
-            j
-        };
-        for (t, tri) in chart.tris.iter().enumerate() {
-            let js = [jac(t, 0), jac(t, 1), jac(t, 2)];
-            let inv = lam_diag[t].map(|x| 1.0 / x);
-            let d = inv[0] + inv[1] + inv[2];
-            let mut bt = [0.0f64; 6];
-            let mut jb = [0.0f64; 6];
-            let mut r1 = c1[t];
-            for c in 0..3 {
-                r1 -= b1[t][c] * inv[c];
-                for s in 0..6 {
-                    bt[s] += js[c][s] * inv[c];
-                    jb[s] += js[c][s] * b1[t][c] * inv[c];
-                }
-            }
-            let slot_row = |s: usize| row[tri[s / 2]].map(|r| 2 * r + s % 2);
-            for s in 0..6 {
-                let Some(rs) = slot_row(s) else { continue };
-                rhs[rs] -= jb[s] + bt[s] * r1 / d;
-                for q in 0..6 {
-                    let Some(rq) = slot_row(q) else { continue };
-                    if rs < rq {
-                        continue;
-                    }
-                    let mut v = -bt[s] * bt[q] / d;
-                    for c in 0..3 {
-                        v += js[c][s] * js[c][q] * inv[c];
-                    }
-                    // Zeros kept: the pattern must not change between steps.
-                    triplets.push(Triplet::new(rs, rq, v));
-                }
-            }
-            local_b[t] = bt;
-            local_r1[t] = r1;
-            local_d[t] = d;
-        }
-        let x = spd_solve(chart, M, m2, &triplets, &rhs, &mut symbolic, 0)?;
-        let mut d_alpha = vec![[0.0f64; 3]; nt];
-        let mut d_lam_t = vec![0.0f64; nt];
-        // Largest step fraction keeping every angle inside (0, π) with a margin (a damped
-        // Newton step; ABF++ takes full steps, which can leave the domain on hard charts).
-        let mut step = 1.0f64;
-        for (t, tri) in chart.tris.iter().enumerate() {
-            let xl: [f64; 6] =
-                std::array::from_fn(|s| row[tri[s / 2]].map(|r| x[2 * r + s % 2]).unwrap_or(0.0));
-            let bx: f64 = (0..6).map(|s| local_b[t][s] * xl[s]).sum();
-            let dl1 = (local_r1[t] - bx) / local_d[t];
-            d_lam_t[t] = dl1;
-            for c in 0..3 {
-                let j = jac(t, c);
-                let jx: f64 = (0..6).map(|s| j[s] * xl[s]).sum();
-                let da = -(b1[t][c] + dl1 + jx) / lam_diag[t][c];
-                let a = alpha[t][c];
-                if da < 0.0 {
-                    step = step.min(0.9 * a / -da);
-                } else if da > 0.0 {
-                    step = step.min(0.9 * (PI - a) / da);
-                }
-                d_alpha[t][c] = da;
-            }
-        }
-        if step.is_nan() || step <= 1e-6 {
-            return Err(chart.solver_error(M, "the Newton step cannot keep the angles in (0, π)"));
-        }
-        for (l, dl) in lam_t.iter_mut().zip(&d_lam_t) {
-            *l += step * dl;
-        }
-        for (a, da) in alpha.iter_mut().zip(&d_alpha) {
-            for c in 0..3 {
-                a[c] += step * da[c];
-            }
-        }
-        for (l, dx) in lam2.iter_mut().zip(&x) {
-            *l += step * dx;
-        }
-    }
-    if !converged {
-        return Err(chart.solver_error(M, format!("no convergence in {ABF_MAX_ITER} Newton steps")));
-    }
-    Ok(alpha)
-}
-
 /// Scale to the 3D area, make counter-clockwise, move to the origin; per chart face corners.
 fn finish(
     mesh: &Mesh,
@@ -963,7 +835,7 @@ pub fn parameterize(
 }
 
 /// Sweeps of the stretch minimisation that `Best` runs on the kept layout.
-pub const STRETCH_SWEEPS: usize = 60;
+pub(crate) const STRETCH_SWEEPS: usize = 60;
 
 /// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4) from a flip-free layout: a
 /// nonlinear Gauss–Seidel over the vertices, each moved by a backtracking line search down the
@@ -1104,6 +976,7 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
 mod tests {
     use super::*;
     use crate::geom::mesh::Face;
+    use std::f64::consts::PI;
 
     /// A 6 x 6 grid lifted into a saddle-and-bump: not developable, every interior vertex has
     /// a non-zero angle defect.

@@ -1,0 +1,1038 @@
+//! Flattening of a segmented smooth surface: every chart of [`Surface::charts`] becomes one
+//! island, laid flat by [`super::param::parameterize`] (LSCM / ABF++, scaled so that its 2D
+//! area equals its 3D area), and [`flatten`] picks between that and the exact polyhedral
+//! [`super::unfold()`] for the CLI.
+//!
+//! **Cuts inside a chart** ([`Surface::cuts`], thesis §5.2.3): a chart is opened along its cut
+//! edges before it is parameterised: [`crate::geom::cut::open`] gives one vertex per
+//! wedge of faces around each mesh vertex, so the vertices along a seam are split, and the
+//! opened chart is laid flat as a mesh of its own. A chart that is still not a disk gets the
+//! cuts of [`crate::geom::cut::disk_cuts`] (a tube the shortest seam between its rims,
+//! a chart with handles its shortest system of loops as well);
+//! cuts a split leaves useless are dropped and found again. A cut edge is never `joined`, so
+//! the pattern stage draws it as a cut line with seam marks on both sides, like a seam
+//! between two pieces; [`Surface::cuts`] of the result lists the cuts that stayed inside a
+//! piece.
+//!
+//! The [`Flat`] it builds is the one the pattern stage already reads: `face_2d` per face
+//! corner, counter-clockwise (a chart laid out mirrored is mirrored back); `joined` for the
+//! edges inside a chart (their two copies coincide, the layout being per opened vertex);
+//! `dihedral` the signed bend of every interior edge, as [`super::unfold()`] computes it.
+//!
+//! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
+//! material's tolerance"), a chart
+//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap) has
+//!   the overlapping region cut off ([`cut_off`], after Lévy et al. 2002, the thesis' [22]:
+//!   the overlapping faces are sorted to the nearer of the two first found overlapping, the
+//!   side with less overlapping area is cut off, again while the rest still overlaps) when
+//!   that part has at most [`CUT_OFF_AREA`] of the chart's area; the part cut off is a chart
+//!   of its own, re-attached at the end to a neighbour where it fits ([`reattach`]). A larger
+//!   overlap splits the chart between the two overlapping faces
+//!   (`split_between` of [`crate::geom::cut`]: each face goes with the nearer of the two,
+//!   through the chart); a chart that needed seams to be a disk (a tube whose layout
+//!   spirals over itself) is halved along the bisector instead;
+//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts` below: up
+//!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
+//!   region, then shortened while it stays within the tolerance), then gussets where the
+//!   surface is saddle-shaped ([`gussets`]: a slit toward the most negative angle defect
+//!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
+//!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
+//!
+//! and is split along the bisector of its two most distant faces
+//! (`bisect` of [`crate::geom::cut`]) when
+//! - it has a flipped triangle,
+//! - the parameteriser refuses it (no cut makes it a disk),
+//! - or its L2 stretch is still over the tolerance — at most [`FlattenOptions::max_splits`]
+//!   times per chart (its darts dropped, each half gets its own); what is still over it then
+//!   is reported (a warning on the surface, and the stretch of every piece in `report.json`).
+//!
+//! Material tolerances on the L2 stretch of a piece ([`material_tolerance`]), chosen here:
+//! paper 1.003 (paper does not stretch; 0.3 % is taken up by folding and gluing without a
+//! visible wrinkle), metal 1.001 (a blank must develop, 0.1 % is within a plotter's accuracy
+//! on a 1 m piece), fabric 1.03 (woven cloth gives a few percent on the bias, and stuffing
+//! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
+//! visible fault.
+//!
+//! The two sides of a seam (a cut inside a piece, or the edge a gusset shares with its
+//! chart) have the same 3D length; laid flat they are as long as the parameterisation makes
+//! them, equal only where it is isometric: on a non-developable piece they differ by up to
+//! its stretch, which sewing takes up as ease.
+
+use super::distortion::{self, Stretch};
+use super::param::{self, ParamMethod};
+use super::{unfold, Flat, FlattenError, UnfoldOptions};
+use crate::geom::cut::{bisect, disk_cuts, open, split_between, Graph};
+use crate::geom::mesh::{Face, Mesh, Topology};
+use crate::geom::polygon;
+use crate::geom::proxy;
+use crate::surface::MaterialKind;
+use crate::surface::Surface;
+use glam::DVec2;
+
+mod darts;
+
+use darts::{darts, gussets, DART_MIN_FACES};
+
+/// How a surface is laid flat.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlattenOptions {
+    /// The exact unfolding's options (surfaces without charts).
+    pub unfold: UnfoldOptions,
+    /// Parameterisation of charts.
+    pub method: ParamMethod,
+    /// Largest L2 stretch of a piece before it is split (see [`material_tolerance`]).
+    pub tolerance: f64,
+    /// Times a chart may be split for being over the tolerance (overlaps and flips are always
+    /// split, down to single faces).
+    pub max_splits: usize,
+    /// Most darts cut into a chart over the tolerance before it is split (see the module doc); 0
+    /// for none.
+    pub darts: usize,
+    /// Most gussets cut into a chart still over the tolerance after its darts (see
+    /// [`gussets`]); 0 for none (default 2).
+    pub gussets: usize,
+    /// Merging threshold `η` for re-attaching a cut-off gusset to an adjacent piece: the mean
+    /// cylinder fitting error of the gusset and two face rings of the piece around their common
+    /// boundary ([`proxy::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
+    /// `η` (`surface::dcharts::DChartsOptions::eta`).
+    pub reattach_eta: f64,
+}
+
+impl Default for FlattenOptions {
+    fn default() -> Self {
+        FlattenOptions {
+            unfold: UnfoldOptions::default(),
+            method: ParamMethod::default(),
+            tolerance: material_tolerance(MaterialKind::Paper),
+            max_splits: 3,
+            darts: 4,
+            gussets: 2,
+            reattach_eta: 1e-3,
+        }
+    }
+}
+
+impl FlattenOptions {
+    /// Defaults for a material.
+    pub fn for_material(kind: MaterialKind) -> Self {
+        FlattenOptions {
+            tolerance: material_tolerance(kind),
+            ..Default::default()
+        }
+    }
+}
+
+/// Largest L2 stretch of a piece, by material (see the module doc).
+fn material_tolerance(kind: MaterialKind) -> f64 {
+    match kind {
+        MaterialKind::Paper => 1.003,
+        MaterialKind::Fabric => 1.03,
+        MaterialKind::Metal => 1.001,
+    }
+}
+
+/// Lay a surface flat: its charts parameterised when it has them, else unfolded exactly.
+pub fn flatten(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+    if surface.charts.is_some() {
+        charts(surface, opts)
+    } else {
+        unfold(surface, &opts.unfold)
+    }
+}
+
+/// A chart laid flat.
+struct Laid {
+    faces: Vec<usize>,
+    /// Edges cut open inside the chart (topology ids, sorted).
+    cuts: Vec<usize>,
+    uv: Vec<Vec<DVec2>>,
+    stretch: Stretch,
+    /// A gusset cut off a chart ([`gussets`]), to be re-attached to a neighbour if one fits.
+    gusset: bool,
+}
+
+/// A chart waiting to be laid flat.
+struct Todo {
+    faces: Vec<usize>,
+    /// Times split for stretch.
+    splits: usize,
+    /// Edges cut open inside it (sorted), inherited from the surface or a larger chart.
+    cuts: Vec<usize>,
+    /// Cut off a larger chart for overlapping it ([`cut_off`]): to be re-attached to a
+    /// neighbour if one fits ([`reattach`]).
+    cut_off: bool,
+}
+
+/// What [`Charts::lay`] made of a chart.
+enum Layout {
+    Laid(Vec<Vec<DVec2>>, Stretch),
+    /// The parameteriser refused it (not a disk, solver failure) or gave non-finite points.
+    Refused,
+}
+
+/// The mesh and what every chart needs.
+struct Charts<'a> {
+    mesh: &'a Mesh,
+    topo: &'a Topology,
+    graph: &'a Graph,
+    method: ParamMethod,
+}
+
+impl Charts<'_> {
+    /// The chart's faces opened along `cuts` and laid flat: the opened chart becomes a mesh of
+    /// its own (vertices split along the cuts), parameterised, then turned counter-clockwise.
+    fn lay(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
+        let op = open(self.mesh, self.topo, faces, &|e| {
+            cuts.binary_search(&e).is_ok()
+        });
+        let local = Mesh {
+            vertices: op.vertex.iter().map(|&v| self.mesh.vertices[v]).collect(),
+            faces: faces
+                .iter()
+                .zip(op.corners)
+                .map(|(&f, verts)| Face {
+                    verts,
+                    line: self.mesh.faces[f].line,
+                })
+                .collect(),
+        };
+        let ids: Vec<usize> = (0..faces.len()).collect();
+        let p = match param::parameterize(&local, &ids, self.method) {
+            Ok(p) => p,
+            // A sliver triangle cannot be laid flat in any chart: say which (mesh numbering).
+            Err(param::ParamError::Degenerate { face, line, angle }) => {
+                return Err(param::ParamError::Degenerate {
+                    face: faces.get(face).copied().unwrap_or(face),
+                    line,
+                    angle,
+                })
+            }
+            Err(_) => return Ok(Layout::Refused),
+        };
+        let mut uv = p.uv;
+        if uv.iter().any(|c| c.iter().any(|q| !q.is_finite())) {
+            return Ok(Layout::Refused);
+        }
+        // Counter-clockwise, as the pattern stage expects.
+        let total: f64 = uv.iter().map(|c| polygon::signed_area(c)).sum();
+        let stretch = if total < 0.0 {
+            for c in uv.iter_mut() {
+                for q in c.iter_mut() {
+                    q.x = -q.x;
+                }
+            }
+            distortion::stretch(&local, &ids, &uv)
+        } else {
+            p.stretch
+        };
+        Ok(Layout::Laid(uv, stretch))
+    }
+
+    /// Cuts that make the chart a disk: `cuts` when they do, else `cuts` with more
+    /// ([`disk_cuts`]), else new ones from scratch; `None` when the chart must be split.
+    fn disk(&self, faces: &[usize], cuts: &[usize]) -> Option<Vec<usize>> {
+        let has = |e: usize| cuts.binary_search(&e).is_ok();
+        if let Some(more) = disk_cuts(self.mesh, self.topo, self.graph, faces, &has) {
+            let mut all = cuts.to_vec();
+            all.extend(more);
+            all.sort_unstable();
+            all.dedup();
+            return Some(all);
+        }
+        if cuts.is_empty() {
+            return None;
+        }
+        disk_cuts(self.mesh, self.topo, self.graph, faces, &|_| false)
+    }
+
+    /// The edges of `cuts` inside `faces` (both faces of the edge in it).
+    fn cuts_within(&self, faces: &[usize], cuts: &[usize]) -> Vec<usize> {
+        if cuts.is_empty() {
+            return Vec::new();
+        }
+        let mut inside = vec![false; self.mesh.faces.len()];
+        for &f in faces {
+            inside[f] = true;
+        }
+        cuts.iter()
+            .copied()
+            .filter(|&e| self.topo.edges[e].uses.iter().all(|u| inside[u.0]))
+            .collect()
+    }
+
+    /// The charts of `chart_of` to lay flat, each with the surface's cuts inside it, the
+    /// first chart last (it is popped first).
+    fn initial(&self, chart_of: &[usize], surface_cuts: &[usize]) -> Vec<Todo> {
+        let count = chart_of.iter().copied().max().map_or(0, |m| m + 1);
+        let mut groups: Vec<Vec<usize>> = vec![Vec::new(); count];
+        for (f, &c) in chart_of.iter().enumerate() {
+            groups[c].push(f);
+        }
+        let mut todo: Vec<Todo> = groups
+            .into_iter()
+            .filter(|g| !g.is_empty())
+            .map(|faces| Todo {
+                cuts: self.cuts_within(&faces, surface_cuts),
+                faces,
+                splits: 0,
+                cut_off: false,
+            })
+            .collect();
+        todo.reverse();
+        todo
+    }
+
+    /// Lay one chart flat (see the module doc): cut into a disk and laid; split or cut where
+    /// it overlaps itself or flips; darts, gussets and splits while over the tolerance. Halves
+    /// and parts cut off go back onto `todo`, the chart laid and its gussets onto `done`.
+    fn lay_one(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        mut t: Todo,
+        todo: &mut Vec<Todo>,
+        done: &mut Vec<Laid>,
+        degenerate: &dyn Fn(usize) -> FlattenError,
+    ) -> Result<(), FlattenError> {
+        let Some(cuts) = self.disk(&t.faces, &t.cuts) else {
+            return self.split_or_fail(todo, &t, degenerate);
+        };
+        t.cuts = cuts;
+        let nf = self.mesh.faces.len();
+        let layout = self.lay(&t.faces, &t.cuts).map_err(|e| match e {
+            param::ParamError::Degenerate { face, .. } => degenerate(face.min(nf - 1)),
+            _ => degenerate(t.faces[0]),
+        })?;
+        let (uv, stretch) = match layout {
+            Layout::Laid(uv, s) => (uv, s),
+            Layout::Refused => return self.split_or_fail(todo, &t, degenerate),
+        };
+        if t.faces.len() > 1 {
+            // Overlapping parts go to different pieces: split between the two faces.
+            if let Some(pair) = self_overlap(&uv, eps) {
+                if self.part_overlap(todo, &t, &uv, pair, eps) {
+                    return Ok(());
+                }
+            }
+            if stretch.flipped > 0 && self.split_in_two(todo, &t, t.splits) {
+                return Ok(());
+            }
+        }
+        self.relieve(opts, eps, t, uv, stretch, todo, done)
+    }
+
+    /// Split a chart that cannot be laid flat in two, or fail on a single face (or a chart
+    /// that does not split).
+    fn split_or_fail(
+        &self,
+        todo: &mut Vec<Todo>,
+        t: &Todo,
+        degenerate: &dyn Fn(usize) -> FlattenError,
+    ) -> Result<(), FlattenError> {
+        if t.faces.len() == 1 || !self.split_in_two(todo, t, t.splits) {
+            return Err(degenerate(t.faces[0]));
+        }
+        Ok(())
+    }
+
+    /// Push the two halves of a chart (cuts kept where they fall inside a half).
+    fn push_halves(
+        &self,
+        todo: &mut Vec<Todo>,
+        a: Vec<usize>,
+        b: Vec<usize>,
+        t: &Todo,
+        splits: usize,
+    ) {
+        let (ca, cb) = (self.cuts_within(&a, &t.cuts), self.cuts_within(&b, &t.cuts));
+        todo.push(Todo {
+            faces: b,
+            splits,
+            cuts: cb,
+            cut_off: false,
+        });
+        todo.push(Todo {
+            faces: a,
+            splits,
+            cuts: ca,
+            cut_off: false,
+        });
+    }
+
+    /// Push the halves of a chart split along the bisector of its two most distant faces;
+    /// false when it does not split.
+    fn split_in_two(&self, todo: &mut Vec<Todo>, t: &Todo, splits: usize) -> bool {
+        let (a, b) = bisect(self.graph, &t.faces);
+        if a.is_empty() || b.is_empty() {
+            return false;
+        }
+        self.push_halves(todo, a, b, t, splits);
+        true
+    }
+
+    /// A chart whose layout `uv` overlaps itself at faces `(x, y)` (indices into its faces):
+    /// halved when it was cut open into a disk (a tube, as a whole), else a small overlapping
+    /// region cut off (§5.3, to be re-attached elsewhere), else split between the two faces.
+    /// True when the parts went onto `todo`.
+    fn part_overlap(
+        &self,
+        todo: &mut Vec<Todo>,
+        t: &Todo,
+        uv: &[Vec<DVec2>],
+        (x, y): (usize, usize),
+        eps: f64,
+    ) -> bool {
+        // A chart cut open into a disk (a tube) is halved instead, as a whole.
+        if !t.cuts.is_empty() && self.split_in_two(todo, t, t.splits) {
+            return true;
+        }
+        // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
+        let pairs = overlaps(uv, eps, OVERLAP_PAIRS);
+        let (fx, fy) = (t.faces[x], t.faces[y]);
+        if let Some((rest, parts)) = cut_off(self, &t.faces, &t.cuts, &[fx], &[fy], &pairs, uv, eps)
+        {
+            let area = |fs: &[usize]| fs.iter().map(|&f| self.graph.area[f]).sum::<f64>();
+            let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
+            if off <= CUT_OFF_AREA * area(&t.faces) {
+                for p in parts.into_iter().rev() {
+                    todo.push(Todo {
+                        faces: p.faces,
+                        splits: t.splits,
+                        cuts: p.cuts,
+                        cut_off: true,
+                    });
+                }
+                todo.push(Todo {
+                    faces: rest.faces,
+                    splits: t.splits,
+                    cuts: rest.cuts,
+                    cut_off: t.cut_off,
+                });
+                return true;
+            }
+        }
+        let (a, b) = split_between(self.graph, &t.faces, t.faces[x], t.faces[y]);
+        if !a.is_empty() && !b.is_empty() {
+            self.push_halves(todo, a, b, t, t.splits);
+            return true;
+        }
+        false
+    }
+
+    /// A chart laid flat as `uv` with `stretch`, over the tolerance: darts first, then
+    /// gussets (onto `done`), then a split for stretch (its darts dropped: each half gets its
+    /// own) while [`FlattenOptions::max_splits`] allows; else it is done as it is.
+    #[allow(clippy::too_many_arguments)]
+    fn relieve(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        t: Todo,
+        uv: Vec<Vec<DVec2>>,
+        stretch: Stretch,
+        todo: &mut Vec<Todo>,
+        done: &mut Vec<Laid>,
+    ) -> Result<(), FlattenError> {
+        let inherited = t.cuts.clone();
+        let mut laid = Laid {
+            faces: t.faces,
+            cuts: t.cuts,
+            uv,
+            stretch,
+            gusset: t.cut_off,
+        };
+        if laid.stretch.l2 > opts.tolerance && opts.darts > 0 && laid.faces.len() >= DART_MIN_FACES
+        {
+            darts(self, &mut laid, opts, eps)?;
+        }
+        if laid.stretch.l2 > opts.tolerance
+            && opts.gussets > 0
+            && laid.faces.len() >= DART_MIN_FACES
+        {
+            let gussets = gussets(self, &mut laid, opts, eps);
+            done.extend(gussets);
+        }
+        if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
+            // Darts are dropped: each half gets its own.
+            let t = Todo {
+                faces: laid.faces,
+                splits: t.splits,
+                cuts: inherited,
+                cut_off: t.cut_off,
+            };
+            if self.split_in_two(todo, &t, t.splits + 1) {
+                return Ok(());
+            }
+            laid.faces = t.faces;
+        }
+        done.push(laid);
+        Ok(())
+    }
+}
+
+/// Lay each chart flat as one island (cutting and splitting where needed, see the module
+/// doc).
+pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+    let mesh = &surface.mesh;
+    let nf = mesh.faces.len();
+    let chart_of = match &surface.charts {
+        Some(c) if c.len() == nf => c.clone(),
+        _ => vec![0; nf],
+    };
+    let topology = mesh.topology();
+    let graph = Graph::new(mesh, &topology);
+    let ctx = Charts {
+        mesh,
+        topo: &topology,
+        graph: &graph,
+        method: opts.method,
+    };
+    let surface_cuts = edge_ids(&topology, &surface.cuts);
+    let mut todo = ctx.initial(&chart_of, &surface_cuts);
+    let mut done: Vec<Laid> = Vec::new();
+    // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
+    let mean_edge = topology
+        .edges
+        .iter()
+        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
+        .sum::<f64>()
+        / topology.edges.len().max(1) as f64;
+    let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge);
+    let degenerate = |f: usize| FlattenError::Degenerate {
+        surface: surface.name.clone(),
+        face: f + 1,
+        line: mesh.faces[f].line,
+    };
+    while let Some(t) = todo.pop() {
+        ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
+    }
+    reattach(&ctx, &mut done, opts, overlap_eps);
+    Ok(assemble(surface, topology, done, opts))
+}
+
+/// The surface's cuts as edge ids (pairs that are not edges of the mesh are ignored), sorted.
+fn edge_ids(topology: &Topology, pairs: &[[usize; 2]]) -> Vec<usize> {
+    let mut edge_of: std::collections::HashMap<[usize; 2], usize> = Default::default();
+    for (e, edge) in topology.edges.iter().enumerate() {
+        let [a, b] = edge.verts;
+        edge_of.insert([a.min(b), a.max(b)], e);
+    }
+    let mut ids: Vec<usize> = pairs
+        .iter()
+        .filter_map(|&[a, b]| edge_of.get(&[a.min(b), a.max(b)]).copied())
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids
+}
+
+/// The laid charts as islands (numbered by smallest face) of a [`Flat`]; the surface gets a
+/// warning per piece over the tolerance, the cuts that stayed inside pieces and the islands
+/// as its charts.
+fn assemble(
+    mut surface: Surface,
+    topology: Topology,
+    mut done: Vec<Laid>,
+    opts: &FlattenOptions,
+) -> Flat {
+    let mesh = &surface.mesh;
+    let nf = mesh.faces.len();
+    let mut over: Vec<(usize, f64)> = Vec::new();
+    // Islands numbered by smallest face.
+    done.sort_by_key(|l| l.faces.iter().copied().min().unwrap_or(0));
+    let mut face_2d: Vec<Vec<DVec2>> = vec![Vec::new(); nf];
+    let mut face_island = vec![0; nf];
+    let mut islands = Vec::with_capacity(done.len());
+    let ne = topology.edges.len();
+    let mut is_cut = vec![false; ne];
+    for (k, l) in done.iter().enumerate() {
+        if l.stretch.l2 > opts.tolerance {
+            over.push((k, l.stretch.l2));
+        }
+        for (f, c) in l.faces.iter().zip(&l.uv) {
+            face_2d[*f] = c.clone();
+            face_island[*f] = k;
+        }
+        for &e in &l.cuts {
+            is_cut[e] = true;
+        }
+        let mut faces = l.faces.clone();
+        faces.sort_unstable();
+        islands.push(faces);
+    }
+    let mut joined = vec![false; ne];
+    let mut dihedral = vec![0.0; ne];
+    let mut lengths = 0.0;
+    for (e, edge) in topology.edges.iter().enumerate() {
+        lengths += mesh.vertices[edge.verts[0]].distance(mesh.vertices[edge.verts[1]]);
+        let [(f, i), (g, j)] = edge.uses[..] else {
+            continue;
+        };
+        dihedral[e] = mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
+        if face_island[f] == face_island[g] && !is_cut[e] {
+            let (p, q) = (face_2d[f][i], face_2d[f][(i + 1) % face_2d[f].len()]);
+            let (q0, p0) = (face_2d[g][j], face_2d[g][(j + 1) % face_2d[g].len()]);
+            let tol = 1e-9 * (1.0 + p.length().max(q.length()));
+            joined[e] = p.distance(p0) <= tol && q.distance(q0) <= tol;
+        }
+    }
+    let mean = lengths / ne.max(1) as f64;
+    for (k, l2) in over {
+        surface.warnings.push(format!(
+            "surface `{}`: piece {} stretches by L2 {:.5}, over the material's {:.4}: expect wrinkles or gaps",
+            surface.name,
+            k + 1,
+            l2,
+            opts.tolerance
+        ));
+    }
+    let mut cuts: Vec<[usize; 2]> = (0..ne)
+        .filter(|&e| is_cut[e])
+        .map(|e| {
+            let [a, b] = topology.edges[e].verts;
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    cuts.sort_unstable();
+    surface.cuts = cuts;
+    surface.charts = Some(face_island.clone());
+    Flat {
+        surface,
+        topology,
+        face_2d,
+        face_island,
+        islands,
+        joined,
+        dihedral,
+        tolerance: opts.unfold.tolerance.min(0.01 * mean),
+    }
+}
+
+/// Stretch of each island of a flat, and of the whole (area-weighted), from its layout.
+pub fn stretch(flat: &Flat) -> (Vec<Stretch>, Stretch) {
+    let per: Vec<Stretch> = flat
+        .islands
+        .iter()
+        .map(|faces| {
+            let uv: Vec<Vec<DVec2>> = faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
+            distortion::stretch(&flat.surface.mesh, faces, &uv)
+        })
+        .collect();
+    let whole = distortion::combine(&per);
+    (per, whole)
+}
+
+/// Two faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`, if
+/// any.
+fn self_overlap(uv: &[Vec<DVec2>], eps: f64) -> Option<(usize, usize)> {
+    overlaps(uv, eps, 1).first().copied()
+}
+
+/// Pairs of faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`,
+/// at most `limit` of them, in sweep order: a sweep over x of the triangles' boxes.
+fn overlaps(uv: &[Vec<DVec2>], eps: f64, limit: usize) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut tris: Vec<([DVec2; 3], usize)> = Vec::new();
+    for (k, c) in uv.iter().enumerate() {
+        for t in polygon::triangulate(c) {
+            tris.push(([c[t[0]], c[t[1]], c[t[2]]], k));
+        }
+    }
+    let mut boxes: Vec<(f64, f64, usize)> = tris
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (t, _))| {
+            polygon::bounds(t.iter().copied()).map(|(lo, hi)| (lo.x, hi.x, i))
+        })
+        .collect();
+    boxes.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    for (k, &(_, hx, i)) in boxes.iter().enumerate() {
+        for &(lx, _, j) in &boxes[k + 1..] {
+            if lx >= hx - eps {
+                break;
+            }
+            if tris[i].1 == tris[j].1 {
+                continue;
+            }
+            if polygon::triangles_overlap(&tris[i].0, &tris[j].0, eps) {
+                out.push((tris[i].1, tris[j].1));
+                if out.len() >= limit {
+                    return out;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Most overlapping face pairs looked at when cutting an overlap off.
+const OVERLAP_PAIRS: usize = 10_000;
+
+/// A global overlap is cut off ([`cut_off`]) when the part cut off has at most this fraction
+/// of the chart's area; a larger one splits the chart between the two overlapping faces.
+const CUT_OFF_AREA: f64 = 0.25;
+
+/// Cut the overlapping region off a chart laid out as `uv` (faces `faces`, opened along
+/// `cuts`), after Lévy et al. 2002 (the thesis' [22]): the chart is split so that each part is
+/// overlap-free. The faces of the overlapping pairs are sorted to the side of `a` or `b`
+/// (nearer through the opened chart, in face steps; ties to `a`): for a gusset the two sides
+/// of its slit, for a global overlap the two faces found overlapping. The side with less
+/// overlapping area is cut off; the rest is its largest connected part (by area; the others
+/// go with the part cut off), laid flat again, and while it still overlaps its overlapping
+/// faces on that side are cut off too (at most 8 rounds). Returns the rest and the cut-off
+/// part's connected pieces, each laid flat (cut into a disk where needed), or `None` when
+/// some part cannot be laid flat without a flip or an overlap.
+#[allow(clippy::too_many_arguments)]
+fn cut_off(
+    ctx: &Charts,
+    faces: &[usize],
+    cuts: &[usize],
+    a: &[usize],
+    b: &[usize],
+    pairs: &[(usize, usize)],
+    uv: &[Vec<DVec2>],
+    eps: f64,
+) -> Option<(Laid, Vec<Laid>)> {
+    let within = Within::new(ctx, faces, cuts);
+    let mut sides = Sides::new(&within, a, b);
+    let mut off = sides.first_cut(faces, pairs, uv, ctx.mesh.faces.len());
+    let rest = within.rest(&sides, &mut off, eps)?;
+    let pieces = within.pieces(&off, eps)?;
+    Some((rest, pieces))
+}
+
+/// A chart's faces joined through its uncut edges.
+struct Within<'a> {
+    ctx: &'a Charts<'a>,
+    faces: &'a [usize],
+    cuts: &'a [usize],
+    /// Per mesh face: in the chart.
+    inside: Vec<bool>,
+}
+
+impl<'a> Within<'a> {
+    fn new(ctx: &'a Charts<'a>, faces: &'a [usize], cuts: &'a [usize]) -> Self {
+        let mut inside = vec![false; ctx.mesh.faces.len()];
+        for &f in faces {
+            inside[f] = true;
+        }
+        Within {
+            ctx,
+            faces,
+            cuts,
+            inside,
+        }
+    }
+
+    /// Faces joined to `f` through uncut chart edges, where `within` holds.
+    fn neighbours(&self, f: usize, within: &[bool]) -> Vec<usize> {
+        let is_cut = |e: usize| self.cuts.binary_search(&e).is_ok();
+        self.ctx.topo.face_edges[f]
+            .iter()
+            .filter(|&&e| !is_cut(e))
+            .filter_map(|&e| match self.ctx.topo.edges[e].uses[..] {
+                [(x, _), (y, _)] if x != y => Some(if x == f { y } else { x }),
+                _ => None,
+            })
+            .filter(|&h| within[h])
+            .collect()
+    }
+
+    /// Face steps from `seeds` through the chart (`usize::MAX` where not reached).
+    fn steps(&self, seeds: &[usize]) -> Vec<usize> {
+        let inside = &self.inside;
+        let mut d = vec![usize::MAX; inside.len()];
+        let mut queue = std::collections::VecDeque::new();
+        for &s in seeds {
+            if inside[s] && d[s] == usize::MAX {
+                d[s] = 0;
+                queue.push_back(s);
+            }
+        }
+        while let Some(f) = queue.pop_front() {
+            for h in self.neighbours(f, inside) {
+                if d[h] == usize::MAX {
+                    d[h] = d[f] + 1;
+                    queue.push_back(h);
+                }
+            }
+        }
+        d
+    }
+
+    /// The connected part of the faces where `within` holds that `f0` is in (breadth first,
+    /// marking `seen`).
+    fn flood(&self, f0: usize, within: &[bool], seen: &mut [bool]) -> Vec<usize> {
+        let mut comp = vec![f0];
+        seen[f0] = true;
+        let mut k = 0;
+        while k < comp.len() {
+            for h in self.neighbours(comp[k], within) {
+                if !seen[h] {
+                    seen[h] = true;
+                    comp.push(h);
+                }
+            }
+            k += 1;
+        }
+        comp
+    }
+
+    /// The rest of the chart once the faces `off` are cut off: its largest connected part,
+    /// laid flat; while it still overlaps, its overlapping faces on the side cut off go too
+    /// (at most 8 rounds). `None` when it cannot be laid flat without a flip or an overlap.
+    fn rest(&self, sides: &Sides, off: &mut [bool], eps: f64) -> Option<Laid> {
+        let (ctx, faces, cuts) = (self.ctx, self.faces, self.cuts);
+        let nf = off.len();
+        for _ in 0..8 {
+            // The rest is the largest connected part left (by area, ties: smallest face); the
+            // other parts go with the cut-off faces.
+            let mut keep = vec![false; nf];
+            let mut best: Option<(f64, Vec<usize>)> = None;
+            let mut seen = vec![false; nf];
+            let free: Vec<bool> = (0..nf).map(|f| self.inside[f] && !off[f]).collect();
+            for &f0 in faces {
+                if off[f0] || seen[f0] {
+                    continue;
+                }
+                let comp = self.flood(f0, &free, &mut seen);
+                let area: f64 = comp.iter().map(|&f| ctx.graph.area[f]).sum();
+                if best.as_ref().is_none_or(|(a, _)| area > *a) {
+                    best = Some((area, comp));
+                }
+            }
+            let (_, main) = best?;
+            for &f in &main {
+                keep[f] = true;
+            }
+            for &f in faces {
+                if !keep[f] {
+                    off[f] = true;
+                }
+            }
+            let rest: Vec<usize> = faces.iter().copied().filter(|&f| !off[f]).collect();
+            if rest.is_empty() {
+                return None;
+            }
+            let rc = ctx.disk(&rest, &ctx.cuts_within(&rest, cuts))?;
+            let Ok(Layout::Laid(ruv, rs)) = ctx.lay(&rest, &rc) else {
+                return None;
+            };
+            if rs.flipped > 0 {
+                return None;
+            }
+            let more = overlaps(&ruv, eps, OVERLAP_PAIRS);
+            if more.is_empty() {
+                return Some(Laid {
+                    faces: rest,
+                    cuts: rc,
+                    uv: ruv,
+                    stretch: rs,
+                    gusset: false,
+                });
+            }
+            let mut grew = false;
+            for (x, y) in more {
+                for k in [x, y] {
+                    let f = rest[k];
+                    if sides.side(f) && !off[f] {
+                        off[f] = true;
+                        grew = true;
+                    }
+                }
+            }
+            if !grew {
+                return None;
+            }
+        }
+        None
+    }
+
+    /// The faces cut off, by connected piece (face order: ascending), each laid flat (cut
+    /// into a disk where needed); `None` when one flips or overlaps itself.
+    fn pieces(&self, off: &[bool], eps: f64) -> Option<Vec<Laid>> {
+        let (ctx, cuts) = (self.ctx, self.cuts);
+        let mut seen = vec![false; off.len()];
+        let mut pieces = Vec::new();
+        for &f0 in self.faces {
+            if !off[f0] || seen[f0] {
+                continue;
+            }
+            let mut comp = self.flood(f0, off, &mut seen);
+            comp.sort_unstable();
+            let pc = ctx.disk(&comp, &ctx.cuts_within(&comp, cuts))?;
+            let Ok(Layout::Laid(puv, ps)) = ctx.lay(&comp, &pc) else {
+                return None;
+            };
+            if ps.flipped > 0 || (comp.len() > 1 && self_overlap(&puv, eps).is_some()) {
+                return None;
+            }
+            pieces.push(Laid {
+                faces: comp,
+                cuts: pc,
+                uv: puv,
+                stretch: ps,
+                gusset: true,
+            });
+        }
+        Some(pieces)
+    }
+}
+
+/// The two sides of an overlap: each face of the chart goes with the nearer of `a` and `b`
+/// (in face steps through the opened chart; ties to `a`).
+struct Sides {
+    da: Vec<usize>,
+    db: Vec<usize>,
+    /// The side cut off is `a`'s.
+    take_a: bool,
+}
+
+impl Sides {
+    fn new(within: &Within, a: &[usize], b: &[usize]) -> Self {
+        let (da, db) = (within.steps(a), within.steps(b));
+        Sides {
+            da,
+            db,
+            take_a: false,
+        }
+    }
+
+    fn on_a(&self, f: usize) -> bool {
+        self.da[f] <= self.db[f]
+    }
+
+    /// Whether face `f` is on the side cut off.
+    fn side(&self, f: usize) -> bool {
+        self.on_a(f) == self.take_a
+    }
+
+    /// The faces of the overlapping `pairs` (indices into `faces` and `uv`) on the side with
+    /// less overlapping area: that side is cut off (chosen here); per mesh face, cut off.
+    fn first_cut(
+        &mut self,
+        faces: &[usize],
+        pairs: &[(usize, usize)],
+        uv: &[Vec<DVec2>],
+        nf: usize,
+    ) -> Vec<bool> {
+        let area2 = |k: usize| polygon::signed_area(&uv[k]).abs();
+        let (mut sa, mut sb) = (0.0, 0.0);
+        let mut fa: Vec<usize> = Vec::new();
+        let mut fb: Vec<usize> = Vec::new();
+        for &(x, y) in pairs {
+            for k in [x, y] {
+                let f = faces[k];
+                if self.on_a(f) {
+                    sa += area2(k);
+                    fa.push(f);
+                } else {
+                    sb += area2(k);
+                    fb.push(f);
+                }
+            }
+        }
+        self.take_a = !fa.is_empty() && (fb.is_empty() || sa <= sb);
+        let mut off = vec![false; nf];
+        for f in if self.take_a { fa } else { fb } {
+            off[f] = true;
+        }
+        off
+    }
+}
+
+/// Re-attach each gusset (and each part cut off for overlapping) to an adjacent piece when
+/// the merging criterion of §5.2.3 holds and the merge creates no new overlap (§5.3): the
+/// neighbours are tried by the length of the common boundary, longest first (ties: lower
+/// piece); the criterion is the mean cylinder fitting error of the gusset's faces and two
+/// rings of the neighbour's faces around their common boundary below
+/// [`FlattenOptions::reattach_eta`]; the merged chart (cut into a disk where needed) must lay
+/// flat with no flip, no overlap and an L2 stretch within the tolerance. The piece a gusset
+/// was cut from fails the overlap test by construction (that is why it was cut off), unless
+/// its layout has changed since.
+fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    if !done.iter().any(|l| l.gusset) {
+        return;
+    }
+    let nf = ctx.mesh.faces.len();
+    let mut owner = vec![usize::MAX; nf];
+    for (k, l) in done.iter().enumerate() {
+        for &f in &l.faces {
+            owner[f] = k;
+        }
+    }
+    let mut gone = vec![false; done.len()];
+    let mut order: Vec<usize> = (0..done.len()).filter(|&k| done[k].gusset).collect();
+    order.sort_by_key(|&k| done[k].faces.iter().copied().min().unwrap_or(0));
+    for gi in order {
+        let mut shared: std::collections::BTreeMap<usize, f64> = Default::default();
+        for &f in &done[gi].faces {
+            for &(h, len) in &ctx.graph.adj[f] {
+                let k = owner[h];
+                if k != gi && k != usize::MAX && !gone[k] {
+                    *shared.entry(k).or_default() += len;
+                }
+            }
+        }
+        let mut cands: Vec<(f64, usize)> = shared.into_iter().map(|(k, l)| (l, k)).collect();
+        cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        for (_, k) in cands {
+            // Two rings of the neighbour around the common boundary, and the gusset.
+            let mut region: Vec<usize> = done[gi].faces.clone();
+            let mut mark = vec![false; nf];
+            for &f in &region {
+                mark[f] = true;
+            }
+            let mut front: Vec<usize> = region.clone();
+            for _ in 0..2 {
+                let mut next = Vec::new();
+                for &f in &front {
+                    for &(h, _) in &ctx.graph.adj[f] {
+                        if owner[h] == k && !mark[h] {
+                            mark[h] = true;
+                            next.push(h);
+                        }
+                    }
+                }
+                region.extend(&next);
+                front = next;
+            }
+            match proxy::cylinder_error(&ctx.graph.moments(region.iter().copied())) {
+                Some(err) if err < opts.reattach_eta => {}
+                _ => continue,
+            }
+            let mut faces = done[k].faces.clone();
+            faces.extend(&done[gi].faces);
+            let mut cuts = done[k].cuts.clone();
+            cuts.extend(&done[gi].cuts);
+            cuts.sort_unstable();
+            cuts.dedup();
+            let Some(cuts) = ctx.disk(&faces, &cuts) else {
+                continue;
+            };
+            let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
+                continue;
+            };
+            if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
+                continue;
+            }
+            for &f in &done[gi].faces {
+                owner[f] = k;
+            }
+            done[k] = Laid {
+                faces,
+                cuts,
+                uv,
+                stretch: s,
+                gusset: false,
+            };
+            gone[gi] = true;
+            break;
+        }
+    }
+    let mut k = 0;
+    done.retain(|_| {
+        k += 1;
+        !gone[k - 1]
+    });
+}
