@@ -8,7 +8,7 @@
 //! criterion, so the closing note can quote it.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use flatcut::device::sim::{self, SimConfig};
+use flatcut::device::sim::SimConfig;
 use flatcut::device::stream;
 use flatcut::profile::{self, Profile};
 use std::time::Duration;
@@ -55,7 +55,7 @@ fn once(p: &Profile, program: &[u8]) -> f64 {
         progress: false,
         ..Default::default()
     };
-    let (r, rep) = sim::stream_job(
+    let (r, rep) = stream::stream_job(
         SimConfig::new(p.clone()),
         program,
         &o,

@@ -122,7 +122,7 @@ pub fn deliver(
             cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
             // The simulated machine works off what it has buffered, as a real one would (after
             // Ctrl-C that includes the tool-up command, queued behind the buffer).
-            let (sent, report) = sim::stream_job(cfg, bytes, &opts, Duration::from_secs(600))?;
+            let (sent, report) = stream::stream_job(cfg, bytes, &opts, Duration::from_secs(600))?;
             let stem = if several {
                 format!("sim-{}", k + 1)
             } else {

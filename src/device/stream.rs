@@ -31,7 +31,7 @@
 
 use super::grbl::{self as proto, Response};
 use super::serial::Link;
-use super::sim::{XOFF, XON};
+use super::sim::{SimConfig, SimError, SimReport, XOFF, XON};
 use crate::profile::{FlowControl, Language, Profile, Protocol};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -966,4 +966,30 @@ impl<'a> Grbl<'a> {
         self.rep.bytes = self.program.len();
         Ok(self.rep)
     }
+}
+/// Stream `program` through a pseudo-terminal into a new simulator set up by `cfg`, exactly
+/// as flatcut's transport streams to a real port (CTS read from the simulator's flag), then let
+/// the simulated machine work off what it holds, as a real one would: at most `finish_within`,
+/// and at most 30 s once the stream was cancelled (Ctrl-C). Returns the stream's outcome and
+/// the simulator's report; the report exists even when the stream failed.
+pub fn stream_job(
+    cfg: SimConfig,
+    program: &[u8],
+    opts: &StreamOptions,
+    finish_within: Duration,
+) -> Result<(Result<StreamReport, StreamError>, SimReport), SimError> {
+    let profile = cfg.profile.clone();
+    let handle = super::sim::spawn(cfg)?;
+    let mut port =
+        super::serial::open(&profile, &handle.path, None)?.with_virtual_cts(handle.cts.clone());
+    let sent = send(&mut port, &profile, program, opts);
+    let written = port.written;
+    drop(port);
+    let wait = if opts.cancel.load(Ordering::SeqCst) {
+        finish_within.min(Duration::from_secs(30))
+    } else {
+        finish_within
+    };
+    let report = handle.finish(written, wait)?;
+    Ok((sent, report))
 }

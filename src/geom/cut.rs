@@ -114,7 +114,7 @@ impl Graph {
 
 /// Split faces in two along the bisector of the two faces farthest apart (through the face
 /// graph restricted to `faces`). Each part is connected when `faces` is.
-pub(crate) fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
+pub fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
     let nf = g.area.len();
     let mut inside = vec![false; nf];
     for &f in faces {
@@ -147,7 +147,7 @@ pub(crate) fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
 /// Split faces in two by which of faces `a` and `b` is nearer through the face graph restricted
 /// to `faces` (used to separate two faces whose layouts overlap). Each part is connected when
 /// `faces` is.
-pub(crate) fn split_between(
+pub fn split_between(
     g: &Graph,
     faces: &[usize],
     a: usize,

@@ -280,7 +280,7 @@ pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
 /// "-0": `12.5`, `0`, `3.142`. Rounding is Rust's `{:.3}` of the `f64`, so the text depends only
 /// on the value. A non-finite value prints as `0` so that a document stays well-formed
 /// (upstream stages only produce finite coordinates).
-pub(crate) fn fmt_mm(v: f64) -> String {
+pub fn fmt_mm(v: f64) -> String {
     if !v.is_finite() {
         return "0".to_string();
     }

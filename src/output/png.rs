@@ -27,7 +27,7 @@ use super::{role_style, OutputError, DRAW_ORDER};
 use crate::toolpath::SheetJob;
 
 /// Scale used when the caller has no preference: 4 px per mm (about 100 dpi).
-pub(crate) const DEFAULT_PX_PER_MM: f64 = 4.0;
+pub const DEFAULT_PX_PER_MM: f64 = 4.0;
 
 /// Longest side of a picture, px; larger pictures are drawn at a reduced scale.
 pub(crate) const MAX_SIDE_PX: u32 = 6000;

@@ -476,11 +476,13 @@ mod tests {
 
     #[test]
     fn cube_piece_has_folds_marks_and_a_simple_outline() {
-        let flat = unfold(
-            crate::flatten::unfold::tests::cube(100.0),
-            &UnfoldOptions::default(),
-        )
-        .unwrap();
+        let cube = crate::surface::Surface {
+            name: "cube".into(),
+            source: "t.obj".into(),
+            mesh: crate::surface::solids::cuboid(100.0, 100.0, 100.0),
+            ..Default::default()
+        };
+        let flat = unfold(cube, &UnfoldOptions::default()).unwrap();
         let pieces = build(&[flat], &PatternOptions::default()).unwrap();
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];

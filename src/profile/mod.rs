@@ -25,8 +25,9 @@ mod tools;
 
 pub use read::parse;
 pub use serial::{FlowControl, Parity, Protocol, SerialSettings};
+pub use tools::DEFAULT_PERFORATION;
+pub(crate) use tools::TOOL_KINDS;
 pub use tools::{StrokeKind, Tool};
-pub(crate) use tools::{DEFAULT_PERFORATION, TOOL_KINDS};
 
 use serde::Deserialize;
 use std::collections::BTreeMap;

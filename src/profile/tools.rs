@@ -67,7 +67,7 @@ pub struct Tool {
 
 /// Dashes of a perforated fold when the perforate tool does not say: 3 mm cut, 1 mm uncut
 /// (flatcut's choice: paper folds cleanly along it and still holds while it is handled).
-pub(crate) const DEFAULT_PERFORATION: [f64; 2] = [3.0, 1.0];
+pub const DEFAULT_PERFORATION: [f64; 2] = [3.0, 1.0];
 
 impl Tool {
     /// Times each stroke is made.

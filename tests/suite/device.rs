@@ -43,7 +43,7 @@ fn run(
     let mut cfg = SimConfig::new(profile.clone());
     cfg.time_factor = time_factor;
     cfg.faults = faults;
-    sim::stream_job(cfg, program, o, Duration::from_secs(120)).unwrap()
+    stream::stream_job(cfg, program, o, Duration::from_secs(120)).unwrap()
 }
 
 /// About `size` bytes of HP-GL: 1 mm pen-down steps zig-zagging over a 100 mm square.
@@ -690,7 +690,7 @@ fn without_flow_control_the_buffer_paces_the_stream() {
     // The bytes it lost run numbers together into far moves, so it is not left to finish them.
     let mut cfg = SimConfig::new(p.clone());
     cfg.time_factor = Some(0.2);
-    let (r, rep) = sim::stream_job(cfg, &prog, &opts(10.0), Duration::from_secs(2)).unwrap();
+    let (r, rep) = stream::stream_job(cfg, &prog, &opts(10.0), Duration::from_secs(2)).unwrap();
     r.unwrap();
     assert!(rep.overruns > 0);
 }

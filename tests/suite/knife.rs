@@ -2,7 +2,8 @@
 //! offset, `sim-dragknife`) through a real pseudo-terminal. With compensation the blade tip
 //! reaches every corner within 0.05 mm; without it the trailing tip rounds them off.
 
-use flatcut::device::sim::{self, SimConfig};
+use flatcut::device::sim::SimConfig;
+use flatcut::device::stream;
 use flatcut::device::stream::StreamOptions;
 use flatcut::profile;
 use flatcut::toolpath::{knife, SheetJob, Stroke, StrokeRole};
@@ -38,7 +39,7 @@ fn cut_square(compensate: bool) -> Vec<Vec<DVec2>> {
         progress: false,
         ..StreamOptions::default()
     };
-    let (sent, rep) = sim::stream_job(
+    let (sent, rep) = stream::stream_job(
         SimConfig::new(p.clone()),
         &program,
         &so,

@@ -154,6 +154,12 @@ pub enum SimError {
     Pty(String),
     #[error("the simulated cutter's thread failed")]
     Thread,
+    /// Opening the simulator's pty as a serial port.
+    #[error(transparent)]
+    Serial(#[from] crate::device::serial::SerialError),
+    /// Drawing or writing what it cut.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }
 
 const RUN: u8 = 0;
@@ -770,39 +776,6 @@ impl Device {
     }
 }
 
-/// Stream `program` through a pseudo-terminal into a new simulator set up by `cfg`, exactly
-/// as flatcut's transport streams to a real port (CTS read from the simulator's flag), then let
-/// the simulated machine work off what it holds, as a real one would: at most `finish_within`,
-/// and at most 30 s once the stream was cancelled (Ctrl-C). Returns the stream's outcome and
-/// the simulator's report; the report exists even when the stream failed.
-pub fn stream_job(
-    cfg: SimConfig,
-    program: &[u8],
-    opts: &crate::device::stream::StreamOptions,
-    finish_within: Duration,
-) -> Result<
-    (
-        Result<crate::device::stream::StreamReport, crate::device::stream::StreamError>,
-        SimReport,
-    ),
-    crate::Error,
-> {
-    let profile = cfg.profile.clone();
-    let handle = spawn(cfg)?;
-    let mut port = crate::device::serial::open(&profile, &handle.path, None)?
-        .with_virtual_cts(handle.cts.clone());
-    let sent = crate::device::stream::send(&mut port, &profile, program, opts);
-    let written = port.written;
-    drop(port);
-    let wait = if opts.cancel.load(Ordering::SeqCst) {
-        finish_within.min(Duration::from_secs(30))
-    } else {
-        finish_within
-    };
-    let report = handle.finish(written, wait)?;
-    Ok((sent, report))
-}
-
 /// Draw what the simulator cut, in the machine's axes (mm), and write `<stem>.png` and
 /// `<stem>.json` into `dir`. Returns the two paths.
 pub(crate) fn write_outputs(
@@ -810,7 +783,7 @@ pub(crate) fn write_outputs(
     profile: &Profile,
     dir: &Path,
     stem: &str,
-) -> Result<(std::path::PathBuf, std::path::PathBuf), crate::Error> {
+) -> Result<(std::path::PathBuf, std::path::PathBuf), SimError> {
     use crate::toolpath::{SheetJob, Stroke, StrokeRole};
     use glam::DVec2;
     let upm = profile.units_per_mm;

@@ -16,7 +16,7 @@ pub(crate) fn ends_instruction(b: u8) -> bool {
 
 /// Length of the complete instruction at the front of `buf` (terminator included), if the
 /// terminator has arrived.
-pub(crate) fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
+pub fn next_instruction<'a>(buf: impl IntoIterator<Item = &'a u8>) -> Option<usize> {
     buf.into_iter()
         .position(|&b| ends_instruction(b))
         .map(|i| i + 1)
