@@ -5,21 +5,12 @@
 //! comment saying how it was made, so `patterns/*.obj` are generated, never hand-edited
 //! (`cargo run --example make_patterns`).
 
-use crate::geom::mesh::{Face, Mesh};
+use crate::geom::mesh::Mesh;
 use glam::DVec3;
 use std::fmt::Write;
 
 fn mesh(vertices: Vec<DVec3>, faces: &[&[usize]]) -> Mesh {
-    Mesh {
-        vertices,
-        faces: faces
-            .iter()
-            .map(|f| Face {
-                verts: f.to_vec(),
-                line: None,
-            })
-            .collect(),
-    }
+    Mesh::from_polygons(vertices, faces)
 }
 
 /// An axis-aligned box `w × d × h`, six quads.
