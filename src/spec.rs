@@ -2655,7 +2655,7 @@ impl Ctx<'_> {
         if let Err(e) = boundary::check(&input) {
             let at_loop = |l: usize| {
                 raw_loops
-                    .get(l.saturating_sub(1))
+                    .get(l)
                     .map_or((header_line, key.to_string()), |r| (r.2, r.1.clone()))
             };
             let (line, k) = match &e {

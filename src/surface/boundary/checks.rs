@@ -16,13 +16,13 @@ pub fn check_loops(loops: &[Vec<DVec3>]) -> Result<(), BoundaryError> {
     for (l, pts) in loops.iter().enumerate() {
         if let Some(i) = pts.iter().position(|p| !p.is_finite()) {
             return Err(BoundaryError::NonFinite {
-                looop: l + 1,
-                point: i + 1,
+                looop: l,
+                point: i,
             });
         }
         if pts.len() < 3 {
             return Err(BoundaryError::TooFew {
-                looop: l + 1,
+                looop: l,
                 got: pts.len(),
             });
         }
@@ -31,9 +31,9 @@ pub fn check_loops(loops: &[Vec<DVec3>]) -> Result<(), BoundaryError> {
             let j = (i + 1) % pts.len();
             if pts[i].distance(pts[j]) <= 1e-9 * scale.max(1e-300) {
                 return Err(BoundaryError::Repeated {
-                    looop: l + 1,
-                    point: j + 1,
-                    prev: i + 1,
+                    looop: l,
+                    point: j,
+                    prev: i,
                 });
             }
         }

@@ -35,7 +35,7 @@ pub(super) struct Darted {
     pub(super) twin: Vec<usize>,
     /// Old point index → new.
     pub(super) map: Vec<usize>,
-    /// The user's (loop, point) name of each new point, from 1.
+    /// The user's (loop, point) name of each new point, 0-based.
     pub(super) labels: Vec<(usize, usize)>,
 }
 
@@ -49,10 +49,7 @@ pub(super) fn insert_darts(
     let n = pts.len();
     let mut by_at: Vec<Option<usize>> = vec![None; n];
     for (di, &(k, d)) in darts.iter().enumerate() {
-        let err = |message: String| BoundaryError::Dart {
-            index: k + 1,
-            message,
-        };
+        let err = |message: String| BoundaryError::Dart { index: k, message };
         if d.at >= n {
             return Err(err(format!(
                 "starts at point {} but loop {} has {n} points",
@@ -102,7 +99,7 @@ pub(super) fn insert_darts(
             out.twin.push(out.pts.len());
             out.pts.push(pts[i]);
             out.hull.push(pts[i]);
-            out.labels.push((l + 1, i + 1));
+            out.labels.push((l, i));
             continue;
         };
         let d = darts[di].1;
@@ -125,18 +122,18 @@ pub(super) fn insert_darts(
             out.twin.push(out.pts.len());
             out.pts.push(if open { v } else { chain[j] });
             out.hull.push(v);
-            out.labels.push((l + 1, i + 1));
+            out.labels.push((l, i));
         }
         out.twin.push(out.pts.len());
         out.pts.push(chain[m - 1]);
         out.hull.push(chain[m - 1]);
-        out.labels.push((l + 1, i + 1));
+        out.labels.push((l, i));
         for j in (0..m - 1).rev() {
             let v = chain[j] + t * half * (1.0 - cum[j] / len);
             out.twin.push(if open { out.pts.len() } else { left + j });
             out.pts.push(if open { v } else { chain[j] });
             out.hull.push(v);
-            out.labels.push((l + 1, i + 1));
+            out.labels.push((l, i));
         }
     }
     Ok(out)

@@ -69,7 +69,7 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
     for (k, d) in input.darts.iter().enumerate() {
         if d.looop >= nl {
             return Err(BoundaryError::Dart {
-                index: k + 1,
+                index: k,
                 message: format!("is on loop {} but there are {nl} loops", d.looop + 1),
             });
         }
@@ -117,10 +117,7 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
     // Rulings as global vertex pairs.
     let mut rulings: Vec<(usize, [usize; 2])> = Vec::new();
     for (r, ru) in input.rulings.iter().enumerate() {
-        let err = |message: String| BoundaryError::Ruling {
-            index: r + 1,
-            message,
-        };
+        let err = |message: String| BoundaryError::Ruling { index: r, message };
         let mut ends = [0; 2];
         for (e, &(l, i)) in ru.iter().enumerate() {
             if l >= nl {
@@ -172,10 +169,7 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
     let mut used: HashSet<usize> = HashSet::new();
     let mut chords: Vec<(usize, [usize; 2])> = Vec::new();
     for &(r, [a, b]) in &pending {
-        let err = |message: String| BoundaryError::Ruling {
-            index: r + 1,
-            message,
-        };
+        let err = |message: String| BoundaryError::Ruling { index: r, message };
         match (cycle_of(&cycles, a), cycle_of(&cycles, b)) {
             (Some(x), Some(y)) if x != y => {
                 if used.contains(&a) || used.contains(&b) {
@@ -259,10 +253,7 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
     // Rulings within a loop split the region.
     let mut regions: Vec<Vec<usize>> = cycles;
     for (r, [a, b]) in chords {
-        let err = |message: String| BoundaryError::Ruling {
-            index: r + 1,
-            message,
-        };
+        let err = |message: String| BoundaryError::Ruling { index: r, message };
         let found = regions.iter().position(|g| {
             let pa = g.iter().position(|&v| v == a);
             let pb = g.iter().position(|&v| v == b);

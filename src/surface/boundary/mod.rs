@@ -159,24 +159,25 @@ pub struct Output {
     pub warnings: Vec<String>,
 }
 
-/// What is wrong with a boundary; loops and points counted from 1 as users count them.
+/// What is wrong with a boundary. Loops, points, rulings and darts are 0-based here, as in
+/// [`Input`]; the messages count them from 1 as users do.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BoundaryError {
     #[error("no boundary loop given")]
     NoLoop,
-    #[error("loop {looop}: needs at least 3 points, got {got}")]
+    #[error("loop {}: needs at least 3 points, got {got}", .looop + 1)]
     TooFew { looop: usize, got: usize },
-    #[error("loop {looop}: point {point} has a coordinate that is not a finite number")]
+    #[error("loop {}: point {} has a coordinate that is not a finite number", .looop + 1, .point + 1)]
     NonFinite { looop: usize, point: usize },
-    #[error("loop {looop}: point {point} repeats point {prev} (consecutive points must differ)")]
+    #[error("loop {}: point {} repeats point {} (consecutive points must differ)", .looop + 1, .point + 1, .prev + 1)]
     Repeated {
         looop: usize,
         point: usize,
         prev: usize,
     },
-    #[error("loop {looop}: the polyline is open; a boundary must be a closed loop")]
+    #[error("loop {}: the polyline is open; a boundary must be a closed loop", .looop + 1)]
     Open { looop: usize },
-    #[error("the boundary crosses itself: segment {a} (points {a}–{a1} of loop {la}) meets segment {b} (points {b}–{b1} of loop {lb}) near ({x:.3}, {y:.3}, {z:.3})")]
+    #[error("the boundary crosses itself: segment {} (points {}–{} of loop {}) meets segment {} (points {}–{} of loop {}) near ({x:.3}, {y:.3}, {z:.3})", .a + 1, .a + 1, .a1 + 1, .la + 1, .b + 1, .b + 1, .b1 + 1, .lb + 1)]
     SelfIntersecting {
         la: usize,
         a: usize,
@@ -188,9 +189,9 @@ pub enum BoundaryError {
         y: f64,
         z: f64,
     },
-    #[error("ruling {index}: {message}")]
+    #[error("ruling {}: {message}", .index + 1)]
     Ruling { index: usize, message: String },
-    #[error("dart {index}: {message}")]
+    #[error("dart {}: {message}", .index + 1)]
     Dart { index: usize, message: String },
     #[error("several loops: {0}")]
     Loops(String),
