@@ -172,36 +172,7 @@ impl Search<'_> {
             g
         };
         if hull.planar.is_some() {
-            // A flat subloop: ear clipping in its plane, on the input points (the offset ones
-            // if those fold over), one envelope since both sides are the same.
-            let op: Vec<DVec3> = sub.iter().map(|&v| self.p[v]).collect();
-            let bp: Vec<DVec3> = sub
-                .iter()
-                .filter_map(|&v| self.base.get(v))
-                .copied()
-                .collect();
-            for pts in [&op, &bp, &hp] {
-                if pts.len() != q {
-                    continue;
-                }
-                let n = newell(pts).normalize_or_zero();
-                if n == DVec3::ZERO {
-                    continue;
-                }
-                let u = n.any_orthonormal_vector();
-                let v = n.cross(u);
-                let ring: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
-                if crate::geom::polygon::is_simple_ring(&ring) {
-                    let tris: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&ring)
-                        .into_iter()
-                        .map(sorted)
-                        .collect();
-                    if tris.len() == q - 2 && Self::non_crossing(&tris) && self.valid(&tris) {
-                        out.envelopes.push(tris);
-                        break;
-                    }
-                }
-            }
+            out.envelopes.extend(self.flat_envelope(sub, &hp));
             return out;
         }
         let nf = hull.faces.len();
@@ -234,37 +205,7 @@ impl Search<'_> {
                 }
             }
         }
-        // Components across non-subloop edges.
-        let comps = |keep: &dyn Fn(usize, usize) -> bool| -> Vec<Vec<usize>> {
-            let mut comp = vec![usize::MAX; nf];
-            let mut list = Vec::new();
-            for f0 in 0..nf {
-                if comp[f0] != usize::MAX || !keep(f0, f0) {
-                    continue;
-                }
-                let id = list.len();
-                let mut members = vec![f0];
-                comp[f0] = id;
-                let mut k = 0;
-                while k < members.len() {
-                    let f = members[k];
-                    k += 1;
-                    for e in 0..3 {
-                        let g = hull.neighbours[f][e];
-                        let (x, y) = (hull.faces[f][e], hull.faces[f][(e + 1) % 3]);
-                        if g == usize::MAX || comp[g] != usize::MAX || is_sub_edge(x, y) {
-                            continue;
-                        }
-                        if keep(f, g) {
-                            comp[g] = id;
-                            members.push(g);
-                        }
-                    }
-                }
-                list.push(members);
-            }
-            list
-        };
+        let comps = |keep: &dyn Fn(usize, usize) -> bool| components(&hull, q, keep);
         // Envelopes: every subloop edge on the hull (each seen from both sides) and exactly two
         // components of one sense each.
         if edge_seen == 2 * q {
@@ -335,6 +276,80 @@ impl Search<'_> {
         out.charts.dedup();
         out
     }
+
+    /// A flat subloop: ear clipping in its plane, on the input points (the offset ones if those
+    /// fold over), one envelope since both sides are the same.
+    fn flat_envelope(&self, sub: &[usize], hp: &[DVec3]) -> Option<Vec<[usize; 3]>> {
+        let q = sub.len();
+        let sorted = |t: [usize; 3]| {
+            let mut g = t.map(|x| sub[x]);
+            g.sort_unstable();
+            g
+        };
+        let op: Vec<DVec3> = sub.iter().map(|&v| self.p[v]).collect();
+        let bp: Vec<DVec3> = sub
+            .iter()
+            .filter_map(|&v| self.base.get(v))
+            .copied()
+            .collect();
+        for pts in [&op[..], &bp[..], hp] {
+            if pts.len() != q {
+                continue;
+            }
+            let n = newell(pts).normalize_or_zero();
+            if n == DVec3::ZERO {
+                continue;
+            }
+            let u = n.any_orthonormal_vector();
+            let v = n.cross(u);
+            let ring: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
+            if crate::geom::polygon::is_simple_ring(&ring) {
+                let tris: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&ring)
+                    .into_iter()
+                    .map(sorted)
+                    .collect();
+                if tris.len() == q - 2 && Self::non_crossing(&tris) && self.valid(&tris) {
+                    return Some(tris);
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Components of hull faces joined across edges that are not subloop edges (`q` points), where
+/// `keep(f, g)` allows the step from face `f` to face `g` (`keep(f, f)`: `f` may start one).
+fn components(hull: &hull::Hull, q: usize, keep: &dyn Fn(usize, usize) -> bool) -> Vec<Vec<usize>> {
+    let nf = hull.faces.len();
+    let is_sub_edge = |x: usize, y: usize| y == (x + 1) % q || x == (y + 1) % q;
+    let mut comp = vec![usize::MAX; nf];
+    let mut list = Vec::new();
+    for f0 in 0..nf {
+        if comp[f0] != usize::MAX || !keep(f0, f0) {
+            continue;
+        }
+        let id = list.len();
+        let mut members = vec![f0];
+        comp[f0] = id;
+        let mut k = 0;
+        while k < members.len() {
+            let f = members[k];
+            k += 1;
+            for e in 0..3 {
+                let g = hull.neighbours[f][e];
+                let (x, y) = (hull.faces[f][e], hull.faces[f][(e + 1) % 3]);
+                if g == usize::MAX || comp[g] != usize::MAX || is_sub_edge(x, y) {
+                    continue;
+                }
+                if keep(f, g) {
+                    comp[g] = id;
+                    members.push(g);
+                }
+            }
+        }
+        list.push(members);
+    }
+    list
 }
 
 #[cfg(test)]

@@ -34,7 +34,7 @@
 //! splits it into regions searched separately.
 
 use super::checks::{check_crossings, check_loops, segment_distance, size};
-use super::darts::{insert_darts, sites_valid};
+use super::darts::{insert_darts, sites_valid, Darted};
 use super::figures::{angle, unit_normal};
 use super::{BoundaryError, Dart, Input, Options};
 use crate::geom::hull;
@@ -64,6 +64,45 @@ pub(super) struct Prepared {
 }
 
 pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepared, BoundaryError> {
+    let darted = dart_loops(input, open)?;
+    let Vertices {
+        verts,
+        hverts,
+        site,
+        starts,
+        loop_ids,
+        input_edges,
+    } = vertices(&darted);
+    let rulings = ruling_ends(input, &starts, &darted)?;
+    let sides = Sides {
+        verts: &verts,
+        hverts: &hverts,
+        site: &site,
+        input_edges: &input_edges,
+    };
+    let (mut cycles, fixed, pending, connecting_charts) =
+        connect_by_charts(&sides, &loop_ids, rulings, opts);
+    let (mut joins, mut used, chords) = join_by_rulings(&mut cycles, &pending)?;
+    if cycles.len() > 1 {
+        join_by_tree(&mut cycles, &verts, &fixed, &chords, &mut joins, &mut used)?;
+    }
+    let regions = split_by_rulings(cycles, chords)?;
+    Ok(Prepared {
+        verts,
+        hverts,
+        site,
+        loop_ids,
+        input_edges,
+        fixed,
+        joins,
+        regions,
+        connecting_charts,
+    })
+}
+
+/// Each loop checked and its darts inserted; the loops (darts opened for the hulls) must not
+/// cross.
+fn dart_loops(input: &Input, open: bool) -> Result<Vec<Darted>, BoundaryError> {
     check_loops(&input.loops)?;
     let nl = input.loops.len();
     for (k, d) in input.darts.iter().enumerate() {
@@ -87,12 +126,28 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
     let hull_loops: Vec<Vec<DVec3>> = darted.iter().map(|d| d.hull.clone()).collect();
     let labels: Vec<Vec<(usize, usize)>> = darted.iter().map(|d| d.labels.clone()).collect();
     check_crossings(&hull_loops, &labels)?;
-    // Global vertices and the input's directed edges.
+    Ok(darted)
+}
+
+/// All loops' vertices in one list, and the loops and input edges over them.
+struct Vertices {
+    verts: Vec<DVec3>,
+    hverts: Vec<DVec3>,
+    site: Vec<usize>,
+    /// First vertex of each loop.
+    starts: Vec<usize>,
+    loop_ids: Vec<Vec<usize>>,
+    input_edges: HashSet<(usize, usize)>,
+}
+
+/// Global vertices and the input's directed edges; holes reversed when their Newell normal
+/// agrees with the outer loop's.
+fn vertices(darted: &[Darted]) -> Vertices {
     let mut verts: Vec<DVec3> = Vec::new();
     let mut hverts: Vec<DVec3> = Vec::new();
     let mut site: Vec<usize> = Vec::new();
     let mut starts = Vec::new();
-    for d in &darted {
+    for d in darted {
         let s = verts.len();
         starts.push(s);
         verts.extend_from_slice(&d.pts);
@@ -114,7 +169,23 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
             input_edges.insert((ids[k], ids[(k + 1) % ids.len()]));
         }
     }
-    // Rulings as global vertex pairs.
+    Vertices {
+        verts,
+        hverts,
+        site,
+        starts,
+        loop_ids,
+        input_edges,
+    }
+}
+
+/// The user's rulings as global vertex pairs, with their index.
+fn ruling_ends(
+    input: &Input,
+    starts: &[usize],
+    darted: &[Darted],
+) -> Result<Vec<(usize, [usize; 2])>, BoundaryError> {
+    let nl = input.loops.len();
     let mut rulings: Vec<(usize, [usize; 2])> = Vec::new();
     for (r, ru) in input.rulings.iter().enumerate() {
         let err = |message: String| BoundaryError::Ruling { index: r, message };
@@ -141,10 +212,40 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
         }
         rulings.push((r, ends));
     }
-    // §6: charts connecting loops first.
-    let mut cycles = loop_ids.clone();
+    Ok(rulings)
+}
+
+/// The vertices as [`connecting_chart`] needs them.
+struct Sides<'a> {
+    verts: &'a [DVec3],
+    hverts: &'a [DVec3],
+    site: &'a [usize],
+    input_edges: &'a HashSet<(usize, usize)>,
+}
+
+/// §6: charts connecting loops first, as long as there are several loops and a valid chart:
+/// the loops left, the charts' triangles, the rulings still to place and how many charts.
+#[allow(clippy::type_complexity)]
+fn connect_by_charts(
+    sides: &Sides,
+    loop_ids: &[Vec<usize>],
+    rulings: Vec<(usize, [usize; 2])>,
+    opts: &Options,
+) -> (
+    Vec<Vec<usize>>,
+    Vec<[usize; 3]>,
+    Vec<(usize, [usize; 2])>,
+    usize,
+) {
+    let Sides {
+        verts,
+        hverts,
+        site,
+        input_edges,
+    } = *sides;
+    let mut cycles = loop_ids.to_vec();
     let mut fixed: Vec<[usize; 3]> = Vec::new();
-    let mut pending = rulings.clone();
+    let mut pending = rulings;
     let mut connecting_charts = 0;
     while cycles.len() > 1 {
         let Some((tris, next)) = connecting_chart(
@@ -163,21 +264,41 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
         cycles = next;
         connecting_charts += 1;
     }
-    // Then the user's rulings between loops, then the shortest tree of connecting edges.
-    let cycle_of = |cycles: &[Vec<usize>], v: usize| cycles.iter().position(|c| c.contains(&v));
+    (cycles, fixed, pending, connecting_charts)
+}
+
+/// The cycle (loop) holding vertex `v`.
+fn cycle_of(cycles: &[Vec<usize>], v: usize) -> Option<usize> {
+    cycles.iter().position(|c| c.contains(&v))
+}
+
+/// Then the user's rulings between loops join them: the joining edges, their ends, and the
+/// rulings within a loop (chords) left for [`split_by_rulings`].
+#[allow(clippy::type_complexity)]
+fn join_by_rulings(
+    cycles: &mut Vec<Vec<usize>>,
+    pending: &[(usize, [usize; 2])],
+) -> Result<
+    (
+        HashSet<(usize, usize)>,
+        HashSet<usize>,
+        Vec<(usize, [usize; 2])>,
+    ),
+    BoundaryError,
+> {
     let mut joins: HashSet<(usize, usize)> = HashSet::new();
     let mut used: HashSet<usize> = HashSet::new();
     let mut chords: Vec<(usize, [usize; 2])> = Vec::new();
-    for &(r, [a, b]) in &pending {
+    for &(r, [a, b]) in pending {
         let err = |message: String| BoundaryError::Ruling { index: r, message };
-        match (cycle_of(&cycles, a), cycle_of(&cycles, b)) {
+        match (cycle_of(cycles, a), cycle_of(cycles, b)) {
             (Some(x), Some(y)) if x != y => {
                 if used.contains(&a) || used.contains(&b) {
                     return Err(err(
                         "an end already joins two loops (rulings between loops must not share points)".into(),
                     ));
                 }
-                join(&mut cycles, x, a, y, b);
+                join(cycles, x, a, y, b);
                 used.extend([a, b]);
                 joins.insert((a.min(b), a.max(b)));
             }
@@ -190,67 +311,84 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
             }
         }
     }
-    if cycles.len() > 1 {
-        let avoid: HashSet<usize> = chords.iter().flat_map(|(_, e)| *e).collect();
-        let mut cand: Vec<(f64, usize, usize)> = Vec::new();
-        for (i, ci) in cycles.iter().enumerate() {
-            for cj in &cycles[i + 1..] {
-                for &a in ci {
-                    for &b in cj {
-                        if !used.contains(&a)
-                            && !used.contains(&b)
-                            && !avoid.contains(&a)
-                            && !avoid.contains(&b)
-                        {
-                            cand.push((verts[a].distance(verts[b]), a.min(b), a.max(b)));
-                        }
+    Ok((joins, used, chords))
+}
+
+/// Then the shortest tree of connecting edges (see the module doc).
+fn join_by_tree(
+    cycles: &mut Vec<Vec<usize>>,
+    verts: &[DVec3],
+    fixed: &[[usize; 3]],
+    chords: &[(usize, [usize; 2])],
+    joins: &mut HashSet<(usize, usize)>,
+    used: &mut HashSet<usize>,
+) -> Result<(), BoundaryError> {
+    let avoid: HashSet<usize> = chords.iter().flat_map(|(_, e)| *e).collect();
+    let mut cand: Vec<(f64, usize, usize)> = Vec::new();
+    for (i, ci) in cycles.iter().enumerate() {
+        for cj in &cycles[i + 1..] {
+            for &a in ci {
+                for &b in cj {
+                    if !used.contains(&a)
+                        && !used.contains(&b)
+                        && !avoid.contains(&a)
+                        && !avoid.contains(&b)
+                    {
+                        cand.push((verts[a].distance(verts[b]), a.min(b), a.max(b)));
                     }
                 }
             }
         }
-        cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
-        let tol = 1e-9 * size(&verts);
-        for (_, a, b) in cand {
-            if cycles.len() == 1 {
-                break;
-            }
-            let (Some(x), Some(y)) = (cycle_of(&cycles, a), cycle_of(&cycles, b)) else {
-                continue;
-            };
-            if x == y || used.contains(&a) || used.contains(&b) {
-                continue;
-            }
-            // No crossing with the loops, the charts, the rulings or the tree so far.
-            let mut segs: Vec<(usize, usize)> = Vec::new();
-            for c in &cycles {
-                segs.extend((0..c.len()).map(|k| (c[k], c[(k + 1) % c.len()])));
-            }
-            for t in &fixed {
-                segs.extend((0..3).map(|k| (t[k], t[(k + 1) % 3])));
-            }
-            segs.extend(chords.iter().map(|(_, e)| (e[0], e[1])));
-            segs.extend(joins.iter().copied());
-            let crosses = segs.iter().any(|&(p, q)| {
-                if p == a || p == b || q == a || q == b {
-                    return false;
-                }
-                segment_distance(verts[a], verts[b], verts[p], verts[q]).0 <= tol
-            });
-            if crosses {
-                continue;
-            }
-            join(&mut cycles, x, a, y, b);
-            used.extend([a, b]);
-            joins.insert((a, b));
-        }
-        if cycles.len() > 1 {
-            return Err(BoundaryError::Loops(
-                "the loops cannot be joined by edges that cross neither the loops nor each other"
-                    .into(),
-            ));
-        }
     }
-    // Rulings within a loop split the region.
+    cand.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let tol = 1e-9 * size(verts);
+    for (_, a, b) in cand {
+        if cycles.len() == 1 {
+            break;
+        }
+        let (Some(x), Some(y)) = (cycle_of(cycles, a), cycle_of(cycles, b)) else {
+            continue;
+        };
+        if x == y || used.contains(&a) || used.contains(&b) {
+            continue;
+        }
+        // No crossing with the loops, the charts, the rulings or the tree so far.
+        let mut segs: Vec<(usize, usize)> = Vec::new();
+        for c in cycles.iter() {
+            segs.extend((0..c.len()).map(|k| (c[k], c[(k + 1) % c.len()])));
+        }
+        for t in fixed {
+            segs.extend((0..3).map(|k| (t[k], t[(k + 1) % 3])));
+        }
+        segs.extend(chords.iter().map(|(_, e)| (e[0], e[1])));
+        segs.extend(joins.iter().copied());
+        let crosses = segs.iter().any(|&(p, q)| {
+            if p == a || p == b || q == a || q == b {
+                return false;
+            }
+            segment_distance(verts[a], verts[b], verts[p], verts[q]).0 <= tol
+        });
+        if crosses {
+            continue;
+        }
+        join(cycles, x, a, y, b);
+        used.extend([a, b]);
+        joins.insert((a, b));
+    }
+    if cycles.len() > 1 {
+        return Err(BoundaryError::Loops(
+            "the loops cannot be joined by edges that cross neither the loops nor each other"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Rulings within a loop split the region.
+fn split_by_rulings(
+    cycles: Vec<Vec<usize>>,
+    chords: Vec<(usize, [usize; 2])>,
+) -> Result<Vec<Vec<usize>>, BoundaryError> {
     let mut regions: Vec<Vec<usize>> = cycles;
     for (r, [a, b]) in chords {
         let err = |message: String| BoundaryError::Ruling { index: r, message };
@@ -280,17 +418,7 @@ pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepa
         regions.push(x);
         regions.push(y);
     }
-    Ok(Prepared {
-        verts,
-        hverts,
-        site,
-        loop_ids,
-        input_edges,
-        fixed,
-        joins,
-        regions,
-        connecting_charts,
-    })
+    Ok(regions)
 }
 
 /// Join cycle `y` into cycle `x` by the edge `a b` (`a` on `x`, `b` on `y`), walked both
@@ -347,37 +475,8 @@ pub(super) fn connecting_chart(
     let face = |f: usize| hull.faces[f].map(|x| ids[x]);
     let on_loop =
         |a: usize, b: usize| edge_cycle.contains_key(&(a, b)) || edge_cycle.contains_key(&(b, a));
-    let mut sense: Vec<Option<bool>> = vec![None; nf];
-    let mut has_edge = vec![false; nf];
-    for f in 0..nf {
-        let t = face(f);
-        let mut vote: Option<bool> = None;
-        let mut mixed = false;
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let v = if edge_cycle.contains_key(&(a, b)) {
-                has_edge[f] = true;
-                input_edges.contains(&(a, b)).then_some(true)
-            } else if edge_cycle.contains_key(&(b, a)) {
-                has_edge[f] = true;
-                input_edges.contains(&(b, a)).then_some(false)
-            } else {
-                None
-            };
-            if let Some(v) = v {
-                mixed |= vote.is_some_and(|w| w != v);
-                vote = Some(v);
-            }
-        }
-        let wound = if vote == Some(false) {
-            [t[0], t[2], t[1]]
-        } else {
-            t
-        };
-        if !mixed && sites_valid(verts, site, &[wound]) {
-            sense[f] = vote;
-        }
-    }
+    let global: Vec<[usize; 3]> = (0..nf).map(face).collect();
+    let (sense, has_edge) = senses(&global, &edge_cycle, input_edges, verts, site);
     let thr = opts.max_dihedral_deg.to_radians();
     let hull_area = hull.area(&hp);
     let mut comp = vec![usize::MAX; nf];
@@ -450,44 +549,11 @@ pub(super) fn connecting_chart(
         if !smooth || !sites_valid(verts, site, &tris) {
             continue;
         }
-        // Subtract: the loops' edges, less the chart's, plus the chart's rim reversed.
-        let mut rem: BTreeSet<(usize, usize)> = edge_cycle.keys().copied().collect();
-        let mut ok = true;
-        for t in &tris {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                if !rem.remove(&(a, b)) {
-                    ok &= rem.insert((b, a));
-                }
-            }
-        }
-        let mut next: BTreeMap<usize, usize> = BTreeMap::new();
-        let mut into: HashSet<usize> = HashSet::new();
-        for &(a, b) in &rem {
-            ok &= next.insert(a, b).is_none() && into.insert(b);
-        }
-        if !ok {
+        let Some(left) = loops_left(&edge_cycle, &tris) else {
             continue;
-        }
-        let mut left: Vec<Vec<usize>> = Vec::new();
-        let mut seen: HashSet<usize> = HashSet::new();
-        for &start in next.keys() {
-            if seen.contains(&start) {
-                continue;
-            }
-            let mut cy = vec![start];
-            seen.insert(start);
-            let mut v = next[&start];
-            while v != start && ok {
-                ok = seen.insert(v);
-                cy.push(v);
-                v = next.get(&v).copied().unwrap_or(start);
-            }
-            ok &= cy.len() >= 3;
-            left.push(cy);
-        }
+        };
         let merged = cycles.len() + 1 - touched.len();
-        if !ok || !(left.len() == merged || left.len() + 1 == merged) {
+        if !(left.len() == merged || left.len() + 1 == merged) {
             continue;
         }
         let feasible = pending.iter().all(|(_, [a, b])| {
@@ -500,6 +566,97 @@ pub(super) fn connecting_chart(
     }
     best.map(|(_, t, l)| (t, l))
 }
+
+/// Which way each hull face runs against the loops (`Some(true)`: as the loops, `Some(false)`:
+/// reversed, `None`: mixed, no input edge, or invalid with the sites), and whether it has a
+/// loop edge.
+fn senses(
+    faces: &[[usize; 3]],
+    edge_cycle: &HashMap<(usize, usize), usize>,
+    input_edges: &HashSet<(usize, usize)>,
+    verts: &[DVec3],
+    site: &[usize],
+) -> (Vec<Option<bool>>, Vec<bool>) {
+    let nf = faces.len();
+    let mut sense: Vec<Option<bool>> = vec![None; nf];
+    let mut has_edge = vec![false; nf];
+    for f in 0..nf {
+        let t = faces[f];
+        let mut vote: Option<bool> = None;
+        let mut mixed = false;
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let v = if edge_cycle.contains_key(&(a, b)) {
+                has_edge[f] = true;
+                input_edges.contains(&(a, b)).then_some(true)
+            } else if edge_cycle.contains_key(&(b, a)) {
+                has_edge[f] = true;
+                input_edges.contains(&(b, a)).then_some(false)
+            } else {
+                None
+            };
+            if let Some(v) = v {
+                mixed |= vote.is_some_and(|w| w != v);
+                vote = Some(v);
+            }
+        }
+        let wound = if vote == Some(false) {
+            [t[0], t[2], t[1]]
+        } else {
+            t
+        };
+        if !mixed && sites_valid(verts, site, &[wound]) {
+            sense[f] = vote;
+        }
+    }
+    (sense, has_edge)
+}
+
+
+/// §6 subtraction of a connecting chart: the loops' edges, less the chart's, plus the chart's
+/// rim reversed, walked into loops; `None` unless they are simple loops of 3 points or more.
+fn loops_left(
+    edge_cycle: &HashMap<(usize, usize), usize>,
+    tris: &[[usize; 3]],
+) -> Option<Vec<Vec<usize>>> {
+    let mut rem: BTreeSet<(usize, usize)> = edge_cycle.keys().copied().collect();
+    let mut ok = true;
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if !rem.remove(&(a, b)) {
+                ok &= rem.insert((b, a));
+            }
+        }
+    }
+    let mut next: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut into: HashSet<usize> = HashSet::new();
+    for &(a, b) in &rem {
+        ok &= next.insert(a, b).is_none() && into.insert(b);
+    }
+    if !ok {
+        return None;
+    }
+    let mut left: Vec<Vec<usize>> = Vec::new();
+    let mut seen: HashSet<usize> = HashSet::new();
+    for &start in next.keys() {
+        if seen.contains(&start) {
+            continue;
+        }
+        let mut cy = vec![start];
+        seen.insert(start);
+        let mut v = next[&start];
+        while v != start && ok {
+            ok = seen.insert(v);
+            cy.push(v);
+            v = next.get(&v).copied().unwrap_or(start);
+        }
+        ok &= cy.len() >= 3;
+        left.push(cy);
+    }
+    ok.then_some(left)
+}
+
 
 /// Split loop `g` along the chord `a b`: (a … b) and (b … a).
 pub(super) fn split_at(g: &[usize], a: usize, b: usize) -> (Vec<usize>, Vec<usize>) {
