@@ -432,6 +432,13 @@ pub fn approximate(
     })
 }
 
+/// One row of eq. 6.3: `Σ_k coef_k · x_{vk} = rhs` (per coordinate), weight `w`.
+struct Row {
+    coef: [(usize, f64); 3],
+    rhs: DVec3,
+    w: f64,
+}
+
 /// Eq. 6.3: new vertex positions whose triangles' deformation gradients (relative to the
 /// moved triangles) are closest to the identity.
 fn glue(
@@ -454,12 +461,26 @@ fn glue(
     if nfree == 0 {
         return;
     }
-    // Rows: Σ_k coef_k · x_{vk} = rhs (per coordinate), weight w.
-    struct Row {
-        coef: [(usize, f64); 3],
-        rhs: DVec3,
-        w: f64,
+    let rows = gradient_rows(mesh, targets);
+    // Normal equations A = Σ w aᵀa + μ I, b = Σ w aᵀ rhs + μ v⁰ (fixed moved to the right).
+    let mu = 1e-3 / (ell * ell);
+    let (diag, b, trip) = normal_equations(mesh, &rows, &var, original, mu);
+    let (start, cols, vals) = compress(trip, nfree);
+    let x0: Vec<DVec3> = (0..nv)
+        .filter(|&v| var[v] != usize::MAX)
+        .map(|v| mesh.vertices[v])
+        .collect();
+    let x = conjugate_gradients(&diag, (&start, &cols, &vals), &b, x0);
+    for v in 0..nv {
+        if var[v] != usize::MAX && x[var[v]].is_finite() {
+            mesh.vertices[v] = x[var[v]];
+        }
     }
+}
+
+/// The rows of eq. 6.3, three per target triangle (one per column of its gradient), weighted
+/// by the triangle's area relative to the mean.
+fn gradient_rows(mesh: &Mesh, targets: &[(usize, [DVec3; 3], DVec3, f64)]) -> Vec<Row> {
     let mut rows: Vec<Row> = Vec::with_capacity(targets.len() * 3);
     let mut total_area = 0.0;
     for (_, _, _, a) in targets {
@@ -494,8 +515,21 @@ fn glue(
             });
         }
     }
-    // Normal equations A = Σ w aᵀa + μ I, b = Σ w aᵀ rhs + μ v⁰ (fixed moved to the right).
-    let mu = 1e-3 / (ell * ell);
+    rows
+}
+
+/// The normal equations of the rows with the damping `mu` towards the original positions:
+/// the diagonal, the right-hand side and the off-diagonal entries as (row, column, value).
+#[allow(clippy::type_complexity)]
+fn normal_equations(
+    mesh: &Mesh,
+    rows: &[Row],
+    var: &[usize],
+    original: &[DVec3],
+    mu: f64,
+) -> (Vec<f64>, Vec<DVec3>, Vec<(usize, usize, f64)>) {
+    let nv = mesh.vertices.len();
+    let nfree = var.iter().filter(|&&v| v != usize::MAX).count();
     let mut diag = vec![mu; nfree];
     let mut b = vec![DVec3::ZERO; nfree];
     for v in 0..nv {
@@ -504,7 +538,7 @@ fn glue(
         }
     }
     let mut trip: Vec<(usize, usize, f64)> = Vec::new();
-    for r in &rows {
+    for r in rows {
         let mut rhs = r.rhs;
         for &(v, c) in &r.coef {
             if var[v] == usize::MAX {
@@ -530,6 +564,14 @@ fn glue(
             }
         }
     }
+    (diag, b, trip)
+}
+
+/// Off-diagonal entries summed and compressed by rows: row starts, columns, values.
+fn compress(
+    mut trip: Vec<(usize, usize, f64)>,
+    nfree: usize,
+) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
     trip.sort_unstable_by_key(|t| (t.0, t.1));
     let mut start = vec![0usize; nfree + 1];
     let mut cols: Vec<usize> = Vec::new();
@@ -552,6 +594,18 @@ fn glue(
     for i in 0..nfree {
         start[i + 1] += start[i];
     }
+    (start, cols, vals)
+}
+
+/// Jacobi-preconditioned conjugate gradients on `diag + off-diagonal`, the three coordinates
+/// at once, from `x`.
+fn conjugate_gradients(
+    diag: &[f64],
+    (start, cols, vals): (&[usize], &[usize], &[f64]),
+    b: &[DVec3],
+    mut x: Vec<DVec3>,
+) -> Vec<DVec3> {
+    let nfree = diag.len();
     let apply = |x: &[DVec3], out: &mut [DVec3]| {
         for i in 0..nfree {
             let mut s = x[i] * diag[i];
@@ -561,22 +615,17 @@ fn glue(
             out[i] = s;
         }
     };
-    // Jacobi-preconditioned conjugate gradients, the three coordinates at once.
-    let mut x: Vec<DVec3> = (0..nv)
-        .filter(|&v| var[v] != usize::MAX)
-        .map(|v| mesh.vertices[v])
-        .collect();
     let mut ax = vec![DVec3::ZERO; nfree];
     apply(&x, &mut ax);
     let mut r: Vec<DVec3> = b.iter().zip(&ax).map(|(b, a)| *b - *a).collect();
-    let z = |r: &[DVec3]| -> Vec<DVec3> { r.iter().zip(&diag).map(|(r, d)| *r / *d).collect() };
+    let z = |r: &[DVec3]| -> Vec<DVec3> { r.iter().zip(diag).map(|(r, d)| *r / *d).collect() };
     let mut zk = z(&r);
     let mut p = zk.clone();
     let dot = |a: &[DVec3], b: &[DVec3]| -> DVec3 {
         a.iter().zip(b).fold(DVec3::ZERO, |s, (x, y)| s + *x * *y)
     };
     let mut rz = dot(&r, &zk);
-    let b_norm = dot(&b, &b).max_element().sqrt().max(1e-300);
+    let b_norm = dot(b, b).max_element().sqrt().max(1e-300);
     let mut ap = vec![DVec3::ZERO; nfree];
     for _ in 0..(4 * nfree).clamp(100, 5000) {
         apply(&p, &mut ap);
@@ -598,11 +647,7 @@ fn glue(
         }
         rz = rz_new;
     }
-    for v in 0..nv {
-        if var[v] != usize::MAX && x[var[v]].is_finite() {
-            mesh.vertices[v] = x[var[v]];
-        }
-    }
+    x
 }
 
 #[cfg(test)]
