@@ -434,8 +434,8 @@ pub(crate) mod tests {
             [2, 3, 7, 6],
             [3, 0, 4, 7],
         ];
-        surface(Mesh {
-            vertices: vec![
+        surface(Mesh::from_polygons(
+            vec![
                 v(0., 0., 0.),
                 v(1., 0., 0.),
                 v(1., 1., 0.),
@@ -445,14 +445,8 @@ pub(crate) mod tests {
                 v(1., 1., 1.),
                 v(0., 1., 1.),
             ],
-            faces: faces
-                .iter()
-                .map(|f| Face {
-                    verts: f.to_vec(),
-                    line: None,
-                })
-                .collect(),
-        })
+            &faces,
+        ))
     }
 
     fn check_isometry(flat: &Flat) {

@@ -8,4 +8,5 @@ pub mod curve;
 pub mod font;
 pub mod hull;
 pub mod mesh;
+pub mod obj;
 pub mod polygon;

@@ -42,7 +42,12 @@ impl Search<'_> {
     }
 
     /// §5.1.1 cover quality: a lower bound for every triangulation containing the cover.
-    pub(super) fn bound(&self, tris: &[[usize; 3]], owner: &[usize], subs: &[Vec<usize>]) -> Quality {
+    pub(super) fn bound(
+        &self,
+        tris: &[[usize; 3]],
+        owner: &[usize],
+        subs: &[Vec<usize>],
+    ) -> Quality {
         let em = Self::edge_map(tris);
         let mut q = Quality {
             interior: tris.iter().filter(|t| self.interior(**t)).count(),
@@ -93,7 +98,12 @@ impl Search<'_> {
 
     /// Quality of `add` next to `base` (edges inside `add` and between the two), or `None`
     /// when some of those edges bend more than the threshold.
-    pub(super) fn added(&self, base_em: &EdgeMap, base: &[[usize; 3]], add: &[[usize; 3]]) -> Option<Quality> {
+    pub(super) fn added(
+        &self,
+        base_em: &EdgeMap,
+        base: &[[usize; 3]],
+        add: &[[usize; 3]],
+    ) -> Option<Quality> {
         let em = Self::edge_map(add);
         let mut q = Quality {
             interior: add.iter().filter(|t| self.interior(**t)).count(),

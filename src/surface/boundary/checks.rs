@@ -15,10 +15,7 @@ pub fn check_loops(loops: &[Vec<DVec3>]) -> Result<(), BoundaryError> {
     }
     for (l, pts) in loops.iter().enumerate() {
         if let Some(i) = pts.iter().position(|p| !p.is_finite()) {
-            return Err(BoundaryError::NonFinite {
-                looop: l,
-                point: i,
-            });
+            return Err(BoundaryError::NonFinite { looop: l, point: i });
         }
         if pts.len() < 3 {
             return Err(BoundaryError::TooFew {

@@ -12,8 +12,8 @@
 //! an edge in space used by more than two triangles (the surface folded onto itself around
 //! the tip) is refused in charts, envelopes, covers and results. Should the coinciding
 //! sides give no valid triangulation, or only one over the limits while the V gives one
-//! within them, the darts are opened into that V for real and a warning says so (the old
-//! behaviour, kept only as this fallback; with neither valid the result is an error). A
+//! within them, the darts are opened into that V for real and a warning says so (only as
+//! this fallback; with neither valid the result is an error). A
 //! dart tip that lies off the surface the rest of the boundary asks for (the dart takes
 //! fabric in) is what makes the flat V open; a tip barely off it can need the fallback.
 //!

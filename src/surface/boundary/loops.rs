@@ -63,7 +63,11 @@ pub(super) struct Prepared {
     pub(super) connecting_charts: usize,
 }
 
-pub(super) fn prepare(input: &Input, opts: &Options, open: bool) -> Result<Prepared, BoundaryError> {
+pub(super) fn prepare(
+    input: &Input,
+    opts: &Options,
+    open: bool,
+) -> Result<Prepared, BoundaryError> {
     let darted = dart_loops(input, open)?;
     let Vertices {
         verts,
@@ -612,7 +616,6 @@ fn senses(
     (sense, has_edge)
 }
 
-
 /// §6 subtraction of a connecting chart: the loops' edges, less the chart's, plus the chart's
 /// rim reversed, walked into loops; `None` unless they are simple loops of 3 points or more.
 fn loops_left(
@@ -656,7 +659,6 @@ fn loops_left(
     }
     ok.then_some(left)
 }
-
 
 /// Split loop `g` along the chord `a b`: (a … b) and (b … a).
 pub(super) fn split_at(g: &[usize], a: usize, b: usize) -> (Vec<usize>, Vec<usize>) {

@@ -108,14 +108,14 @@ pub struct Input {
 
 /// Predictability then fairness; lower is better.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Quality {
-    pub interior: usize,
-    pub fairness: f64,
+struct Quality {
+    interior: usize,
+    fairness: f64,
 }
 
 impl Quality {
     /// Strictly better: fewer interior triangles, or as many and less fairness (1e-12 slack).
-    pub fn better(&self, o: &Quality) -> bool {
+    fn better(&self, o: &Quality) -> bool {
         self.interior < o.interior
             || (self.interior == o.interior && self.fairness < o.fairness - 1e-12)
     }

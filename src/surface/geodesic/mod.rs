@@ -1,4 +1,4 @@
-//! Bent sheets (issue 5): a flat sheet bent so that a line or curve drawn on it follows a 3D
+//! Bent sheets: a flat sheet bent so that a line or curve drawn on it follows a 3D
 //! control curve — the geodesic-controlled developables of Bo & Wang 2007 (seed 004), with
 //! their extension to non-geodesic control curves (§5).
 //!

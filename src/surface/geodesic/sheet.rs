@@ -273,34 +273,11 @@ pub(super) fn cut_holes(
 }
 
 /// Where a line crosses the sheet's rings.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Crossing {
-    pub(super) t: f64,
-    pub(super) ring: usize,
-    pub(super) edge: usize,
-    pub(super) u: f64,
-}
+pub(super) type Crossing = polygon::LineCrossing;
 
+/// Every crossing of the line `p + t d` with the rings, sorted along it.
 pub(super) fn crossings(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<Crossing> {
-    let mut out = Vec::new();
-    for (ri, r) in rings.iter().enumerate() {
-        let n = r.len();
-        for i in 0..n {
-            let (a, b) = (r[i], r[(i + 1) % n]);
-            let (sa, sb) = (d.perp_dot(a - p), d.perp_dot(b - p));
-            if (sa > 0.0) != (sb > 0.0) {
-                let u = sa / (sa - sb);
-                out.push(Crossing {
-                    t: (a + (b - a) * u - p).dot(d),
-                    ring: ri,
-                    edge: i,
-                    u,
-                });
-            }
-        }
-    }
-    out.sort_by(|x, y| x.t.total_cmp(&y.t));
-    out
+    polygon::line_crossings(rings, p, d)
 }
 
 /// The intervals of a ruling on the sheet: the one through its point (or the two beside it when

@@ -427,14 +427,14 @@ fn off_hull(len: [f64; 4], t: [f64; 6], l2: f64, lens: [f64; 4]) -> bool {
     let (ge23, le23) = pair(2, 3, t23);
     // Some neighbour has every other one on one side of it (or at most one
     // neighbour is off the bridge's line): the bridge is on the hull.
-    let hull0 = ((ge01 | !o1) & (ge02 | !o2) & (ge03 | !o3))
-        | ((le01 | !o1) & (le02 | !o2) & (le03 | !o3));
-    let hull1 = ((le01 | !o0) & (ge12 | !o2) & (ge13 | !o3))
-        | ((ge01 | !o0) & (le12 | !o2) & (le13 | !o3));
-    let hull2 = ((le02 | !o0) & (le12 | !o1) & (ge23 | !o3))
-        | ((ge02 | !o0) & (ge12 | !o1) & (le23 | !o3));
-    let hull3 = ((le03 | !o0) & (le13 | !o1) & (le23 | !o2))
-        | ((ge03 | !o0) & (ge13 | !o1) & (ge23 | !o2));
+    let hull0 =
+        ((ge01 | !o1) & (ge02 | !o2) & (ge03 | !o3)) | ((le01 | !o1) & (le02 | !o2) & (le03 | !o3));
+    let hull1 =
+        ((le01 | !o0) & (ge12 | !o2) & (ge13 | !o3)) | ((ge01 | !o0) & (le12 | !o2) & (le13 | !o3));
+    let hull2 =
+        ((le02 | !o0) & (le12 | !o1) & (ge23 | !o3)) | ((ge02 | !o0) & (ge12 | !o1) & (le23 | !o3));
+    let hull3 =
+        ((le03 | !o0) & (le13 | !o1) & (le23 | !o2)) | ((ge03 | !o0) & (ge13 | !o1) & (ge23 | !o2));
     let any = (o0 & hull0) | (o1 & hull1) | (o2 & hull2) | (o3 & hull3);
     let real = u8::from(o0) + u8::from(o1) + u8::from(o2) + u8::from(o3);
     !(any | (real <= 1))

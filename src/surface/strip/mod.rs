@@ -256,7 +256,7 @@ impl Strip {
 
     /// Whether bridge `p_i q_j` lies on the convex hull of its six points (§3.2), by
     /// [`crate::geom::hull::segment_on_hull`].
-    pub fn locally_convex(&self, i: usize, j: usize) -> bool {
+    pub(crate) fn locally_convex(&self, i: usize, j: usize) -> bool {
         let (pp, pn) = Self::neighbours(self.m(), self.closed, i);
         let (qp, qn) = Self::neighbours(self.n(), self.closed, j);
         let mut v = [DVec3::ZERO; 4];
@@ -312,7 +312,7 @@ impl Strip {
 
     /// Bending energy on bridge (i, j) between the triangle that made it (`prev`) and the one
     /// that follows (`next`); zero on the starting bridge.
-    pub fn energy(&self, i: usize, j: usize, prev: Step, next: Step) -> f64 {
+    pub(crate) fn energy(&self, i: usize, j: usize, prev: Step, next: Step) -> f64 {
         if i == 0 && j == 0 {
             return 0.0;
         }
@@ -346,7 +346,7 @@ impl Strip {
     }
 
     /// Bridges of a BBT in order, as (i, j), starting and ending bridge included.
-    pub fn bridges(&self, steps: &[Step]) -> Vec<(usize, usize)> {
+    pub(crate) fn bridges(&self, steps: &[Step]) -> Vec<(usize, usize)> {
         let mut out = Vec::with_capacity(steps.len() + 1);
         let (mut i, mut j) = (0, 0);
         out.push((0, 0));
@@ -464,7 +464,6 @@ impl Strip {
         }
         out
     }
-
 }
 
 /// Unit normal (zero when degenerate) and area of a triangle.
