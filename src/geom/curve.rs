@@ -20,7 +20,10 @@
 //! - A Bézier curve is one curve of degree `len − 1` through its first and last control point
 //!   (de Casteljau). A B-spline is uniform, of degree `degree` (default 3, lowered to
 //!   `len − 1` when there are fewer control points); open ones are clamped (they start and end
-//!   at the first and last control point), closed ones are periodic.
+//!   at the first and last control point), closed ones are periodic. Samples are evaluated by
+//!   de Boor's algorithm; [`bspline_derivatives`] gives position and three derivatives of an
+//!   open one on the same knots ([`clamped_knots`], Piegl & Tiller A2.3) for the control curves
+//!   of bent sheets.
 //! - Point lists and CSV files are taken as given, except that consecutive duplicates (closer
 //!   than 1e-9 mm) are dropped, and for a closed curve a last point equal to the first.
 //! - CSV: one point per line, `x,y` or `x,y,z` (commas, semicolons, tabs or spaces between

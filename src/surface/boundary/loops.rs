@@ -69,34 +69,27 @@ pub(super) fn prepare(
     open: bool,
 ) -> Result<Prepared, BoundaryError> {
     let darted = dart_loops(input, open)?;
-    let Vertices {
-        verts,
-        hverts,
-        site,
-        starts,
-        loop_ids,
-        input_edges,
-    } = vertices(&darted);
-    let rulings = ruling_ends(input, &starts, &darted)?;
-    let sides = Sides {
-        verts: &verts,
-        hverts: &hverts,
-        site: &site,
-        input_edges: &input_edges,
-    };
-    let (mut cycles, fixed, pending, connecting_charts) =
-        connect_by_charts(&sides, &loop_ids, rulings, opts);
+    let v = vertices(&darted);
+    let rulings = ruling_ends(input, &v.starts, &darted)?;
+    let (mut cycles, fixed, pending, connecting_charts) = connect_by_charts(&v, rulings, opts);
     let (mut joins, mut used, chords) = join_by_rulings(&mut cycles, &pending)?;
     if cycles.len() > 1 {
-        join_by_tree(&mut cycles, &verts, &fixed, &chords, &mut joins, &mut used)?;
+        join_by_tree(
+            &mut cycles,
+            &v.verts,
+            &fixed,
+            &chords,
+            &mut joins,
+            &mut used,
+        )?;
     }
     let regions = split_by_rulings(cycles, chords)?;
     Ok(Prepared {
-        verts,
-        hverts,
-        site,
-        loop_ids,
-        input_edges,
+        verts: v.verts,
+        hverts: v.hverts,
+        site: v.site,
+        loop_ids: v.loop_ids,
+        input_edges: v.input_edges,
         fixed,
         joins,
         regions,
@@ -219,20 +212,11 @@ fn ruling_ends(
     Ok(rulings)
 }
 
-/// The vertices as [`connecting_chart`] needs them.
-struct Sides<'a> {
-    verts: &'a [DVec3],
-    hverts: &'a [DVec3],
-    site: &'a [usize],
-    input_edges: &'a HashSet<(usize, usize)>,
-}
-
 /// §6: charts connecting loops first, as long as there are several loops and a valid chart:
 /// the loops left, the charts' triangles, the rulings still to place and how many charts.
 #[allow(clippy::type_complexity)]
 fn connect_by_charts(
-    sides: &Sides,
-    loop_ids: &[Vec<usize>],
+    v: &Vertices,
     rulings: Vec<(usize, [usize; 2])>,
     opts: &Options,
 ) -> (
@@ -241,26 +225,22 @@ fn connect_by_charts(
     Vec<(usize, [usize; 2])>,
     usize,
 ) {
-    let Sides {
+    let Vertices {
         verts,
         hverts,
         site,
+        loop_ids,
         input_edges,
-    } = *sides;
+        ..
+    } = v;
     let mut cycles = loop_ids.to_vec();
     let mut fixed: Vec<[usize; 3]> = Vec::new();
     let mut pending = rulings;
     let mut connecting_charts = 0;
     while cycles.len() > 1 {
-        let Some((tris, next)) = connecting_chart(
-            &verts,
-            &hverts,
-            &site,
-            &cycles,
-            &input_edges,
-            &pending,
-            opts,
-        ) else {
+        let Some((tris, next)) =
+            connecting_chart(verts, hverts, site, &cycles, input_edges, &pending, opts)
+        else {
             break;
         };
         pending.retain(|(_, [a, b])| !tris.iter().any(|t| t.contains(a) && t.contains(b)));
