@@ -193,7 +193,7 @@ pub(super) type Chain = Vec<(Crossing, Crossing)>;
 pub(super) fn ruling_chains(rings: &[Vec<DVec2>], rulings: &mut [Ruling]) -> Vec<Chain> {
     let mut chains: Vec<Vec<(Crossing, Crossing)>> = Vec::with_capacity(rulings.len());
     for r in rulings.iter_mut() {
-        let ch = chain(&crossings(&rings, r.point, r.dir));
+        let ch = chain(&crossings(rings, r.point, r.dir));
         r.extent = match (ch.first(), ch.last()) {
             (Some(f), Some(l)) => (f.0.t, l.1.t),
             _ => (0.0, 0.0),
@@ -237,7 +237,7 @@ pub(super) fn cut_holes(
         }
         let mut done = false;
         for dir in dirs {
-            let cr = crossings(&rings, centre, dir);
+            let cr = crossings(rings, centre, dir);
             let ch = chain(&cr);
             let Some(ext) = ch.first().zip(ch.last()).map(|(f, l)| (f.0.t, l.1.t)) else {
                 continue;
