@@ -77,7 +77,12 @@ impl Strip {
                 row.after_p(&cols, self.p[r0 - 1], pb[r0 - 1].0[1]);
             }
             for (k, i) in (r0..r1).enumerate() {
-                self.cost_row_fastest::<COUNT, ENERGY, AREA>(i, &pb, &cols, row, out, k * n);
+                let at_row = RowAt {
+                    i,
+                    pb: &pb,
+                    cols: &cols,
+                };
+                self.cost_row_fastest::<COUNT, ENERGY, AREA>(at_row, row, out, k * n);
             }
         };
         let mut dp = Recurrence::new(m, n);
@@ -158,12 +163,9 @@ impl Strip {
     /// [`Strip::cost_row`] compiled for the widest vector instructions the CPU has: AVX2 on
     /// x86-64 machines that have it (checked at run time), else the baseline. The compiler
     /// never fuses a multiply and an add on its own, so both give bit-identical costs.
-    #[allow(clippy::too_many_arguments)]
     fn cost_row_fastest<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
         &self,
-        i: usize,
-        pb: &[([DVec3; 3], [f64; 2])],
-        cols: &Columns,
+        at_row: RowAt,
         row: &mut Tris,
         out: &mut Costs,
         at: usize,
@@ -171,10 +173,10 @@ impl Strip {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked just above.
-            unsafe { self.cost_row_avx2::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at) };
+            unsafe { self.cost_row_avx2::<COUNT, ENERGY, AREA>(at_row, row, out, at) };
             return;
         }
-        self.cost_row::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at);
+        self.cost_row::<COUNT, ENERGY, AREA>(at_row, row, out, at);
     }
 
     /// [`Strip::cost_row`] with AVX2 instructions.
@@ -183,17 +185,14 @@ impl Strip {
     /// The CPU must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
     unsafe fn cost_row_avx2<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
         &self,
-        i: usize,
-        pb: &[([DVec3; 3], [f64; 2])],
-        cols: &Columns,
+        at_row: RowAt,
         row: &mut Tris,
         out: &mut Costs,
         at: usize,
     ) {
-        self.cost_row::<COUNT, ENERGY, AREA>(i, pb, cols, row, out, at);
+        self.cost_row::<COUNT, ENERGY, AREA>(at_row, row, out, at);
     }
 
     /// The costs of every node of row `i`, written at `out[at..at + n]`. `row` holds, for
@@ -204,18 +203,16 @@ impl Strip {
     /// chunk with no dependency between columns, which the compiler turns into instructions
     /// that handle several columns at once; the only thing carried from one chunk to the
     /// next is the Q-step triangle after the chunk's last column.
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn cost_row<const COUNT: bool, const ENERGY: bool, const AREA: bool>(
         &self,
-        i: usize,
-        pb: &[([DVec3; 3], [f64; 2])],
-        cols: &Columns,
+        at_row: RowAt,
         row: &mut Tris,
         out: &mut Costs,
         at: usize,
     ) {
         const L: usize = LANES;
+        let RowAt { i, pb, cols } = at_row;
         let n = self.n();
         let ([ep0, ep1, cp], [lp0, lp1]) = pb[i];
         let pi = self.p[i];
@@ -300,6 +297,14 @@ impl Strip {
             o11[o..o + w].copy_from_slice(&w11[..w]);
         }
     }
+}
+
+/// What a cost row reads: its index `i`, the P banks and the Q columns.
+#[derive(Clone, Copy)]
+struct RowAt<'a> {
+    i: usize,
+    pb: &'a [([DVec3; 3], [f64; 2])],
+    cols: &'a Columns,
 }
 
 /// A chunk of `LANES` values of `v` from `c0` (the arrays are padded to whole chunks).
