@@ -407,34 +407,7 @@ pub(crate) mod tests {
     }
 
     pub(crate) fn cube(size: f64) -> Surface {
-        let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) * size;
-        let faces = [
-            [0, 3, 2, 1],
-            [4, 5, 6, 7],
-            [0, 1, 5, 4],
-            [1, 2, 6, 5],
-            [2, 3, 7, 6],
-            [3, 0, 4, 7],
-        ];
-        surface(Mesh {
-            vertices: vec![
-                v(0., 0., 0.),
-                v(1., 0., 0.),
-                v(1., 1., 0.),
-                v(0., 1., 0.),
-                v(0., 0., 1.),
-                v(1., 0., 1.),
-                v(1., 1., 1.),
-                v(0., 1., 1.),
-            ],
-            faces: faces
-                .iter()
-                .map(|f| Face {
-                    verts: f.to_vec(),
-                    line: None,
-                })
-                .collect(),
-        })
+        surface(crate::surface::solids::cuboid(size, size, size))
     }
 
     fn check_isometry(flat: &Flat) {

@@ -20,7 +20,10 @@
 //! - A Bézier curve is one curve of degree `len − 1` through its first and last control point
 //!   (de Casteljau). A B-spline is uniform, of degree `degree` (default 3, lowered to
 //!   `len − 1` when there are fewer control points); open ones are clamped (they start and end
-//!   at the first and last control point), closed ones are periodic.
+//!   at the first and last control point), closed ones are periodic. Samples are evaluated by
+//!   de Boor's algorithm; [`bspline_derivatives`] gives position and three derivatives of an
+//!   open one on the same knots ([`clamped_knots`], Piegl & Tiller A2.3) for the control curves
+//!   of bent sheets.
 //! - Point lists and CSV files are taken as given, except that consecutive duplicates (closer
 //!   than 1e-9 mm) are dropped, and for a closed curve a last point equal to the first.
 //! - CSV: one point per line, `x,y` or `x,y,z` (commas, semicolons, tabs or spaces between
@@ -307,6 +310,122 @@ fn de_boor(control: &[DVec3], knots: &[f64], p: usize, k: usize, t: f64) -> DVec
     d[p]
 }
 
+/// Uniform clamped knots of an open B-spline with `n` control points: the degree used
+/// (`degree`, lowered to `n − 1` when there are too few points) and the knots `0 … 0, 1, 2, …,
+/// n − p … n − p`, each end repeated `p + 1` times.
+pub fn clamped_knots(n: usize, degree: usize) -> (usize, Vec<f64>) {
+    let p = degree.clamp(1, n.saturating_sub(1).max(1));
+    let inner = n.saturating_sub(p).max(1); // number of spans
+    let mut knots = vec![0.0; p + 1];
+    knots.extend((1..inner).map(|i| i as f64));
+    knots.extend(std::iter::repeat_n(inner as f64, p + 1));
+    (p, knots)
+}
+
+/// Position and first, second and third derivatives of a B-spline of degree `p` with knot
+/// vector `knots` at `u` (clamped to its last span at the end): the basis derivatives of
+/// Piegl & Tiller's algorithm A2.3 times the control points. Derivatives above `p` are zero.
+pub fn bspline_derivatives(control: &[DVec3], p: usize, knots: &[f64], u: f64) -> [DVec3; 4] {
+    let k = span(control.len(), p, knots, u);
+    let nd = 3.min(p);
+    let ders = ders_basis(k, u, p, nd, knots);
+    let mut out = [DVec3::ZERO; 4];
+    for (o, row) in out.iter_mut().zip(&ders) {
+        for (c, w) in control[k - p..=k].iter().zip(row) {
+            *o += *c * *w;
+        }
+    }
+    out
+}
+
+/// The knot span holding `u` of a B-spline with `len` control points.
+fn span(len: usize, p: usize, knots: &[f64], u: f64) -> usize {
+    let n = len - 1;
+    if u >= knots[n + 1] {
+        return n;
+    }
+    let mut k = p;
+    while k < n && u >= knots[k + 1] {
+        k += 1;
+    }
+    k
+}
+
+/// Basis function derivatives (Piegl & Tiller, The NURBS Book, algorithm A2.3).
+fn ders_basis(i: usize, u: f64, p: usize, n: usize, knots: &[f64]) -> Vec<Vec<f64>> {
+    let mut ndu = vec![vec![0.0; p + 1]; p + 1];
+    let mut left = vec![0.0; p + 1];
+    let mut right = vec![0.0; p + 1];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = u - knots[i + 1 - j];
+        right[j] = knots[i + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = if ndu[j][r] != 0.0 {
+                ndu[r][j - 1] / ndu[j][r]
+            } else {
+                0.0
+            };
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    let mut ders = vec![vec![0.0; p + 1]; n + 1];
+    for j in 0..=p {
+        ders[0][j] = ndu[j][p];
+    }
+    let mut a = vec![vec![0.0; p + 1]; 2];
+    for r in 0..=p {
+        let (mut s1, mut s2) = (0usize, 1usize);
+        a[0][0] = 1.0;
+        for k in 1..=n {
+            let mut d = 0.0;
+            let rk = r as isize - k as isize;
+            let pk = p - k;
+            if r >= k {
+                let den = ndu[pk + 1][rk as usize];
+                a[s2][0] = if den != 0.0 { a[s1][0] / den } else { 0.0 };
+                d = a[s2][0] * ndu[rk as usize][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if r as isize - 1 <= pk as isize {
+                k - 1
+            } else {
+                p - r
+            };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                let den = ndu[pk + 1][idx];
+                a[s2][j] = if den != 0.0 {
+                    (a[s1][j] - a[s1][j - 1]) / den
+                } else {
+                    0.0
+                };
+                d += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                let den = ndu[pk + 1][r];
+                a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
+                d += a[s2][k] * ndu[r][pk];
+            }
+            ders[k][r] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    // Row k times p!/(p − k)!.
+    let mut f = p as f64;
+    for (k, row) in ders.iter_mut().enumerate().skip(1) {
+        for v in row.iter_mut() {
+            *v *= f;
+        }
+        f *= p.saturating_sub(k) as f64;
+    }
+    ders
+}
+
 fn bspline(control: &[DVec3], degree: usize, closed: bool, tol: f64) -> Vec<DVec3> {
     let mut out = Vec::new();
     if closed {
@@ -320,12 +439,8 @@ fn bspline(control: &[DVec3], degree: usize, closed: bool, tol: f64) -> Vec<DVec
             adaptive(&f, knots[k], knots[k + 1], tol, &mut out);
         }
     } else {
-        let p = degree.clamp(1, control.len() - 1);
         let n = control.len();
-        let inner = n - p; // number of spans
-        let mut knots = vec![0.0; p + 1];
-        knots.extend((1..inner).map(|i| i as f64));
-        knots.extend(std::iter::repeat_n(inner as f64, p + 1));
+        let (p, knots) = clamped_knots(n, degree);
         for k in p..n {
             let f = |t: f64| de_boor(control, &knots, p, k, t);
             adaptive(&f, knots[k], knots[k + 1], tol, &mut out);

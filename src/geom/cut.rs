@@ -147,12 +147,7 @@ pub fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
 /// Split faces in two by which of faces `a` and `b` is nearer through the face graph restricted
 /// to `faces` (used to separate two faces whose layouts overlap). Each part is connected when
 /// `faces` is.
-pub fn split_between(
-    g: &Graph,
-    faces: &[usize],
-    a: usize,
-    b: usize,
-) -> (Vec<usize>, Vec<usize>) {
+pub fn split_between(g: &Graph, faces: &[usize], a: usize, b: usize) -> (Vec<usize>, Vec<usize>) {
     let nf = g.area.len();
     let mut inside = vec![false; nf];
     for &f in faces {

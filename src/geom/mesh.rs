@@ -41,18 +41,36 @@ pub struct Topology {
     pub face_edges: Vec<Vec<usize>>,
 }
 
+/// Newell normal of a closed polygon: the sum of `p[i] × p[i + 1]` (indices cyclic). Its
+/// direction is the polygon's normal (counter-clockwise seen from its tip), its length twice
+/// the area of the (possibly non-planar) polygon's projection on the plane across it.
+pub fn newell(p: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    for i in 0..p.len() {
+        n += p[i].cross(p[(i + 1) % p.len()]);
+    }
+    n
+}
+
 impl Mesh {
+    /// A mesh of the given vertices and polygon faces (vertex indices, no source lines).
+    pub fn from_polygons<F: AsRef<[usize]>>(vertices: Vec<DVec3>, faces: &[F]) -> Mesh {
+        Mesh {
+            vertices,
+            faces: faces
+                .iter()
+                .map(|f| Face {
+                    verts: f.as_ref().to_vec(),
+                    line: None,
+                })
+                .collect(),
+        }
+    }
+
     /// Newell normal of a face: its direction is the face normal, its length twice the area of
     /// the (possibly non-planar) polygon's projection.
     pub fn newell(&self, f: usize) -> DVec3 {
-        let v = &self.faces[f].verts;
-        let mut n = DVec3::ZERO;
-        for i in 0..v.len() {
-            let a = self.vertices[v[i]];
-            let b = self.vertices[v[(i + 1) % v.len()]];
-            n += a.cross(b);
-        }
-        n
+        newell(&self.face_points(f))
     }
 
     /// Area of a face (of its projection on the best plane for non-planar polygons).

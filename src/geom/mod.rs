@@ -10,6 +10,7 @@ pub mod font;
 pub mod heap;
 pub mod hull;
 pub mod mesh;
+pub mod obj;
 pub mod polygon;
 pub mod proxy;
 pub mod rng;

@@ -359,24 +359,48 @@ pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
     (best.d > 0.0).then_some((best.c, best.d))
 }
 
-/// The intervals of the line `p + t d` (`d` a unit vector) that lie inside a set of rings, as
-/// sorted `(t0, t1)` pairs (even-odd rule).
-pub fn line_intervals(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<(f64, f64)> {
-    let mut ts = Vec::new();
-    for r in rings {
+/// Where the line `p + t d` crosses edge `edge` of ring `ring`: at `t` along the line, at
+/// fraction `u` along the edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineCrossing {
+    pub t: f64,
+    pub ring: usize,
+    pub edge: usize,
+    pub u: f64,
+}
+
+/// Every crossing of the line `p + t d` (`d` a unit vector) with the edges of a set of rings,
+/// sorted along the line. Half-open in the signed offset from the line, so a vertex on it
+/// counts once.
+pub fn line_crossings(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<LineCrossing> {
+    let mut out = Vec::new();
+    for (ri, r) in rings.iter().enumerate() {
         let n = r.len();
         for i in 0..n {
             let (a, b) = (r[i], r[(i + 1) % n]);
-            // Half-open in the signed offset from the line, so a vertex on it counts once.
             let (sa, sb) = (d.perp_dot(a - p), d.perp_dot(b - p));
             if (sa > 0.0) != (sb > 0.0) {
                 let u = sa / (sa - sb);
-                ts.push((a + (b - a) * u - p).dot(d));
+                out.push(LineCrossing {
+                    t: (a + (b - a) * u - p).dot(d),
+                    ring: ri,
+                    edge: i,
+                    u,
+                });
             }
         }
     }
-    ts.sort_by(f64::total_cmp);
-    ts.chunks_exact(2).map(|c| (c[0], c[1])).collect()
+    out.sort_by(|x, y| x.t.total_cmp(&y.t));
+    out
+}
+
+/// The intervals of the line `p + t d` (`d` a unit vector) that lie inside a set of rings, as
+/// sorted `(t0, t1)` pairs (even-odd rule).
+pub fn line_intervals(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<(f64, f64)> {
+    line_crossings(rings, p, d)
+        .chunks_exact(2)
+        .map(|c| (c[0].t, c[1].t))
+        .collect()
 }
 
 #[cfg(test)]

@@ -2,63 +2,21 @@
 //!
 //! Used for `--surface-obj` (a bent or generated surface to look at in a 3D viewer) and
 //! `--uv-obj` (the mesh with its flat layout as `vt`, in mm, so anyone can measure the pattern
-//! against the surface). Choices: coordinates are written with `{}` formatting of f64 (shortest
-//! round-trip representation, so a read-back is exact and the output deterministic); faces keep
-//! their vertex order (counter-clockwise seen from the printed side); texture coordinates are
-//! given per face corner — a vertex on a seam has one `vt` per piece it belongs to — and equal
-//! consecutive corners are not merged, so face `f` corner `i` is `vt` number
-//! (sum of earlier faces' corners) + i + 1.
+//! against the surface). The text is [`crate::geom::obj::write`]'s with coordinates in their
+//! shortest round-trip representation ([`crate::geom::obj::exact`]), so a read-back is exact and
+//! the output deterministic; faces keep their vertex order (counter-clockwise seen from the
+//! printed side).
 
 use crate::geom::mesh::Mesh;
+use crate::geom::obj;
 use glam::DVec2;
-use std::fmt::Write as _;
 
 /// The OBJ text of `mesh`, headed by `# comment` lines (one per line of `comment`). With `uv`
 /// (one 2D point per corner of each face, in mm) every face is written `f v/vt …`.
 ///
 /// Returns `None` when `uv` does not have one point per corner of every face.
 pub fn write(mesh: &Mesh, uv: Option<&[Vec<DVec2>]>, comment: &str) -> Option<String> {
-    if let Some(uv) = uv {
-        if uv.len() != mesh.faces.len()
-            || uv
-                .iter()
-                .zip(&mesh.faces)
-                .any(|(c, f)| c.len() != f.verts.len())
-        {
-            return None;
-        }
-    }
-    let mut s = String::new();
-    for line in comment.lines() {
-        let _ = writeln!(s, "# {line}");
-    }
-    for v in &mesh.vertices {
-        let _ = writeln!(s, "v {} {} {}", v.x, v.y, v.z);
-    }
-    if let Some(uv) = uv {
-        for p in uv.iter().flatten() {
-            let _ = writeln!(s, "vt {} {}", p.x, p.y);
-        }
-    }
-    let mut t = 0usize;
-    for (fi, f) in mesh.faces.iter().enumerate() {
-        s.push('f');
-        for (i, &v) in f.verts.iter().enumerate() {
-            match uv {
-                Some(_) => {
-                    let _ = write!(s, " {}/{}", v + 1, t + i + 1);
-                }
-                None => {
-                    let _ = write!(s, " {}", v + 1);
-                }
-            }
-        }
-        s.push('\n');
-        if uv.is_some() {
-            t += mesh.faces[fi].verts.len();
-        }
-    }
-    Some(s)
+    obj::write(mesh, uv, comment, obj::exact)
 }
 
 #[cfg(test)]

@@ -451,10 +451,10 @@ impl Ctx<'_> {
     }
 }
 
-/// The line and key of loop `l` (counted from 1, as [`BoundaryError`] counts them); the
+/// The line and key of loop `l` (0-based, as [`BoundaryError`] counts them); the
 /// entry's header and key when there is no such loop.
 fn at_loop(raw_loops: &[RawLoop], l: usize, key: &str, header_line: usize) -> (usize, String) {
     raw_loops
-        .get(l.saturating_sub(1))
+        .get(l)
         .map_or((header_line, key.to_string()), |r| (r.2, r.1.clone()))
 }

@@ -1,10 +1,20 @@
 //! Surface stage: where developables come from. Each way of making a developable lives in its
-//! own file; all of them produce a [`Surface`]: a polygon mesh in millimetres whose faces are
-//! flat panels, with its name and the file it came from.
+//! own file or folder (the papers are in shared/seeds/, see its README); all of them produce a
+//! [`Surface`]: a polygon mesh in millimetres whose faces are flat panels, with its name and
+//! the file it came from.
 //!
-//! Sources: a polyhedral mesh ([`obj`]), a developable strip between two boundary curves
-//! ([`strip`], Wang–Tang) and the sheet-metal fittings built on strips ([`fittings`]); boundary
-//! and geodesic developables will add files here (see shared/seeds/README.md).
+//! - [`obj`]: a polyhedral mesh read from a Wavefront OBJ file, checked and repaired.
+//! - [`solids`]: small polyhedra for the example patterns and tests (cube, tetrahedron,
+//!   lampshade, house).
+//! - [`strip`]/: Wang & Tang, *Developable Triangulations of a Strip*: the developable
+//!   triangulation between two boundary curves.
+//! - [`fittings`]: sheet-metal fittings (cone, square-to-round, pipe miter …) built on strips.
+//! - [`boundary`]/: Rose et al. 2007, *Developable Surfaces from Arbitrary Sketched
+//!   Boundaries*: a boundary triangulation of closed 3D loops, with darts and rulings.
+//! - [`geodesic`]/: Bo & Wang 2007, *Geodesic-Controlled Developable Surfaces*: a flat sheet
+//!   bent along control curves (bent sheets).
+//! - [`dcharts`]: Julius 2006, D-Charts: a smooth mesh segmented into nearly developable charts.
+//! - [`dcs`]: Julius 2006, §6 DCS approximation: a mesh moved towards a developable one.
 
 pub mod boundary;
 pub mod dcharts;

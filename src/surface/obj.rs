@@ -68,6 +68,35 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
             "not an OBJ file: it contains binary data; export the model as Wavefront OBJ",
         ));
     }
+    let face_lines = prescan(text, path)?;
+    let opts = tobj::LoadOptions {
+        triangulate: false,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let mut reader = std::io::BufReader::new(text.as_bytes());
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
+            .map_err(|e| parse_err(path, None, format!("OBJ reader: {e}")))?;
+
+    let (mut mesh, welded) = weld(&models, path)?;
+    // tobj keeps faces in file order; name their lines when the counts agree.
+    if mesh.faces.len() == face_lines.len() {
+        for (f, l) in mesh.faces.iter_mut().zip(&face_lines) {
+            f.line = Some(*l);
+        }
+    }
+    Ok(RawMesh {
+        path: path.to_path_buf(),
+        mesh,
+        welded,
+    })
+}
+
+/// Pre-scan: vertex count, lines of faces, finite coordinates, valid indices; the line
+/// (1-based) of each face.
+fn prescan(text: &str, path: &Path) -> Result<Vec<usize>, SurfaceError> {
     // Pre-scan: vertex count, lines of faces, finite coordinates, valid indices.
     let mut n_vertices = 0usize;
     let mut face_lines = Vec::new();
@@ -167,21 +196,16 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
         ));
     }
 
-    let opts = tobj::LoadOptions {
-        triangulate: false,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let mut reader = std::io::BufReader::new(text.as_bytes());
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
-            .map_err(|e| parse_err(path, None, format!("OBJ reader: {e}")))?;
+    Ok(face_lines)
+}
 
+/// The models' vertices welded where they coincide exactly, and their faces; how many
+/// vertices were welded.
+fn weld(models: &[tobj::Model], path: &Path) -> Result<(Mesh, usize), SurfaceError> {
     let mut mesh = Mesh::default();
     let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
     let mut welded = 0usize;
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         let mut local = Vec::with_capacity(m.positions.len() / 3);
         for p in m.positions.chunks_exact(3) {
@@ -228,17 +252,7 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
             mesh.faces.push(Face { verts, line: None });
         }
     }
-    // tobj keeps faces in file order; name their lines when the counts agree.
-    if mesh.faces.len() == face_lines.len() {
-        for (f, l) in mesh.faces.iter_mut().zip(&face_lines) {
-            f.line = Some(*l);
-        }
-    }
-    Ok(RawMesh {
-        path: path.to_path_buf(),
-        mesh,
-        welded,
-    })
+    Ok((mesh, welded))
 }
 
 fn lines_of(mesh: &Mesh, faces: &[usize], limit: usize) -> String {

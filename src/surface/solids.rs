@@ -5,21 +5,12 @@
 //! comment saying how it was made, so `patterns/*.obj` are generated, never hand-edited
 //! (`cargo run --example make_patterns`).
 
-use crate::geom::mesh::{Face, Mesh};
+use crate::geom::mesh::Mesh;
+use crate::geom::obj;
 use glam::DVec3;
-use std::fmt::Write;
 
 fn mesh(vertices: Vec<DVec3>, faces: &[&[usize]]) -> Mesh {
-    Mesh {
-        vertices,
-        faces: faces
-            .iter()
-            .map(|f| Face {
-                verts: f.to_vec(),
-                line: None,
-            })
-            .collect(),
-    }
+    Mesh::from_polygons(vertices, faces)
 }
 
 /// An axis-aligned box `w × d × h`, six quads.
@@ -122,27 +113,7 @@ pub fn house(w: f64, d: f64, wall: f64, ridge: f64) -> Mesh {
 
 /// OBJ text of a mesh, with a header comment.
 pub fn to_obj(mesh: &Mesh, comment: &str) -> String {
-    let mut s = String::new();
-    for line in comment.lines() {
-        let _ = writeln!(s, "# {line}");
-    }
-    for p in &mesh.vertices {
-        let _ = writeln!(s, "v {} {} {}", fmt(p.x), fmt(p.y), fmt(p.z));
-    }
-    for f in &mesh.faces {
-        let idx: Vec<String> = f.verts.iter().map(|v| (v + 1).to_string()).collect();
-        let _ = writeln!(s, "f {}", idx.join(" "));
-    }
-    s
-}
-
-fn fmt(v: f64) -> String {
-    let r = (v * 1e9).round() / 1e9;
-    if r == 0.0 {
-        "0".into()
-    } else {
-        format!("{r}")
-    }
+    obj::write(mesh, None, comment, obj::rounded).unwrap_or_default()
 }
 
 /// The example patterns: (file stem, mesh, how it was made).
