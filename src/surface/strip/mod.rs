@@ -519,16 +519,7 @@ pub(crate) mod tests {
     use std::cmp::Ordering;
     use std::collections::BinaryHeap;
 
-    /// Deterministic pseudo-random numbers (xorshift64*).
-    pub(crate) struct Rng(pub u64);
-    impl Rng {
-        pub(crate) fn next(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    pub(crate) use crate::geom::rng::Rng;
 
     /// A wavy random strip: two noisy curves about `width` apart.
     pub(crate) fn random_strip(rng: &mut Rng, m: usize, n: usize) -> Strip {
@@ -536,8 +527,8 @@ pub(crate) mod tests {
             let mut x = 0.0;
             (0..k)
                 .map(|_| {
-                    x += 0.5 + rng.next();
-                    DVec3::new(x, y + 0.6 * (rng.next() - 0.5), 2.0 * (rng.next() - 0.5))
+                    x += 0.5 + rng.f64();
+                    DVec3::new(x, y + 0.6 * (rng.f64() - 0.5), 2.0 * (rng.f64() - 0.5))
                 })
                 .collect()
         };
@@ -637,10 +628,10 @@ pub(crate) mod tests {
 
     #[test]
     fn strip_dp_equals_dijkstra_on_random_strips() {
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         for trial in 0..40 {
-            let m = 2 + (rng.next() * 12.0) as usize;
-            let n = 2 + (rng.next() * 12.0) as usize;
+            let m = 2 + (rng.f64() * 12.0) as usize;
+            let n = 2 + (rng.f64() * 12.0) as usize;
             let s = random_strip(&mut rng, m, n);
             for method in [Method::Godt, Method::Gmbt, Method::Gmat, Method::GodtGmbt] {
                 let steps = s.triangulate(method);
@@ -659,7 +650,7 @@ pub(crate) mod tests {
     /// Every step sequence with m−1 P's and n−1 Q's.
     #[test]
     fn strip_dp_is_the_same_on_any_number_of_threads_and_bands() {
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         for (m, n) in [(37, 29), (120, 64)] {
             let s = random_strip(&mut rng, m, n);
             for method in [Method::GodtGmbt, Method::Godt, Method::Gmbt, Method::Gmat] {
@@ -703,11 +694,11 @@ pub(crate) mod tests {
 
     #[test]
     fn strip_dp_equals_brute_force_on_tiny_strips() {
-        let mut rng = Rng(99);
+        let mut rng = Rng::new(99);
         for _ in 0..15 {
             let (m, n) = (
-                2 + (rng.next() * 5.0) as usize,
-                2 + (rng.next() * 5.0) as usize,
+                2 + (rng.f64() * 5.0) as usize,
+                2 + (rng.f64() * 5.0) as usize,
             );
             let s = random_strip(&mut rng, m, n);
             let paths = all_paths(m, n);
@@ -726,7 +717,7 @@ pub(crate) mod tests {
 
     #[test]
     fn strip_global_beats_local_on_random_strips() {
-        let mut rng = Rng(2024);
+        let mut rng = Rng::new(2024);
         for _ in 0..30 {
             let s = random_strip(&mut rng, 30, 40);
             let g = s.metrics(&s.triangulate(Method::Godt));
@@ -751,7 +742,7 @@ pub(crate) mod tests {
 
     #[test]
     fn strip_bbt_has_m_plus_n_minus_2_triangles_of_two_bridges_and_a_bank() {
-        let mut rng = Rng(5);
+        let mut rng = Rng::new(5);
         let s = random_strip(&mut rng, 17, 23);
         for method in Method::NAMES.map(|(_, m)| m) {
             let steps = s.triangulate(method);
