@@ -298,7 +298,6 @@ fn all_files() -> Vec<PathBuf> {
 }
 
 #[test]
-#[ignore = "issue 19: on until the house is redrawn"]
 fn imports_run_down_the_pipeline() {
     let mut bad = Vec::new();
     for f in all_files() {
@@ -401,7 +400,6 @@ fn is_public(module: &[String], name: &str) -> bool {
 }
 
 #[test]
-#[ignore = "issue 19: on until the house is redrawn"]
 fn stages_use_only_public_items_of_other_modules() {
     let mut bad = Vec::new();
     for f in all_files() {
@@ -448,7 +446,6 @@ fn stages_use_only_public_items_of_other_modules() {
 }
 
 #[test]
-#[ignore = "issue 19: on until the house is redrawn"]
 fn no_cycle_between_the_files_of_a_module() {
     // Edges between sibling submodules (`nest::problem` → `nest::construct`); a module's
     // mod.rs (its parent) is left out: children naming their parent's types is no cycle.
@@ -571,7 +568,6 @@ fn sizes(text: &str, max_fn: usize) -> (usize, Vec<(String, usize, usize)>) {
 }
 
 #[test]
-#[ignore = "issue 19: on until the house is redrawn"]
 fn no_god_files_and_no_long_functions() {
     let mut bad = Vec::new();
     for f in all_files() {

@@ -14,9 +14,9 @@
 //!
 //! [`Search::dive`] completes a cover depth first when the iterations run out.
 
-use super::charts::{Chart, Sub};
 use super::darts::sites_valid;
 use super::figures::{angle, unit_normal};
+use super::{Chart, Sub};
 use super::{Options, Quality};
 use glam::DVec3;
 use std::collections::{BTreeMap, HashMap, HashSet};

@@ -13,22 +13,12 @@
 //! Charts and envelopes are cached per subloop.
 
 use super::bnb::Search;
+use super::{Chart, Sub};
 use crate::geom::hull;
 use crate::geom::mesh::newell;
 use glam::{DVec2, DVec3};
 use std::collections::{BTreeMap, HashSet};
 use std::rc::Rc;
-
-pub(super) struct Chart {
-    pub(super) tris: Vec<[usize; 3]>,
-    pub(super) area: f64,
-}
-
-#[derive(Default)]
-pub(super) struct Sub {
-    pub(super) envelopes: Vec<Vec<[usize; 3]>>,
-    pub(super) charts: Vec<usize>,
-}
 
 impl Search<'_> {
     /// Whether the directed loop edge `a → b` (a, b adjacent in the loop) is an input edge.

@@ -235,3 +235,17 @@ pub fn triangulate(input: &Input, opts: &Options) -> Result<Output, BoundaryErro
 
 /// How the warning that the limits were relaxed starts.
 const RELAXED: &str = "no triangulation with every dihedral angle under";
+/// A chart of a subloop's convex hull (§3): its triangles (indices into the search's points)
+/// and its area. Shared by the chart finder ([`charts`]) and the search ([`bnb`]).
+struct Chart {
+    tris: Vec<[usize; 3]>,
+    area: f64,
+}
+
+/// What a subloop's hull offers the search: its envelopes and the charts (indices into the
+/// search's chart list) found on it.
+#[derive(Default)]
+struct Sub {
+    envelopes: Vec<Vec<[usize; 3]>>,
+    charts: Vec<usize>,
+}
