@@ -1,14 +1,198 @@
 //! flatcut: developable surfaces to nested flat patterns for cutter plotters.
 //!
-//! The pipeline runs one way, one stage per module, plain data between them:
-//! a [`spec::Spec`] names the surfaces; [`surface`] makes each a [`surface::Surface`] (3D flat
-//! panels: imported meshes, Wang–Tang strips between two curves, sheet-metal fittings); [`flatten`] lays it into the plane as a [`flatten::Flat`] (islands of faces moved by
-//! rigid motions); [`pattern`] turns islands into [`pattern::Piece`]s (cut outline, fold lines,
-//! edge ids, labels); [`nest`] places pieces on sheets as a [`nest::Layout`]; [`toolpath`]
-//! orders the strokes of each sheet into a [`toolpath::Job`]; [`output`] encodes a job as HPGL,
-//! SVG or PNG; [`device`] knows the machines (profiles) and carries the program to them.
+//! # The pipeline
 //!
-//! Millimetres and `f64` inside; device units appear only in [`output`].
+//! One direction, one stage per module, plain data between them, composed in one place,
+//! [`pipeline`]:
+//!
+//! 1. [`spec`] reads a job (a TOML spec, or a bare mesh with defaults) into the stages' own
+//!    option types, with messages that name `FILE:LINE` and the key.
+//! 2. [`surface`] makes each surface a [`surface::Surface`]: a 3D mesh of flat panels (imported
+//!    OBJ meshes, D-Charts of smooth meshes, Wang–Tang strips between two curves, Bo–Wang bent
+//!    sheets, Rose et al. boundary triangulations, sheet-metal fittings).
+//! 3. [`flatten`] lays it into the plane as a [`flatten::Flat`]: exact unfolding into islands
+//!    of faces moved by rigid motions, or LSCM / ABF++ charts of nearly developable meshes.
+//! 4. [`pattern`] turns islands into [`pattern::Piece`]s: cut outline, fold and bend lines,
+//!    seam ids, notches, labels, glue tabs, allowance and kerf.
+//! 5. [`nest`] places pieces on sheets or a roll as a [`nest::Layout`].
+//! 6. [`toolpath`] orders each sheet's strokes into a [`toolpath::Job`] and prepares it for the
+//!    machine (perforation, overcut, drag-knife offset).
+//! 7. [`output`] encodes a job as HP-GL / CAMM-GL or GRBL G-code, and draws it as SVG, PNG and
+//!    DXF, with report.json and the run's files written atomically.
+//! 8. [`device`] carries a program to the machine: serial transport, buffered HP-GL and GRBL
+//!    streaming, and the simulated cutter on a pseudo-terminal.
+//!
+//! Two leaves serve every stage: [`profile`] (device profiles and the stroke kinds their tools
+//! make) and [`geom`] (shared math: meshes, curves, polygons, hulls, chart cutting, one seeded
+//! RNG). [`cli`] parses the command line and calls [`pipeline`]. Imports run down the list
+//! `cli → pipeline → spec → surface → … → device → profile, geom` and never up it; a stage uses
+//! an earlier stage's public types, never its internals (`tests/suite/house.rs` checks it).
+//!
+//! Millimetres and `f64` inside, angles in radians (a field in another unit says so:
+//! `angle_deg`); device units appear only in [`output`]. Indices are 0-based inside and
+//! 1-based only in messages.
+//!
+//! # Using the crate
+//!
+//! [`pipeline::pieces`], [`pipeline::plan`] and [`pipeline::cut`] run the stages on a
+//! [`spec::Spec`] ([`spec::load`]) for a [`profile::Profile`] ([`profile::find`]); each stage's
+//! entry point (`surface::build`, `flatten::charts::flatten`, `pattern::build`, `nest::nest`,
+//! `toolpath::plan`, `output::program`, `device::stream::send`) takes the previous stage's value
+//! and its own options.
+//!
+//! # Layout
+//!
+//! ```text
+//! lib.rs                       flatcut
+//! main.rs                      The `flatcut` binary
+//! pipeline.rs                  The one composer of the pipeline
+//! cli/
+//!   mod.rs                     Command line
+//!   args.rs                    Flag groups shared by several subcommands (`cut`, `flatten`, `fitting`, `nest`)
+//!   check.rs                   `flatcut check OBJ`
+//!   cut.rs                     `flatcut cut SPEC|OBJ`
+//!   fitting.rs                 `flatcut fitting KIND`
+//!   flatten.rs                 `flatcut flatten SPEC|OBJ`
+//!   link.rs                    What the subcommands that talk to a machine share
+//!   nest.rs                    `flatcut nest INSTANCE.json [--nest-time S] [--seed N] [--threads T] -o DIR`
+//!   ports.rs                   `flatcut ports` lists serial ports
+//!   send.rs                    `flatcut send FILE --device D [--port P]`
+//!   sim.rs                     `flatcut sim --device D -o DIR`
+//! device/
+//!   mod.rs                     Device stage
+//!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host ([`super::stream`]) and the simula…
+//!   serial.rs                  The serial transport
+//!   stream.rs                  Streaming a program into a device without ever overrunning it
+//!   sim/
+//!     mod.rs                   The simulated cutter
+//!     grbl.rs                  The simulated cutter's GRBL 1.1 interpreter
+//!     hpgl.rs                  The simulated cutter's HP-GL interpreter
+//!     record.rs                What the simulated cutter remembers of a job
+//! flatten/
+//!   mod.rs                     Flatten stage
+//!   distortion.rs              Distortion of a flat layout against its 3D surface
+//!   unfold.rs                  Exact unfolding of polyhedral meshes
+//!   charts/
+//!     mod.rs                   Flattening of a segmented smooth surface
+//!     darts.rs                 Darts and gussets (Julius 2006, thesis §5.2.3 "partial cuts from the boundaries toward the regi…
+//!   param/
+//!     mod.rs                   Parameterisation of nearly developable disk-topology charts
+//!     abf.rs                   ABF++ angles (Sheffer, Lévy, Mogilnitsky, Bogomyakov 2005)
+//! geom/
+//!   mod.rs                     Shared math for every stage
+//!   boolean.rs                 Polygon booleans and offsets on [`DVec2`] rings, through the `i_overlay` crate (pure Rust, MIT)
+//!   curve.rs                   Boundary curves for strips (issue 4, item 2)
+//!   cut.rs                     Cutting a chart of a mesh open into a topological disk (Julius 2006, thesis §5.2.3, "cuts conne…
+//!   font.rs                    Single-stroke vector font for piece labels and edge id numbers
+//!   heap.rs                    A binary-heap entry that pops the smallest key first, ties broken on the smaller id
+//!   hull.rs                    3D convex hulls with facet adjacency and orientation, and the local-convexity test of an edge (…
+//!   mesh.rs                    Polygon meshes and their edge adjacency
+//!   obj.rs                     Wavefront OBJ text of a mesh, optionally with texture coordinates
+//!   polygon.rs                 2D polygons
+//!   proxy.rs                   The DCS proxy and its fit (Julius 2006, thesis §4.3, eq
+//!   rng.rs                     The crate's one seeded random number generator
+//!   segment.rs                 Distances between points and segments, in 2D and 3D
+//!   unionfind.rs               Union-find (disjoint sets) over `0..n` with path halving
+//! nest/
+//!   mod.rs                     Nest stage
+//!   bench.rs                   The few solver steps that the benchmarks in `benches/nest.rs` time, behind a narrow public entr…
+//!   esicup.rs                  ESICUP strip-packing instances in the JSON form used by jagua-rs and sparrow (see `../shared/da…
+//!   problem.rs                 The nesting problem as data, independent of flatcut's pieces and of the ESICUP files
+//!   collision/
+//!     mod.rs                   Collision detection of the nest stage, in exact `f64` geometry, and the overlap measure the sep…
+//!     overlap.rs               The overlap proxy between two colliding shapes, after sparrow (Gardeyn, Vanden Berghe, Wauters,…
+//!     poles.rs                 Poles of inaccessibility of an item, after sparrow (Gardeyn, Vanden Berghe, Wauters, "An open-s…
+//!     shape.rs                 Shapes of the nest stage
+//!   solve/
+//!     mod.rs                   The solver
+//!     construct.rs             Constructive start
+//!     improve.rs               Improvement of a constructed layout by overlap minimisation, after sparrow (Gardeyn, Vanden Ber…
+//!     separate.rs              The separator of sparrow (Gardeyn, Vanden Berghe, Wauters, "An open-source heuristic to reboot …
+//!     state.rs                 The state of one search
+//! output/
+//!   mod.rs                     Output stage
+//!   dxf.rs                     DXF output for sheet-metal shops (issue 4, item 6)
+//!   files.rs                   Writing a run's files
+//!   gcode.rs                   GRBL 1.1 G-code programs (dialect `grbl`) for a drag knife on Z, a servo-lifted pen or a laser,…
+//!   obj.rs                     Wavefront OBJ writer
+//!   png.rs                     PNG output
+//!   report.rs                  `report.json`
+//!   svg.rs                     SVG output
+//!   hpgl/
+//!     mod.rs                   HP-GL programs, plain (dialect `hp-gl`) and Roland CAMM-GL mode 2 (dialect `camm-gl2`), one ins…
+//!     read.rs                  Reading HP-GL
+//! pattern/
+//!   mod.rs                     Pattern stage
+//!   allowance.rs               What a material adds to the border of a piece before it is cut (issue 8, item 2)
+//!   bends.rs                   Which joined edges of a flat become fold (score) or bend lines, and at which angle
+//!   marks.rs                   Marks that tell a person which edge goes where and which way up a piece goes
+//!   simplify.rs                Simplified seams for pieces laid out from D-Charts (issue 7, thesis §5.3 "Simplifying boundarie…
+//! profile/
+//!   mod.rs                     Device profiles, the configuration several stages read (toolpath, output, device)
+//!   read.rs                    Reading a profile
+//!   serial.rs                  Serial line settings and the protocol that paces a program into the device
+//!   tools.rs                   The tool table
+//! spec/
+//!   mod.rs                     The job spec
+//!   bent.rs                    The reader of `kind = "bent-sheet"` surfaces
+//!   boundary.rs                The reader of `kind = "boundary"` surfaces
+//!   context.rs                 The `FILE:LINE` and dotted-key context of the spec reader's messages
+//!   curves.rs                  Readers shared by several kinds of surface
+//!   mesh.rs                    The reader of `kind = "mesh"` surfaces
+//!   names.rs                   The names a user writes for the stages' enums
+//!   spanned.rs                 The spanned-value machinery of the spec reader
+//!   strip.rs                   The reader of `kind = "strip"` surfaces
+//!   tests.rs                   Tests of the spec reader
+//! surface/
+//!   mod.rs                     Surface stage
+//!   dcs.rs                     The DCS approximation (Julius 2006, thesis chapter 6, eq
+//!   fittings.rs                Sheet-metal fittings a shop makes every day (issue 4, item 3), each built as a developable stri…
+//!   material.rs                The material a pattern is cut from
+//!   obj.rs                     Polyhedral meshes from Wavefront OBJ files, read through `tobj`, keeping polygon faces (a plana…
+//!   segment.rs                 How a mesh surface is cut into pieces
+//!   solids.rs                  Small polyhedra for the example patterns in `patterns/` and for tests
+//!   source.rs                  The description of one surface to build, the input of [`crate::surface::build`]
+//!   boundary/
+//!     mod.rs                   Developable surfaces from a closed 3D boundary (Rose, Sheffer, Wither, Cani, Thibert 2007, seed…
+//!     bnb.rs                   §5 branch-and-bound on one simple loop (local vertex indices 0..m, in loop order), Fig
+//!     bounds.rs                §5.1.1 cover quality
+//!     charts.rs                §3 charts of a subloop's convex hull, its envelopes, and the subloops a cover leaves
+//!     checks.rs                Checks of the input boundary
+//!     darts.rs                 §6.1 darts
+//!     figures.rs               §4 metrics of a finished triangulation, for the report
+//!     loops.rs                 §6 several loops and §6.1 rulings
+//!     search.rs                The search of every region (§5), with the §7 radial offset and what happens when it finds nothi…
+//!   dcharts/
+//!     mod.rs                   D-Charts
+//!     creases.rs               Which meshes are segmented, and what a pattern scores inside a chart
+//!     disks.rs                 Charts made disks (Julius 2006, thesis §5.2.3, "cuts connecting the chart boundary loops")
+//!     grow.rs                  Chart growing (Julius 2006, thesis §5.2.1, eq
+//!     holes.rs                 Hole filling (Julius 2006, thesis §5.2.2)
+//!     merge.rs                 Merging (Julius 2006, thesis §5.2.3)
+//!     straighten.rs            Boundary straightening (Julius 2006, thesis §5.2.3, first post-processing step)
+//!   geodesic/
+//!     mod.rs                   Bent sheets
+//!     admissible.rs            Admissibility (§3.2, §3.3, §4.3)
+//!     bends.rs                 Bend lines from the rulings
+//!     control.rs               A piece's control curve (§4.1)
+//!     folds.rs                 The folds of one piece
+//!     mesh.rs                  The folded sheet as a mesh (§3.3 step 4, §3.4, §4.2)
+//!     path.rs                  The curve drawn on the flat sheet (§5
+//!     sheet.rs                 The flat sheet (§3.3)
+//!     spline.rs                Control curves as something to evaluate
+//!   strip/
+//!     mod.rs                   Developable triangulations of a strip (Wang & Tang, seed 003)
+//!     global.rs                The global searches (§5)
+//!     lanes.rs                 The data the cost rows of [`super::global`] run on
+//!     local.rs                 LODT + LMBT (§4)
+//!     offset.rs                A strip moved by a distance along its surface normals (a sheet's thickness
+//! toolpath/
+//!   mod.rs                     Toolpath stage
+//!   collect.rs                 The strokes of one sheet, unordered
+//!   knife.rs                   What a machine's tools need beyond the ordered design
+//!   order.rs                   Travel optimisation inside one group of strokes
+//!   weed.rs                    Weed lines for vinyl (and any material whose waste is peeled off the carrier)
+//! ```
 
 pub mod cli;
 pub mod device;

@@ -1,7 +1,17 @@
-//! Shared math for every stage: boundary curves sampled to a tolerance ([`curve`]), polygon meshes with edge adjacency ([`mesh`]), 2D polygons and
-//! their tests ([`polygon`]), and a single-stroke font for labels a pen or knife can draw
-//! ([`font`]). Millimetres and `f64` throughout (glam `DVec2`/`DVec3`).
-//! 3D convex hulls and the local-convexity test of an edge: [`hull`].
+//! Shared math for every stage, one kernel per file; it imports no other module of the crate.
+//! Millimetres and `f64` throughout (glam `DVec2`/`DVec3`).
+//!
+//! - [`mesh`]: polygon meshes, edge adjacency, Newell normals, signed dihedral angles.
+//! - [`obj`]: the Wavefront OBJ writer.
+//! - [`curve`]: boundary curves sampled to a tolerance, B-spline knots and derivatives.
+//! - [`polygon`], [`boolean`], [`segment`]: 2D polygons (area, triangulation, overlap, poles,
+//!   line crossings), their booleans and offsets, point and segment distances (2D and 3D).
+//! - [`hull`]: 3D convex hulls and the local-convexity test of an edge.
+//! - [`cut`], [`proxy`]: cutting a mesh chart open into a disk, and the developable proxy fit
+//!   (D-Charts), shared by the surface and flatten stages.
+//! - [`unionfind`], [`heap`]: disjoint sets and a smallest-first heap entry.
+//! - [`rng`]: the crate's one seeded random number generator.
+//! - [`font`]: the single-stroke font for labels a pen or knife can draw.
 
 pub mod boolean;
 pub mod curve;

@@ -168,7 +168,7 @@ impl Ctx<'_> {
                             toml::Value::String(s) if s.trim().eq_ignore_ascii_case("boundary") => {
                                 Fixed::Boundary
                             }
-                            toml::Value::Integer(n) if *n >= 1 => Fixed::Vertex(*n as usize),
+                            toml::Value::Integer(n) if *n >= 1 => Fixed::Vertex(*n as usize - 1),
                             _ => {
                                 return Err(bad(
                                     &format!("{key}.fixed"),

@@ -92,10 +92,11 @@ pub enum SurfaceError {
         line: Option<usize>,
         message: String,
     },
-    #[error("{}:{line}: vertex {index} has a coordinate that is not a finite number ({text}); fix or remove it", path.display())]
+    #[error("{}:{line}: vertex {} has a coordinate that is not a finite number ({text}); fix or remove it", path.display(), index + 1)]
     NonFinite {
         path: PathBuf,
         line: usize,
+        /// The vertex, 0-based (1-based in the message, as OBJ counts).
         index: usize,
         text: String,
     },

@@ -121,7 +121,7 @@ fn prescan(text: &str, path: &Path) -> Result<Vec<usize>, SurfaceError> {
                             return Err(SurfaceError::NonFinite {
                                 path: path.to_path_buf(),
                                 line: line_no,
-                                index: n_vertices + 1,
+                                index: n_vertices,
                                 text: (*c).to_string(),
                             })
                         }

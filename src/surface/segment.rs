@@ -52,6 +52,6 @@ pub struct ApproximateSpec {
 pub enum Fixed {
     /// Every vertex on the mesh boundary.
     Boundary,
-    /// A vertex by its 1-based number in the (welded) mesh.
+    /// A vertex of the (welded) mesh, 0-based (the spec numbers them from 1).
     Vertex(usize),
 }

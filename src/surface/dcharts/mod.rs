@@ -236,10 +236,11 @@ pub fn apply(
                         fixed.extend(e.verts);
                     }
                 }
-                Fixed::Vertex(n) if n >= 1 && n <= nv => fixed.push(n - 1),
-                Fixed::Vertex(n) => {
+                Fixed::Vertex(v) if v < nv => fixed.push(v),
+                Fixed::Vertex(v) => {
                     return Err(invalid(format!(
-                        "approximate.fixed names vertex {n}, but the mesh has {nv} vertices"
+                        "approximate.fixed names vertex {}, but the mesh has {nv} vertices",
+                        v + 1
                     )))
                 }
             }
