@@ -338,6 +338,36 @@ fn imports_run_down_the_pipeline() {
     );
 }
 
+#[test]
+fn no_subcommand_calls_another() {
+    // cli/<sub>.rs files parse their flags and call `pipeline`; what several share lives in
+    // cli/mod.rs, cli/args.rs and cli/link.rs.
+    let shared = ["args", "link"];
+    let mut bad = Vec::new();
+    for f in all_files() {
+        let me = module_of(&f);
+        if me.len() != 2 || me[0] != "cli" || shared.contains(&me[1].as_str()) {
+            continue;
+        }
+        for (line, path) in references(&f) {
+            if path.len() >= 2
+                && path[0] == "cli"
+                && path[1] != me[1]
+                && !shared.contains(&path[1].as_str())
+                && module_file(&path[..2]).is_some()
+            {
+                bad.push(format!(
+                    "{}:{line}: cli::{} uses {}",
+                    f.strip_prefix(src()).unwrap_or(&f).display(),
+                    me[1],
+                    path.join("::")
+                ));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
 /// The file that defines module `path` (`["surface", "dcharts"]`), if it is a module.
 fn module_file(path: &[String]) -> Option<PathBuf> {
     let mut p = src();
