@@ -60,7 +60,7 @@
 //!   sim.rs                     `flatcut sim --device D -o DIR`
 //! device/
 //!   mod.rs                     Device stage
-//!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host ([`super::stream`]) and the simula…
+//!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host (`super::stream`) and the simulate…
 //!   serial.rs                  The serial transport
 //!   stream.rs                  Streaming a program into a device without ever overrunning it
 //!   sim/
@@ -74,22 +74,22 @@
 //!   unfold.rs                  Exact unfolding of polyhedral meshes
 //!   charts/
 //!     mod.rs                   Flattening of a segmented smooth surface
-//!     darts.rs                 Darts and gussets (Julius 2006, thesis §5.2.3 "partial cuts from the boundaries toward the regi…
+//!     darts.rs                 Darts and gussets
 //!   param/
 //!     mod.rs                   Parameterisation of nearly developable disk-topology charts
 //!     abf.rs                   ABF++ angles (Sheffer, Lévy, Mogilnitsky, Bogomyakov 2005)
 //! geom/
-//!   mod.rs                     Shared math for every stage
-//!   boolean.rs                 Polygon booleans and offsets on [`DVec2`] rings, through the `i_overlay` crate (pure Rust, MIT)
+//!   mod.rs                     Shared math for every stage, one kernel per file
+//!   boolean.rs                 Polygon booleans and offsets on `DVec2` rings, through the `i_overlay` crate (pure Rust, MIT)
 //!   curve.rs                   Boundary curves for strips (issue 4, item 2)
 //!   cut.rs                     Cutting a chart of a mesh open into a topological disk (Julius 2006, thesis §5.2.3, "cuts conne…
 //!   font.rs                    Single-stroke vector font for piece labels and edge id numbers
 //!   heap.rs                    A binary-heap entry that pops the smallest key first, ties broken on the smaller id
 //!   hull.rs                    3D convex hulls with facet adjacency and orientation, and the local-convexity test of an edge (…
-//!   mesh.rs                    Polygon meshes and their edge adjacency
+//!   mesh.rs                    Polygon meshes and their edge adjacency, Newell normals (`newell`) and signed dihedral angles (…
 //!   obj.rs                     Wavefront OBJ text of a mesh, optionally with texture coordinates
 //!   polygon.rs                 2D polygons
-//!   proxy.rs                   The DCS proxy and its fit (Julius 2006, thesis §4.3, eq
+//!   proxy.rs                   The DCS proxy and its fit (Julius 2006, thesis §4.3, eq. 4.1 and eq. 5.4; §6.2.1, eq. 6.1)
 //!   rng.rs                     The crate's one seeded random number generator
 //!   segment.rs                 Distances between points and segments, in 2D and 3D
 //!   unionfind.rs               Union-find (disjoint sets) over `0..n` with path halving
@@ -145,16 +145,16 @@
 //!   tests.rs                   Tests of the spec reader
 //! surface/
 //!   mod.rs                     Surface stage
-//!   dcs.rs                     The DCS approximation (Julius 2006, thesis chapter 6, eq
+//!   dcs.rs                     The DCS approximation (Julius 2006, thesis chapter 6, eq. 6.1–6.3)
 //!   fittings.rs                Sheet-metal fittings a shop makes every day (issue 4, item 3), each built as a developable stri…
 //!   material.rs                The material a pattern is cut from
 //!   obj.rs                     Polyhedral meshes from Wavefront OBJ files, read through `tobj`, keeping polygon faces (a plana…
 //!   segment.rs                 How a mesh surface is cut into pieces
 //!   solids.rs                  Small polyhedra for the example patterns in `patterns/` and for tests
-//!   source.rs                  The description of one surface to build, the input of [`crate::surface::build`]
+//!   source.rs                  The description of one surface to build, the input of `crate::surface::build`
 //!   boundary/
 //!     mod.rs                   Developable surfaces from a closed 3D boundary (Rose, Sheffer, Wither, Cani, Thibert 2007, seed…
-//!     bnb.rs                   §5 branch-and-bound on one simple loop (local vertex indices 0..m, in loop order), Fig
+//!     bnb.rs                   §5 branch-and-bound on one simple loop (local vertex indices 0..m, in loop order), Fig. 9
 //!     bounds.rs                §5.1.1 cover quality
 //!     charts.rs                §3 charts of a subloop's convex hull, its envelopes, and the subloops a cover leaves
 //!     checks.rs                Checks of the input boundary
@@ -166,7 +166,7 @@
 //!     mod.rs                   D-Charts
 //!     creases.rs               Which meshes are segmented, and what a pattern scores inside a chart
 //!     disks.rs                 Charts made disks (Julius 2006, thesis §5.2.3, "cuts connecting the chart boundary loops")
-//!     grow.rs                  Chart growing (Julius 2006, thesis §5.2.1, eq
+//!     grow.rs                  Chart growing (Julius 2006, thesis §5.2.1, eq. 5.1–5.3)
 //!     holes.rs                 Hole filling (Julius 2006, thesis §5.2.2)
 //!     merge.rs                 Merging (Julius 2006, thesis §5.2.3)
 //!     straighten.rs            Boundary straightening (Julius 2006, thesis §5.2.3, first post-processing step)
@@ -177,15 +177,15 @@
 //!     control.rs               A piece's control curve (§4.1)
 //!     folds.rs                 The folds of one piece
 //!     mesh.rs                  The folded sheet as a mesh (§3.3 step 4, §3.4, §4.2)
-//!     path.rs                  The curve drawn on the flat sheet (§5
+//!     path.rs                  The curve drawn on the flat sheet (§5: a line for a geodesic, else a planar curve whose signed …
 //!     sheet.rs                 The flat sheet (§3.3)
 //!     spline.rs                Control curves as something to evaluate
 //!   strip/
 //!     mod.rs                   Developable triangulations of a strip (Wang & Tang, seed 003)
 //!     global.rs                The global searches (§5)
-//!     lanes.rs                 The data the cost rows of [`super::global`] run on
-//!     local.rs                 LODT + LMBT (§4)
-//!     offset.rs                A strip moved by a distance along its surface normals (a sheet's thickness
+//!     lanes.rs                 The data the cost rows of `super::global` run on
+//!     local.rs                 LODT + LMBT (§4), kept for comparison
+//!     offset.rs                A strip moved by a distance along its surface normals
 //! toolpath/
 //!   mod.rs                     Toolpath stage
 //!   collect.rs                 The strokes of one sheet, unordered

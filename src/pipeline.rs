@@ -1,6 +1,6 @@
 //! The one composer of the pipeline: spec → surfaces → flats → pieces → layout → job →
-//! programs → files. Every subcommand (`cli`), the integration tests and the benches run the
-//! stages through these functions; no stage calls another stage's entry point, and `cli`
+//! programs → files. Every subcommand (`cli`) and the integration tests run the stages
+//! through these functions (the benches time single stages on their own inputs); no stage calls another stage's entry point, and `cli`
 //! only parses flags, fills the options below and prints.
 //!
 //! - [`pieces`]: spec → surfaces → flats → pieces (surface, flatten and pattern stages).
@@ -377,11 +377,7 @@ pub fn nest_instance(
         seed: opts.seed,
         threads: opts.threads,
     };
-    let t0 = std::time::Instant::now();
     let sol = esicup::solve(&inst, &cfg)?;
-    if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
-        eprintln!("work {} in {:.2} s", sol.work, t0.elapsed().as_secs_f64());
-    }
     let dir = output.unwrap_or_else(|| default_dir(&inst.name));
     create_dir(&dir)?;
     let text = serde_json::to_string_pretty(&esicup::solution_json(&inst, &sol))

@@ -25,8 +25,12 @@ pub struct NestArgs {
 }
 
 pub fn run(a: &NestArgs) -> Result<(), Error> {
+    let t0 = std::time::Instant::now();
     let run = crate::pipeline::nest_instance(&a.input, &a.search.search()?, a.output.clone())?;
     let (inst, sol) = (&run.instance, &run.solution);
+    if std::env::var_os("FLATCUT_NEST_DEBUG").is_some() {
+        eprintln!("work {} in {:.2} s", sol.work, t0.elapsed().as_secs_f64());
+    }
     if !a.quiet {
         println!(
             "{}: {} items, strip {:.4} × {}, density {:.2} %; wrote {}: solution.json, layout.svg",

@@ -1,4 +1,5 @@
-//! Polygon meshes and their edge adjacency.
+//! Polygon meshes and their edge adjacency, Newell normals ([`newell`]) and signed dihedral
+//! angles ([`Mesh::signed_dihedral`]).
 //!
 //! A [`Mesh`] keeps polygon faces as they were modelled (a planar quad stays one face) with the
 //! source line of each face, so that later stages can name it in errors. [`Topology`] lists the

@@ -1,5 +1,6 @@
 //! 2D polygons: signed area, containment, convex hull, minimum-area bounding rectangle,
-//! ear-clipping triangulation and a separating-axis overlap test for triangles.
+//! ear-clipping triangulation, a separating-axis overlap test for triangles, and where a line
+//! crosses a polygon (`line_crossings`, `line_intervals`).
 //!
 //! Conventions: a polygon is a slice of points without the closing duplicate; counter-clockwise
 //! rings have positive area. Overlap tests take a tolerance: shapes that only touch (share an

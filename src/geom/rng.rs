@@ -76,7 +76,7 @@ mod tests {
 
     #[test]
     fn sequence_is_fixed_by_the_seed() {
-        // Recorded from the generator as it stood in nest/engine.rs: the layouts depend on it.
+        // Recorded from the generator as it stood in the nest stage before it moved here: the layouts depend on it.
         let mut r = Rng::new(1);
         assert_eq!(
             r.0,

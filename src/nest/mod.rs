@@ -16,7 +16,7 @@
 //!   see its docs for why.
 //! - [`esicup`]: the ESICUP benchmark instances (JSON as used by jagua-rs and sparrow), their
 //!   solutions and pictures, for `flatcut nest`.
-//! - [`bench`]: the few solver steps the benchmarks in `benches/nest.rs` time.
+//! - [`bench`](mod@bench): the few solver steps the benchmarks in `benches/nest.rs` time.
 //!
 //! flatcut's pieces: the polygon nested is the cut outline (`outline[0]`, with the holes
 //! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it (up to
@@ -31,7 +31,7 @@
 //! along the sheet's y axis as before.
 //!
 //! Units: [`Placement::rotation`] is in radians; the rotations a user allows ([`Rotations`])
-//! and the search's orientations ([`problem::Orient`], see why there) are in degrees.
+//! and the search's orientations ([`problem::Orient`], whose type doc says why) are in degrees.
 //!
 //! Same inputs, seed and thread count give the same layout: the searches count work instead
 //! of reading the clock (see `solve/state.rs`).

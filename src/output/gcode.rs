@@ -32,7 +32,7 @@
 //! no line here has more than [`LINE_MAX`] characters before its newline.
 //!
 //! Choices where the documents are silent:
-//! - Coordinates: every point goes through [`to_device`] (axes and units per
+//! - Coordinates: every point goes through [`super::to_device`] (axes and units per
 //!   mm, 1 for G-code) and is printed with [`fmt_mm`], at most 3 decimals of
 //!   its absolute value, so rounding never accumulates; a point repeated after rounding is sent
 //!   once; a one-point stroke is a `G1` to where the tool already is. Positions beyond

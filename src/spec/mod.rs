@@ -6,7 +6,7 @@
 //! device = "hpgl-pens"     # optional device profile name
 //!
 //! [[surface]]              # one or more
-//! kind = "mesh"            # required: "mesh", "strip" or "bent-sheet" (see below)
+//! kind = "mesh"            # required: "mesh", "strip", "bent-sheet" or "boundary"
 //! path = "cube.obj"        # required for mesh; relative to the spec file's directory
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"

@@ -13,8 +13,10 @@
 //!   Boundaries*: a boundary triangulation of closed 3D loops, with darts and rulings.
 //! - [`geodesic`]/: Bo & Wang 2007, *Geodesic-Controlled Developable Surfaces*: a flat sheet
 //!   bent along control curves (bent sheets).
-//! - [`dcharts`]: Julius 2006, D-Charts: a smooth mesh segmented into nearly developable charts.
+//! - [`dcharts`]/: Julius 2006, D-Charts: a smooth mesh segmented into nearly developable charts.
 //! - [`dcs`]: Julius 2006, §6 DCS approximation: a mesh moved towards a developable one.
+//! - [`source`], [`material`], [`segment`]: what a surface is built from (the spec's
+//!   reader fills them): the surface description, the material, the D-Charts options.
 
 pub mod boundary;
 pub mod dcharts;

@@ -2,7 +2,7 @@
 //! meshes (fandisk, cylinder, mushroom), generated developables, a 30° spherical cap, broken
 //! inputs, and the command line (`--segment dcharts --uv-obj`).
 //!
-//! Figures are printed (`cargo test --release --test dcharts -- --nocapture`) for the issue
+//! Figures are printed (`cargo test --test suite dcharts:: -- --nocapture`) for the issue
 //! note.
 
 use crate::common::*;
@@ -161,7 +161,7 @@ fn mushroom_charts_and_stretch() {
         seg.count, flat.islands.len(), s.l2, s.linf, worst, s.flipped
     );
     check_flat(&flat);
-    // The whole disk against libigl's LSCM (L2 2.585) is `param`'s acceptance (tests/param.rs).
+    // The whole disk against libigl's LSCM (L2 2.585) is `param`'s acceptance (tests/suite/param.rs).
     assert!(s.l2.is_finite() && s.l2 >= 1.0 && s.l2 < whole.stretch.l2);
     assert_eq!(s.flipped, 0);
 }

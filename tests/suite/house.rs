@@ -477,7 +477,7 @@ fn stages_use_only_public_items_of_other_modules() {
 
 #[test]
 fn no_cycle_between_the_files_of_a_module() {
-    // Edges between sibling submodules (`nest::problem` → `nest::construct`); a module's
+    // Edges between sibling submodules (`nest::solve::improve` → `nest::solve::separate`); a module's
     // mod.rs (its parent) is left out: children naming their parent's types is no cycle.
     let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
     for f in all_files() {

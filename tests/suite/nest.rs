@@ -319,7 +319,7 @@ fn nest_command_writes_solution_and_rejects_bad_instances() {
 }
 
 /// Checks solution files written by `flatcut nest` (e.g. the 60 s runs for the issue note):
-/// `NEST_SOLUTIONS=/tmp/nest- cargo test --test nest -- --ignored` reads
+/// `NEST_SOLUTIONS=/tmp/nest- cargo test --test suite nest:: -- --ignored` reads
 /// `/tmp/nest-<instance>/solution.json` for each instance present.
 #[test]
 #[ignore]

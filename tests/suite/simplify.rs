@@ -3,7 +3,7 @@
 //! (`simplify = 0` and the tolerance under test) and compared piece by piece; bad spec values;
 //! the report.
 //!
-//! Figures are printed (`cargo test --release --test simplify -- --nocapture`).
+//! Figures are printed (`cargo test --test suite simplify:: -- --nocapture`).
 
 use crate::common::*;
 use flatcut::flatten::Flat;

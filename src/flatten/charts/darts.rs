@@ -36,7 +36,7 @@ pub(super) const DART_MIN_FACES: usize = 24;
 /// and the tip is its largest value among inner vertices farther from every earlier dart's tip
 /// than that dart is long (a seam relieves a disc of its own length around its tip). The path:
 /// the shortest from the chart's boundary (cuts included) to the tip, bent edges counting
-/// shorter (as the seams of [`disk_cuts`]).
+/// shorter (as the seams of [`crate::geom::cut::disk_cuts`]).
 pub(super) fn darts(
     ctx: &Charts,
     laid: &mut Laid,
@@ -249,7 +249,7 @@ fn path_length(ctx: &Charts, path: &[usize]) -> f64 {
 /// kept only when the chart and its gussets together have a lower L2 than the chart had, no
 /// flip, no overlap, and every gusset is within the tolerance. A slit that opens after all
 /// (no overlap) is kept as a dart when it lowers L2. Returns the gussets (laid, marked for
-/// [`reattach`]).
+/// [`super::reattach`]).
 pub(super) fn gussets(ctx: &Charts, laid: &mut Laid, opts: &FlattenOptions, eps: f64) -> Vec<Laid> {
     let mut out: Vec<Laid> = Vec::new();
     let mut tips: Vec<(usize, f64)> = Vec::new();

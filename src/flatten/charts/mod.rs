@@ -31,7 +31,7 @@
 //!   (`split_between` of [`crate::geom::cut`]: each face goes with the nearer of the two,
 //!   through the chart); a chart that needed seams to be a disk (a tube whose layout
 //!   spirals over itself) is halved along the bisector instead;
-//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts` below: up
+//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts ([`darts`]: up
 //!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
 //!   region, then shortened while it stays within the tolerance), then gussets where the
 //!   surface is saddle-shaped ([`gussets`]: a slit toward the most negative angle defect

@@ -12,17 +12,8 @@
 //! iterative refinement (the normal equations square the condition number; refined, an
 //! exactly developable chart comes out isometric to ~1e-11 relative).
 //!
-//! **ABF++.** Unknowns: the 3 angles α of every triangle. Targets β: the 3D angles, scaled at
-//! each interior vertex so they sum to 2π (ABF, Sheffer & de Sturler 2001). Energy Σ (α − β)²/β²
-//! under the constraints: triangle sums π, interior vertex sums 2π, and the wheel (law of sines)
-//! condition Σ log sin α_next − Σ log sin α_prev = 0 around each interior vertex (the log form of
-//! the paper's product, same zero set, better scaled). Newton steps on the Lagrangian with the
-//! Hessian approximated by its diagonal Λ = 2/β² (ABF++ §4.1); each step is solved through the
-//! ABF++ reduction: the triangle constraints (J₁, whose J₁Λ⁻¹J₁ᵀ is diagonal) are eliminated, and
-//! only the Schur complement J₂Λ⁻¹J₂ᵀ − BᵀD⁻¹B over the 2 × (interior vertices) vertex and
-//! wheel multipliers is factored (sparse Cholesky) (ABF++ §4.2, eq. 12–16). Angles → coordinates
-//! as ABF++ §5 does: the LSCM energy with each triangle's shape built from its angles (law of
-//! sines), same two pins.
+//! **ABF++** ([`abf`]): the angles of every triangle solved for, then turned into coordinates
+//! by the LSCM energy with each triangle's shape built from its angles, same two pins.
 //!
 //! Choices where the papers are silent:
 //! - **Pins**: the two boundary vertices farthest apart in 3D (ties: the lowest local indices,

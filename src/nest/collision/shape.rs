@@ -66,7 +66,7 @@ pub(crate) struct Shape {
     pub mids: Vec<DVec2>,
     pub poles: Vec<(DVec2, f64)>,
     /// The poles again, one array per coordinate, padded with empty circles far away, for
-    /// the vectorised [`overlap_proxy`].
+    /// the vectorised [`super::overlap_proxy`].
     pub lanes: PoleLanes,
     pub size: DVec2,
     /// Area of the material.
@@ -184,7 +184,7 @@ pub(crate) struct PoleLanes {
     pub r: [f64; POLE_LANES],
 }
 
-/// Lanes of [`PoleLanes`]: the most poles an item keeps ([`poles`]).
+/// Lanes of [`PoleLanes`]: the most poles an item keeps ([`super::poles`]).
 pub(crate) const POLE_LANES: usize = 12;
 
 impl PoleLanes {

@@ -15,7 +15,7 @@
 //! ```
 //!
 //! Coordinates are absolute, in plotter units: each point goes through
-//! [`to_device`] (the profile's axes and units per mm, 40 for HP-GL's
+//! [`super::to_device`] (the profile's axes and units per mm, 40 for HP-GL's
 //! 0.025 mm plotter unit) and is rounded once, from the absolute position, so rounding never
 //! accumulates. A point repeated after rounding is sent once. A stroke of one point is a dot:
 //! `PU x,y;` then `PD x,y;`.
@@ -51,6 +51,9 @@
 //!   instruction. A stroke kind the profile has no tool for is left out; a tool without `pen`
 //!   is an error, as is a coordinate beyond ±(2^23 − 1) plotter units in plain HP-GL (a
 //!   conservative bound: HP-GL devices differ, 2^23 units is 209 m at 40 per mm).
+//!
+//! [`read`] is the one HP-GL reader (instructions, numbers, pen-down paths) that the tests and
+//! the simulated cutter use.
 
 use super::{device_points, one_line, stroke_tool, tool_error, OutputError};
 use crate::profile::{Profile, Tool};

@@ -59,7 +59,7 @@ pub struct ParsedStroke {
     pub points: Vec<(i64, i64)>,
 }
 
-/// Read back the pen-down paths of a program made by [`emit`]: absolute `PU`/`PD`/`PA`, `SP`,
+/// Read back the pen-down paths of a program made by [`super::emit`]: absolute `PU`/`PD`/`PA`, `SP`,
 /// `VS`, `FS` and Roland's `!FS`; `IN` resets pen, velocity and force. Other instructions
 /// (a profile's `init` and `end` lines) are skipped, except `PR`, whose relative moves this
 /// reader does not follow. For tests and reports; the full interpreter is the simulated

@@ -1,5 +1,5 @@
 //! Hole filling (Julius 2006, thesis §5.2.2): the faces no chart reached within `F_max` form
-//! connected holes; a hole larger than [`DChartsOptions::small_hole`] of the total area (or one
+//! connected holes; a hole larger than [`super::DChartsOptions::small_hole`] of the total area (or one
 //! no chart touches) gets a new chart grown inside it, again and again while new holes
 //! appear; the small ones are then grown into by the charts around them without the `F_max`
 //! bound.

@@ -14,7 +14,7 @@
 //!   cannot help;
 //! - `merge`: merging adjacent charts whose common boundary fits a cylinder (§5.2.3, `η`);
 //! - `creases`: which meshes are segmented at all ([`is_smooth`]) and the creases inside a
-//!   chart that a pattern scores ([`creases`]).
+//!   chart that a pattern scores (`creases`).
 //!
 //! [`apply`] reads a mesh surface's spec settings (the DCS approximation of chapter 6 first,
 //! [`super::dcs`]) and stores the charts, their cuts and creases on the [`super::Surface`].

@@ -1,6 +1,5 @@
 //! Admissibility (§3.2, §3.3, §4.3).
 //!
-//!
 //! Two neighbouring rulings meet at the discrete curve of regression (eq. 2–5: the limit of this
 //! intersection is `l(s) = sin α / α'` along the ruling). A sheet is refused when that point
 //! lies on the sheet (eq. 6), with the arc length along the line (mm), its distance from the

@@ -2,7 +2,6 @@
 //! into regions (a planar subdivision by half-edges), each region is moved rigidly by the folds
 //! between it and the region holding the first piece's start, and triangulated.
 //!
-//!
 //! Regions the rulings do not reach (corners beyond the first and last ruling, the sheet beyond
 //! the line's ends, the sheet between several curved pieces) are simply not folded: they stay
 //! planar and join the curved part tangentially along its end ruling (§3.4, §4.2). Several

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-/// Columns per chunk in [`Strip::cost_row`].
+/// Columns per chunk in [`super::Strip::cost_row`].
 pub(super) const LANES: usize = 4;
 
 /// Vectors stored one array per axis (structure of arrays), padded with zeros to a whole
@@ -125,7 +125,7 @@ impl Tris {
     }
 
     /// The P-step triangles after the bridges from `p` (bank `e1` to the next point):
-    /// `e1 × (q_j − p)`, the expression [`Strip::cost_row`] computes them with.
+    /// `e1 × (q_j − p)`, the expression [`super::Strip::cost_row`] computes them with.
     pub(super) fn after_p(&mut self, cols: &Columns, p: DVec3, e1: DVec3) {
         for j in 0..self.x.len() {
             let (dx, dy, dz) = (cols.q.x[j] - p.x, cols.q.y[j] - p.y, cols.q.z[j] - p.z);
@@ -176,7 +176,7 @@ pub(super) struct Costs {
 }
 
 impl Costs {
-    /// Room for `len` nodes; the values left are overwritten by [`Strip::cost_row`].
+    /// Room for `len` nodes; the values left are overwritten by [`super::Strip::cost_row`].
     pub(super) fn resize(&mut self, len: usize) {
         self.invalid.resize(len, false);
         for w in self.w.iter_mut().flatten() {

@@ -1,5 +1,3 @@
-//! LODT + LMBT (§4).
-//!
 //! LODT + LMBT (§4), kept for comparison: the greedy walk; when neither successor is valid it
 //! finds the nearest valid bridge `E_{i',j'}` with i' > i and j' > j (fewest steps, then the
 //! one most balanced between P and Q, then smaller i'), or the ending bridge if there is
