@@ -124,7 +124,7 @@ impl Link {
         self.port.read_clear_to_send().unwrap_or(true)
     }
 
-    /// Write some of `bytes`; `Ok(0)` when the port would not take any within [`POLL`].
+    /// Write some of `bytes`; `Ok(0)` when the port would not take any within `POLL`.
     pub fn write_some(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
         match self.port.write(bytes) {
             Ok(0) => Err(std::io::Error::new(

@@ -1,6 +1,6 @@
 //! Streaming a program into a device without ever overrunning it.
 //!
-//! - **Buffered** (HP-GL cutters): the program goes out in chunks of at most [`CHUNK`] bytes,
+//! - **Buffered** (HP-GL cutters): the program goes out in chunks of at most `CHUNK` bytes,
 //!   paced at the line rate (baud / 10 bytes a second) so that no more than two chunks are in
 //!   the kernel's queue when the device asks to stop. XON/XOFF: after every chunk the input is
 //!   read; XOFF stops sending until XON. RTS/CTS: CTS is checked before every chunk. Without

@@ -12,7 +12,7 @@
 //! - The flat layout is first scaled uniformly so that its area equals the 3D area (Sander
 //!   §3: "we normalise"), so 1.0 means isometric whatever the layout's units.
 //! - Whole-chart figures are weighted by 3D triangle area: L2 = √(Σ A·L2(T)² / Σ A), L∞ = max
-//!   Γ; [`combine`] does the same across charts (L2 in quadrature, L∞ the maximum).
+//!   Γ; `combine` does the same across charts (L2 in quadrature, L∞ the maximum).
 //! - Shear per triangle is (Γ − γ)/(Γ + γ): 0 for a conformal (angle-keeping) map, towards 1 for
 //!   a triangle squashed flat; it does not depend on how the layout is rotated. L2 shear is its
 //!   area-weighted root mean square. (ABF++ reports an L2 shear without restating the formula;
@@ -21,7 +21,7 @@
 //!   in [`Stretch::flipped`]; a flat triangle of zero area makes L2 and L∞ infinite (never NaN).
 //!   A face whose `uv` does not have one point per corner, or whose index is out of range, is
 //!   not measured and is counted as flipped, so a broken layout can never pass as isometric.
-//! - Polygon faces are measured through the triangles of [`face_triangles`] (ear clipping in
+//! - Polygon faces are measured through the triangles of `face_triangles` (ear clipping in
 //!   the face's plane), the same triangles `param` flattens.
 
 use crate::geom::mesh::Mesh;
@@ -29,7 +29,7 @@ use crate::geom::polygon;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
-/// Distortion figures of a flat layout (one chart, or a whole surface via [`combine`]).
+/// Distortion figures of a flat layout (one chart, or a whole surface via `combine`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Stretch {
     /// Area-weighted L2 stretch (1.0 = isometric).
@@ -220,7 +220,7 @@ pub(crate) fn corner_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// Angle defect per vertex: 2π − Σ corner angles for interior vertices (every edge around
 /// them shared by exactly two faces), 0 on the boundary, at non-manifold edges and for unused
-/// vertices. Polygon corners are summed over the triangles of [`face_triangles`].
+/// vertices. Polygon corners are summed over the triangles of `face_triangles`.
 pub fn angle_defect(mesh: &Mesh) -> Vec<f64> {
     let nv = mesh.vertices.len();
     let mut sum = vec![0.0; nv];

@@ -2,7 +2,7 @@
 //! 3D↔2D correspondence (every face keeps its mesh index; every edge knows whether its two
 //! faces stay joined in the plane and by how much the surface bends there).
 //!
-//! [`unfold`] is the exact unfolding of polyhedral (developable) meshes. [`param`] flattens
+//! [`unfold`](mod@unfold) is the exact unfolding of polyhedral (developable) meshes. [`param`] flattens
 //! nearly developable disk-topology charts (LSCM / ABF++) and [`distortion`] measures any flat
 //! layout against its mesh (L2 / L∞ stretch, shear, angle defect).
 

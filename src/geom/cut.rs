@@ -11,13 +11,13 @@
 //!   path between its two rims, a sphere with holes a tree of such paths, a closed shell one
 //!   path between two far-apart vertices; a chart with handles (genus g > 0) is cut open
 //!   along 2g loops as well (tree–cotree, Eppstein 2003, with the greedy shortest system of
-//!   loops of Erickson and Whittlesey 2005). Bent edges count shorter ([`cut_weight`]), so
+//!   loops of Erickson and Whittlesey 2005). Bent edges count shorter (`cut_weight`), so
 //!   seams follow creases.
 //! - `bisect` and `split_between`: a chart that cutting cannot make a disk (faces joined only
 //!   through a vertex, a non-manifold edge) or whose layout overlaps is split in two through
 //!   the face graph.
 //!
-//! Choices where the thesis is silent: the cut weight (an edge bent by [`SHARP_DEG`] or more
+//! Choices where the thesis is silent: the cut weight (an edge bent by `SHARP_DEG` or more
 //! costs a quarter of its length); the roots (the boundary loop through the lowest boundary
 //! vertex, or on a closed chart its lowest vertex); ties break on the smaller index
 //! everywhere, so cuts are deterministic.
@@ -429,8 +429,8 @@ fn trace(topo: &Topology, via: &[(usize, usize)], mut v: usize) -> Vec<usize> {
 /// already joined to the nearest loop not yet joined), a closed shell one path between two
 /// vertices far apart (the second farthest from the first, the first farthest from the
 /// chart's lowest vertex). Paths run along chart edges, bent edges counting shorter
-/// ([`cut_weight`]). A chart with handles (V − E + F = 2 − 2g − b, g > 0) then gets its 2g
-/// generator loops cut too ([`handle_cuts`]; on a closed chart they replace the path). Empty
+/// (`cut_weight`). A chart with handles (V − E + F = 2 − 2g − b, g > 0) then gets its 2g
+/// generator loops cut too (`handle_cuts`; on a closed chart they replace the path). Empty
 /// when the chart already is a disk; `None` when cutting cannot make it one (faces not
 /// connected through edges, or a non-manifold edge): the caller splits it.
 pub fn disk_cuts(

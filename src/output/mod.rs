@@ -1,5 +1,5 @@
 //! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
-//! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in [`gcode`]), an SVG
+//! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in `gcode`), an SVG
 //! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
 //! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
@@ -9,7 +9,7 @@
 //!
 //! Choices shared by the encoders and kept in this module so that they agree:
 //! - SVG and PNG: the colour and dash pattern of each [`StrokeRole`], and the drawing order
-//!   ([`DRAW_ORDER`]: labels, marks, valley folds, mountain folds, cuts — cuts end up on top).
+//!   (`DRAW_ORDER`: labels, marks, valley folds, mountain folds, cuts — cuts end up on top).
 //! - HP-GL and G-code: the sheet-to-machine transform [`to_device`] (DESIGN.md "Devices": the
 //!   profile's axes and units), applied to every absolute position, which each encoder then
 //!   rounds once (plotter units, or 3 decimals of a mm with [`fmt_mm`]) — rounding never
@@ -195,7 +195,7 @@ pub(crate) fn device_points(
 }
 
 /// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
-/// ([`hpgl::emit`]), or GRBL G-code ([`gcode::emit`]), by `profile.language` and
+/// (`hpgl::emit`), or GRBL G-code (`gcode::emit`), by `profile.language` and
 /// `profile.dialect`.
 pub fn program(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     match profile.language {

@@ -1,15 +1,15 @@
 //! PNG output: a raster preview of one sheet of a job.
 //!
 //! Choices:
-//! - The canvas is the sheet plus a [`BORDER_MM`] white border on every side, at `px_per_mm`
+//! - The canvas is the sheet plus a `BORDER_MM` white border on every side, at `px_per_mm`
 //!   ([`DEFAULT_PX_PER_MM`] unless the caller asks otherwise). If the longer side would exceed
-//!   [`MAX_SIDE_PX`], the scale is reduced so that it fits: a preview of a 10 m roll is still
+//!   `MAX_SIDE_PX`, the scale is reduced so that it fits: a preview of a 10 m roll is still
 //!   drawn, just coarser, rather than failing or allocating gigabytes.
 //! - A sheet with a zero, negative or non-finite size, a scale that is not a positive finite
 //!   number, or a canvas that cannot be allocated gives [`OutputError::Picture`].
-//! - White background, sheet outline light grey, then the strokes in [`DRAW_ORDER`] (labels,
+//! - White background, sheet outline light grey, then the strokes in `DRAW_ORDER` (labels,
 //!   marks, valley folds, mountain folds, cuts on top), colours and dash patterns as in the SVG
-//!   (see `role_style` in the module root). Lines are [`LINE_MM`] wide but at least 1 px,
+//!   (see `role_style` in the module root). Lines are `LINE_MM` wide but at least 1 px,
 //!   anti-aliased, round caps and joins. Dash lengths are the mm values times the scale; when a
 //!   line had to be widened to 1 px, its dashes grow by the same factor so that the pattern
 //!   stays readable.
@@ -45,7 +45,7 @@ const SHEET_OUTLINE_MM: f64 = 0.2;
 const SHEET_GREY: u8 = 0xc0;
 
 /// Renders sheet `index` of a job (the index is only used in errors) as PNG bytes at
-/// `px_per_mm`, reduced if needed so that neither side exceeds [`MAX_SIDE_PX`].
+/// `px_per_mm`, reduced if needed so that neither side exceeds `MAX_SIDE_PX`.
 pub fn render(sheet: &SheetJob, index: usize, px_per_mm: f64) -> Result<Vec<u8>, OutputError> {
     let picture_error = |w: f64, h: f64| OutputError::Picture {
         sheet: index,

@@ -4,10 +4,10 @@
 //! Choices:
 //! - Units are millimetres: `width`/`height` carry `mm` and the `viewBox` is in mm, so one user
 //!   unit is one mm and coordinates are the job's own numbers (printed by [`fmt_mm`]).
-//! - Sheets sit left to right with a [`SHEET_GAP_MM`] gap, tops aligned; the document is as
+//! - Sheets sit left to right with a `SHEET_GAP_MM` gap, tops aligned; the document is as
 //!   high as the highest sheet. The y axis is flipped per sheet: `y_svg = sheet.height - y`.
 //! - One Inkscape layer per role, always all of them even when empty, in the order `sheet`
-//!   (outlines, locked), then [`DRAW_ORDER`]: `label`, `mark`, `fold-valley`, `fold-mountain`,
+//!   (outlines, locked), then `DRAW_ORDER`: `label`, `mark`, `fold-valley`, `fold-mountain`,
 //!   `cut`, so cuts are drawn on top. Styles are presentation attributes on the layer group;
 //!   paths carry only geometry, `data-sheet` and, when known, `data-piece`.
 //! - Each stroke is one `<path>` (`M x y L x y …`); a closed stroke drops its repeated end point

@@ -9,7 +9,7 @@
 //! added to each of its two neighbours. Vertices are collapsed cheapest first.
 //!
 //! **Choices where the thesis is silent.**
-//! - *What is simplified:* only the interior vertices of seam chains ([`super::marks::find`]):
+//! - *What is simplified:* only the interior vertices of seam chains (`super::marks::find`):
 //!   a chain of border vertices shared by two pieces, or by the two sides of a cut inside one
 //!   chart. Chain ends (where three or more sides meet, or a seam meets the free boundary) stay,
 //!   and so does every border vertex where a fold line ends. The free boundary (the mesh's own
@@ -35,7 +35,7 @@
 //!   three vertices. The outline therefore stays simple and clear of its holes and folds.
 //! - *Marks:* seam ids, notches and registration marks are placed after simplification, on
 //!   the simplified chains, side B's notches at the same fractions of its length as side A's
-//!   ([`super::marks::place`]).
+//!   (`super::marks::place`).
 //! - *Bookkeeping:* a simplified border segment stands for a run of mesh edges;
 //!   `border_edges` and `border_faces` keep those of the first. A seam side's `length` becomes
 //!   the length of its simplified chain (what is cut and sewn).

@@ -122,7 +122,7 @@ pub struct Profile {
     pub description: String,
     pub language: Language,
     /// HP-GL: `hp-gl` or `camm-gl2` (Roland CAMM-GL, mode 2: the HP-GL-like instruction set of
-    /// Roland's cutters; see [`HPGL_DIALECTS`]). G-code: `grbl`.
+    /// Roland's cutters; see `HPGL_DIALECTS`). G-code: `grbl`.
     pub dialect: String,
     pub units_per_mm: f64,
     /// Largest width the machine can cut (mm); 0 when unknown.

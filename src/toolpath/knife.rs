@@ -16,9 +16,9 @@
 //! (the tip strays by about r·θ²/8: 0.001 mm at 10° and 0.25 mm). The blade keeps its direction
 //! while lifted, so it is carried from stroke to stroke, and each stroke starts with a swivel
 //! from the carried direction. Its first direction on a sheet is made known by an alignment
-//! precut: [`PRECUT_MM`] along +x in the margin, near the origin, before anything else.
+//! precut: `PRECUT_MM` along +x in the margin, near the origin, before anything else.
 //!
-//! Choices where Inkcut is silent or differs: arcs are polylines of at most [`ARC_STEP_DEG`]
+//! Choices where Inkcut is silent or differs: arcs are polylines of at most `ARC_STEP_DEG`
 //! per step (holder chord error 0.001 mm at 0.25 mm offset, below one plotter unit); when a
 //! tool makes more than one pass, every compensated stroke ends with a swivel back to the
 //! direction it started with, so that the encoder's repeat (a closed path goes round again, an
@@ -29,7 +29,7 @@
 //! **Overcut**: a closed cut contour continues past its start along its own first edges for
 //! `overcut` mm, so that the last cut meets the first whatever the blade did on entering.
 //!
-//! **Folds** use the tool [`fold_kind`](super::fold_kind) picks; with the perforate tool each
+//! **Folds** use the tool `fold_kind` picks; with the perforate tool each
 //! fold is cut as dashes of `perforation = [cut_mm, skip_mm]`, starting with a cut at its start
 //! and ending with whatever part of a cut is left at its end.
 
@@ -59,7 +59,7 @@ pub struct MachineOptions {
     pub multi_pass_kinds: Vec<StrokeKind>,
     /// Closed cut contours go on this far past their start, mm.
     pub overcut: f64,
-    /// Where the alignment precut starts (sheet mm); it runs [`PRECUT_MM`] along +x.
+    /// Where the alignment precut starts (sheet mm); it runs `PRECUT_MM` along +x.
     pub precut_at: DVec2,
 }
 

@@ -12,7 +12,7 @@
 //! The ordered job is the design (what the SVG and PNG show). What a machine's tools need on top
 //! of it — folds as perforation dashes, overcut, drag-knife offset compensation with an
 //! alignment precut — is [`knife::prepare`], applied to the job that is encoded. Which tool makes
-//! a fold is [`fold_kind`]: the scoring tool, else the perforating one, else the pen.
+//! a fold is `fold_kind`: the scoring tool, else the perforating one, else the pen.
 //! [`weed`] adds weed lines for vinyl.
 //!
 //! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); notches
@@ -102,7 +102,7 @@ pub(crate) fn fold_kind(has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> 
 }
 
 /// The tool kind that makes a stroke of `role` on a device with the kinds `has` accepts
-/// (folds: [`fold_kind`]; the rest: [`StrokeRole::kind`] if the device has it).
+/// (folds: `fold_kind`; the rest: [`StrokeRole::kind`] if the device has it).
 pub fn tool_kind(role: StrokeRole, has: impl Fn(StrokeKind) -> bool) -> Option<StrokeKind> {
     match role.kind() {
         StrokeKind::Score => fold_kind(has),

@@ -13,15 +13,15 @@
 //!    the run of strokes at positions `i..=j` reverses each open stroke in it and replaces the
 //!    travel edges `(exit[i-1], entry[i])` and `(exit[j], entry[j+1])` by `(exit[i-1], exit[j])`
 //!    and `(entry[i], entry[j+1])`; the travel inside the run is unchanged. Candidate moves come
-//!    from the [`NEIGHBOURS`] nearest stroke ends of each end (an improving move shortens at
+//!    from the `NEIGHBOURS` nearest stroke ends of each end (an improving move shortens at
 //!    least one of its two edges, so one of its new edges joins two near neighbours), and a run
-//!    is at most [`WINDOW`] strokes long, so a move costs O(WINDOW) at most.
+//!    is at most `WINDOW` strokes long, so a move costs O(WINDOW) at most.
 //! 3. **Closed strokes re-pick their entry vertex**: the vertex that minimises the travel in and
-//!    out, with the neighbours fixed. Steps 2 and 3 alternate for at most [`ROUNDS`] rounds.
+//!    out, with the neighbours fixed. Steps 2 and 3 alternate for at most `ROUNDS` rounds.
 //!
-//! Choices where the sources are silent: the bounds are counts ([`PASSES`] sweeps of 2-opt per
-//! round, [`ROUNDS`] rounds), never time, so that the result never depends on the machine's
-//! load; a move must gain more than [`EPS`] mm; ties go to the lower index. The caller keeps the
+//! Choices where the sources are silent: the bounds are counts (`PASSES` sweeps of 2-opt per
+//! round, `ROUNDS` rounds), never time, so that the result never depends on the machine's
+//! load; a move must gain more than `EPS` mm; ties go to the lower index. The caller keeps the
 //! group's original order when that travels less ([`order`] does).
 
 use super::Stroke;

@@ -18,7 +18,7 @@
 //! several tools qualify, the one whose setting is nearest wins. Profiles without such tools
 //! (plain G-code) count Z < 0 as down.
 //!
-//! Motion time: `G1` at `F` (mm/min), `G0` at [`RAPID_MM_MIN`], `G4` its `P`.
+//! Motion time: `G1` at `F` (mm/min), `G0` at `RAPID_MM_MIN`, `G4` its `P`.
 
 use super::record::Recorder;
 use crate::profile::Profile;

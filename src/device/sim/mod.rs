@@ -13,7 +13,7 @@
 //!   buffer (at least 16 bytes, at most 256), XON (0x11) when it is back under a quarter full.
 //!   RTS/CTS: the same thresholds drop and raise CTS; a pty has no modem lines, so CTS is a
 //!   shared flag ([`SimHandle::cts`]) that flatcut's transport reads in place of the real
-//!   line. After asking the host to stop, the simulator still takes up to [`SKID`] bytes (a
+//!   line. After asking the host to stop, the simulator still takes up to `SKID` bytes (a
 //!   UART FIFO's worth) and then leaves the rest in the pty, as a stopped transmitter would
 //!   hold it. A host that ignores the stop is caught: the bytes waiting in the pty must stop
 //!   growing within [`STOP_GRACE`] of the stop, or the growth is counted as
@@ -23,13 +23,13 @@
 //! - **Execution.** HP-GL instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the
-//!   interpreters compute ([`hpgl`], [`grbl`]) divided by the time factor (`None`: no time).
+//!   interpreters compute (`hpgl`, [`grbl`]) divided by the time factor (`None`: no time).
 //!   GRBL real-time bytes (`?`, `!`, `~`, Ctrl-X) act on arrival and are never buffered.
 //! - **Faults** for tests ([`Faults`]): hang up after N bytes, stall (stop reading and
 //!   executing) after N bytes, send garbage after N bytes, lose the XONs, answer a given
 //!   GRBL line with `error:N`.
 //!
-//! Everything it cuts is recorded ([`record`]) and, on [`SimHandle::finish`], summarised in a
+//! Everything it cuts is recorded (`record`) and, on [`SimHandle::finish`], summarised in a
 //! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
 
 pub mod grbl;

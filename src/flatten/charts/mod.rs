@@ -22,19 +22,19 @@
 //! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
 //! material's tolerance"), a chart
 //! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap) has
-//!   the overlapping region cut off ([`cut_off`], after Lévy et al. 2002, the thesis' [22]:
+//!   the overlapping region cut off (`cut_off`, after Lévy et al. 2002, the thesis' ref. 22:
 //!   the overlapping faces are sorted to the nearer of the two first found overlapping, the
 //!   side with less overlapping area is cut off, again while the rest still overlaps) when
-//!   that part has at most [`CUT_OFF_AREA`] of the chart's area; the part cut off is a chart
-//!   of its own, re-attached at the end to a neighbour where it fits ([`reattach`]). A larger
+//!   that part has at most `CUT_OFF_AREA` of the chart's area; the part cut off is a chart
+//!   of its own, re-attached at the end to a neighbour where it fits (`reattach`). A larger
 //!   overlap splits the chart between the two overlapping faces
 //!   (`split_between` of [`crate::geom::cut`]: each face goes with the nearer of the two,
 //!   through the chart); a chart that needed seams to be a disk (a tube whose layout
 //!   spirals over itself) is halved along the bisector instead;
-//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts ([`darts`]: up
+//! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts`: up
 //!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
 //!   region, then shortened while it stays within the tolerance), then gussets where the
-//!   surface is saddle-shaped ([`gussets`]: a slit toward the most negative angle defect
+//!   surface is saddle-shaped (`gussets`: a slit toward the most negative angle defect
 //!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
 //!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
 //!
@@ -46,7 +46,7 @@
 //!   times per chart (its darts dropped, each half gets its own); what is still over it then
 //!   is reported (a warning on the surface, and the stretch of every piece in `report.json`).
 //!
-//! Material tolerances on the L2 stretch of a piece ([`material_tolerance`]), chosen here:
+//! Material tolerances on the L2 stretch of a piece (`material_tolerance`), chosen here:
 //! paper 1.003 (paper does not stretch; 0.3 % is taken up by folding and gluing without a
 //! visible wrinkle), metal 1.001 (a blank must develop, 0.1 % is within a plotter's accuracy
 //! on a 1 m piece), fabric 1.03 (woven cloth gives a few percent on the bias, and stuffing
@@ -80,7 +80,7 @@ pub struct FlattenOptions {
     pub unfold: UnfoldOptions,
     /// Parameterisation of charts.
     pub method: ParamMethod,
-    /// Largest L2 stretch of a piece before it is split (see [`material_tolerance`]).
+    /// Largest L2 stretch of a piece before it is split (see `material_tolerance`).
     pub tolerance: f64,
     /// Times a chart may be split for being over the tolerance (overlaps and flips are always
     /// split, down to single faces).
@@ -89,7 +89,7 @@ pub struct FlattenOptions {
     /// for none.
     pub darts: usize,
     /// Most gussets cut into a chart still over the tolerance after its darts (see
-    /// [`gussets`]); 0 for none (default 2).
+    /// `gussets`); 0 for none (default 2).
     pub gussets: usize,
     /// Merging threshold `η` for re-attaching a cut-off gusset to an adjacent piece: the mean
     /// cylinder fitting error of the gusset and two face rings of the piece around their common

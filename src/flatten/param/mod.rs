@@ -12,13 +12,13 @@
 //! iterative refinement (the normal equations square the condition number; refined, an
 //! exactly developable chart comes out isometric to ~1e-11 relative).
 //!
-//! **ABF++** ([`abf`]): the angles of every triangle solved for, then turned into coordinates
+//! **ABF++** (`abf`): the angles of every triangle solved for, then turned into coordinates
 //! by the LSCM energy with each triangle's shape built from its angles, same two pins.
 //!
 //! Choices where the papers are silent:
 //! - **Pins**: the two boundary vertices farthest apart in 3D (ties: the lowest local indices,
 //!   local indices being first appearance in `faces` order), placed at (0, 0) and (d, 0), d their
-//!   3D distance. Exact over all pairs up to [`EXACT_PIN_LIMIT`] boundary vertices; beyond it a
+//!   3D distance. Exact over all pairs up to `EXACT_PIN_LIMIT` boundary vertices; beyond it a
 //!   double sweep (the vertex farthest from the first boundary vertex, then the one farthest
 //!   from that), which is within a factor √2 of the diameter and O(n).
 //! - **Output frame**: the layout is scaled so its area equals the chart's 3D area, mirrored if
@@ -27,11 +27,11 @@
 //!   point to, like [`super::Flat`].
 //! - **Best**: both methods run; the result with fewer flipped triangles wins, then the lower L2
 //!   stretch; a tie keeps LSCM. If one method fails (singular system, ABF++ not converging in
-//!   [`ABF_MAX_ITER`] Newton steps) the other is kept; if both fail, the LSCM
+//!   `ABF_MAX_ITER` Newton steps) the other is kept; if both fail, the LSCM
 //!   error is returned. ABF++ steps are damped when a full Newton step would take an angle
 //!   out of (0, π) (the paper takes full steps). If both results have flipped triangles the one with fewer is returned
 //!   and `stretch.flipped` says how many: the caller must split such a chart (D-Charts does).
-//!   An LSCM layout already isometric (L2 within [`ISOMETRIC`] of 1, no flip) is returned at
+//!   An LSCM layout already isometric (L2 within `ISOMETRIC` of 1, no flip) is returned at
 //!   once. A flip-free winner is otherwise relaxed by free-boundary L2 stretch minimisation (Sander et
 //!   al. 2001 §4, the parameterisation the thesis evaluates its charts with, §5.4), which never
 //!   raises L2 and never flips a triangle (a developable chart, already at 1.0, stays as it
@@ -39,10 +39,10 @@
 //!   of conformality (shear) and, on strongly curved charts, of L∞: `Lscm` and `Abf` give the
 //!   pure conformal layouts.
 //! - **Polygon faces** (more than 3 corners) are ear-clipped in their best-fit plane
-//!   ([`distortion::face_triangles`]); their `uv` is still one point per original corner.
+//!   (`distortion::face_triangles`); their `uv` is still one point per original corner.
 //! - **Refused** (a [`ParamError`] naming the face and its OBJ line): no faces, a face index out
 //!   of range or repeated, a vertex index out of range or not finite, a triangle with an angle
-//!   below [`MIN_ANGLE`] (1e-3 rad), an edge used by more than two triangles, two faces wound
+//!   below `MIN_ANGLE` (1e-3 rad), an edge used by more than two triangles, two faces wound
 //!   against each other, a vertex where two boundary fans meet, several connected components,
 //!   no boundary (closed), several boundary loops (holes), handles. Nothing is repaired here:
 //!   charts come from a segmentation that can cut differently.

@@ -1,9 +1,9 @@
 //! Reading HP-GL: the one lexer of the crate. An instruction ends with `;` or a line feed
-//! ([`ends_instruction`], [`next_instruction`]); it is a two-letter mnemonic, or `!` and two
+//! (`ends_instruction`, [`next_instruction`]); it is a two-letter mnemonic, or `!` and two
 //! letters for Roland's CAMM-GL extensions, upper-cased ([`instruction`]), then numbers
 //! separated by commas or whitespace ([`numbers`]). The simulated cutter
 //! (`device::sim::hpgl`) executes what this reads as a plotter would; [`parse`] reads back the
-//! pen-down paths of a program that [`super::emit`] made, for tests and reports.
+//! pen-down paths of a program that `super::emit` made, for tests and reports.
 //!
 //! Choices where the HP-GL manuals leave room: a parameter that is not a finite number makes
 //! the whole instruction unreadable (the simulator skips it and counts it; [`parse`] refuses
@@ -59,7 +59,7 @@ pub struct ParsedStroke {
     pub points: Vec<(i64, i64)>,
 }
 
-/// Read back the pen-down paths of a program made by [`super::emit`]: absolute `PU`/`PD`/`PA`, `SP`,
+/// Read back the pen-down paths of a program made by `super::emit`: absolute `PU`/`PD`/`PA`, `SP`,
 /// `VS`, `FS` and Roland's `!FS`; `IN` resets pen, velocity and force. Other instructions
 /// (a profile's `init` and `end` lines) are skipped, except `PR`, whose relative moves this
 /// reader does not follow. For tests and reports; the full interpreter is the simulated

@@ -8,16 +8,16 @@
 //!
 //! The paper's steps, one file each:
 //!
-//! - [`checks`]: the input polyline as the paper assumes it (closed, simple, finite).
-//! - [`darts`]: §6.1 darts, inserted into their loop as two coinciding sides.
-//! - [`loops`]: §6 several loops (connecting charts, rulings between loops, the shortest tree)
+//! - `checks`: the input polyline as the paper assumes it (closed, simple, finite).
+//! - `darts`: §6.1 darts, inserted into their loop as two coinciding sides.
+//! - `loops`: §6 several loops (connecting charts, rulings between loops, the shortest tree)
 //!   and §6.1 rulings within a loop, giving the regions to search.
-//! - [`search`]: each region searched (§5) with the §7 radial offset, then relaxed limits and
+//! - `search`: each region searched (§5) with the §7 radial offset, then relaxed limits and
 //!   the fallbacks; the alternatives.
-//! - [`bnb`]: §5 branch-and-bound over covers (Fig. 9), potential §5.1.2.
-//! - [`charts`]: §3 charts, envelopes and subloops of a subloop's hull (cached).
-//! - [`bounds`]: §5.1.1 cover quality, the lower bound that prunes the search.
-//! - [`figures`]: §4 metrics of a finished triangulation and the output mesh.
+//! - `bnb`: §5 branch-and-bound over covers (Fig. 9), potential §5.1.2.
+//! - `charts`: §3 charts, envelopes and subloops of a subloop's hull (cached).
+//! - `bounds`: §5.1.1 cover quality, the lower bound that prunes the search.
+//! - `figures`: §4 metrics of a finished triangulation and the output mesh.
 //!
 //! # Choices where the paper is silent
 //!

@@ -24,15 +24,15 @@
 //!
 //! # Files
 //!
-//! - [`path`]: the curve on the flat sheet ([`FlatPath`]: line, arc, spline) by arc length.
-//! - [`spline`]: control curves with three derivatives ([`Param`], [`Spline`]) and arc length
+//! - `path`: the curve on the flat sheet ([`FlatPath`]: line, arc, spline) by arc length.
+//! - `spline`: control curves with three derivatives ([`Param`], [`Spline`]) and arc length
 //!   ([`ArcLength`], §4.1.3).
-//! - [`control`]: a piece's control curve from the spec, and control handles (§4.1.2, eq. 7).
-//! - [`folds`]: the folds of one piece: rulings from the Darboux vector (eq. 1, §5).
-//! - [`sheet`]: the flat outline and holes, the curves on it, where rulings cross it (§3.3).
-//! - [`admissible`]: the curve of regression and crossing rulings (§3.2, eq. 2–6, §4.3).
-//! - [`mesh`]: the sheet cut along the rulings, each region moved rigidly (§3.3, §3.4, §4.2).
-//! - [`bends`]: which rulings become bend lines, with their signed angles.
+//! - `control`: a piece's control curve from the spec, and control handles (§4.1.2, eq. 7).
+//! - `folds`: the folds of one piece: rulings from the Darboux vector (eq. 1, §5).
+//! - `sheet`: the flat outline and holes, the curves on it, where rulings cross it (§3.3).
+//! - `admissible`: the curve of regression and crossing rulings (§3.2, eq. 2–6, §4.3).
+//! - `mesh`: the sheet cut along the rulings, each region moved rigidly (§3.3, §3.4, §4.2).
+//! - `bends`: which rulings become bend lines, with their signed angles.
 
 mod admissible;
 mod bends;

@@ -32,8 +32,8 @@
 //! - Faces are wound `p_i p_{i+1} q_j` and `p_i q_{j+1} q_j`: with P below Q and both running
 //!   counter-clockwise seen from +z (as the fittings build them), normals point outward.
 //!
-//! The searches live beside this file: [`local`] (LODT + LMBT, §4), [`global`] (GODT, GMBT,
-//! GMAT, §5) on the cost rows of [`lanes`]; [`offset`] moves a strip by a sheet thickness.
+//! The searches live beside this file: `local` (LODT + LMBT, §4), `global` (GODT, GMBT,
+//! GMAT, §5) on the cost rows of `lanes`; `offset` moves a strip by a sheet thickness.
 
 mod global;
 mod lanes;
