@@ -113,8 +113,9 @@ fn a_host_that_ignores_xoff_is_caught() {
         let _ = port.write_some(c);
         std::thread::sleep(Duration::from_millis(10));
     }
-    // Longer than the simulator's grace for reacting to XOFF.
-    std::thread::sleep(sim::STOP_GRACE * 3);
+    // The simulator counts the bytes that keep coming once its grace for reacting to XOFF is
+    // over: wait for that count rather than a fixed time.
+    assert!(h.wait_for_violation(Duration::from_secs(10)));
     let rep = h.stop().unwrap();
     assert!(rep.xoff_sent >= 1);
     assert!(rep.violations() > 0, "{rep:?}");
@@ -191,7 +192,7 @@ fn a_naive_grbl_host_overruns_the_simulated_buffer() {
     for c in job.as_bytes().chunks(256) {
         let _ = port.write_some(c);
     }
-    std::thread::sleep(Duration::from_millis(500));
+    assert!(h.wait_for_violation(Duration::from_secs(10)));
     let rep = h.stop().unwrap();
     assert!(rep.overruns > 0, "{rep:?}");
     let _ = port.flush();

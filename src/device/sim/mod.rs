@@ -174,6 +174,8 @@ pub struct SimHandle {
     pub cts: Arc<AtomicBool>,
     ctl: Arc<AtomicU8>,
     expect: Arc<AtomicUsize>,
+    /// Overruns plus flow-control violations so far, as the device counts them.
+    violations: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
 }
 
@@ -193,6 +195,22 @@ impl SimHandle {
         }
         self.ctl.store(STOP, Ordering::SeqCst);
         t.join().map_err(|_| SimError::Thread)
+    }
+
+    /// Wait until the device has counted a buffer overrun or a flow-control violation, or
+    /// `timeout` passes; returns whether it did. A test that provokes one waits for it instead
+    /// of sleeping a fixed time.
+    pub fn wait_for_violation(&self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if self.violations.load(Ordering::SeqCst) > 0 {
+                return true;
+            }
+            if Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
     }
 
     /// Stop at once.
@@ -224,16 +242,18 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let cts = Arc::new(AtomicBool::new(true));
     let ctl = Arc::new(AtomicU8::new(RUN));
     let expect = Arc::new(AtomicUsize::new(0));
-    let (c2, k2, e2) = (cts.clone(), ctl.clone(), expect.clone());
+    let violations = Arc::new(AtomicUsize::new(0));
+    let (c2, k2, e2, v2) = (cts.clone(), ctl.clone(), expect.clone(), violations.clone());
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2, e2).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2)).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
         cts,
         ctl,
         expect,
+        violations,
         thread: Some(thread),
     })
 }
@@ -295,6 +315,7 @@ struct Device {
     cts: Arc<AtomicBool>,
     ctl: Arc<AtomicU8>,
     expect: Arc<AtomicUsize>,
+    violations: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -327,7 +348,7 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
-        expect: Arc<AtomicUsize>,
+        (expect, violations): (Arc<AtomicUsize>, Arc<AtomicUsize>),
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -358,6 +379,7 @@ impl Device {
             cts,
             ctl,
             expect,
+            violations,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -490,6 +512,8 @@ impl Device {
                 self.rep.ended = "finished".into();
                 break;
             }
+            self.violations
+                .store(self.rep.violations(), Ordering::SeqCst);
             let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
