@@ -11,7 +11,8 @@
 //! from earlier darts by their length; the path is the shortest from the chart's boundary,
 //! bent edges counting shorter (as the seams of [`crate::geom::cut::disk_cuts`]).
 
-use super::{cut_off, overlaps, self_overlap, Charts, FlattenOptions, Laid, Layout, OVERLAP_PAIRS};
+use super::overlap::{cut_off, overlaps, self_overlap, OVERLAP_PAIRS};
+use super::{Charts, FlattenOptions, Laid, Layout};
 use crate::flatten::distortion::{self, Stretch};
 use crate::flatten::FlattenError;
 use crate::geom::cut::{self, open};
