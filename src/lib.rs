@@ -75,6 +75,7 @@
 //!   charts/
 //!     mod.rs                   Flattening of a segmented smooth surface
 //!     darts.rs                 Darts and gussets
+//!     overlap.rs               Overlap inside one chart's layout, and what is done about it (Julius 2006, thesis §5.3 "fixing …
 //!   param/
 //!     mod.rs                   Parameterisation of nearly developable disk-topology charts
 //!     abf.rs                   ABF++ angles (Sheffer, Lévy, Mogilnitsky, Bogomyakov 2005)
