@@ -309,6 +309,11 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         };
         items.push(Item::new(rings, orients));
     }
+    if items.len() <= problem::FEW_ITEMS {
+        for it in &mut items {
+            it.add_shortest_shapes(if roll { uw } else { uh });
+        }
+    }
     let container = if roll {
         Container::Strip { height: uw }
     } else {

@@ -14,6 +14,13 @@ use std::sync::Arc;
 
 pub use super::collision::Orient;
 
+/// Problems with at most this many items try, for each freely turning item, the turns that
+/// make it shortest ([`Item::add_shortest_shapes`]) besides the four of its smallest
+/// enclosing rectangle.
+pub const FEW_ITEMS: usize = 8;
+/// How many shortest turns such an item gets.
+pub const SHORTEST_TURNS: usize = 2;
+
 /// Allowed orientations of an item.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Orients {
@@ -77,6 +84,62 @@ impl Item {
             poles,
             orients,
             shapes,
+        }
+    }
+
+    /// Few items (see [`FEW_ITEMS`]): add to a freely turning item's construction shapes the
+    /// [`SHORTEST_TURNS`] turns that make it shortest along the container's length (x) while it
+    /// fits the `height`, among the turns that lay an edge of its convex hull along x or y
+    /// (rotating calipers: the narrowest width is reached with a hull edge flush), so that a
+    /// lone piece on a roll takes the least roll. Items with a set of orientations and mirrored
+    /// turns are left as they are.
+    pub(crate) fn add_shortest_shapes(&mut self, height: f64) {
+        if !matches!(self.orients, Orients::Free { .. }) {
+            return;
+        }
+        let hull = crate::geom::polygon::convex_hull(&self.rings[0]);
+        let n = hull.len();
+        if n < 3 {
+            return;
+        }
+        let mut cands: Vec<(f64, f64)> = Vec::new();
+        for i in 0..n {
+            let e = hull[(i + 1) % n] - hull[i];
+            if e.length_squared() <= 0.0 {
+                continue;
+            }
+            let theta = e.y.atan2(e.x).to_degrees();
+            for base in [0.0, 90.0, 180.0, 270.0] {
+                let deg = (base - theta).rem_euclid(360.0);
+                let r = DVec2::from_angle(deg.to_radians());
+                let (lo, hi) = crate::geom::polygon::bounds(hull.iter().map(|p| r.rotate(*p)))
+                    .unwrap_or_default();
+                let size = hi - lo;
+                if size.y <= height - 1e-6 {
+                    cands.push((size.x, deg));
+                }
+            }
+        }
+        cands.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let mut added = 0;
+        for (_, deg) in cands {
+            if added == SHORTEST_TURNS {
+                break;
+            }
+            let same = |o: &Orient| {
+                let d = (o.angle_deg - deg).rem_euclid(360.0);
+                !o.mirror && d.min(360.0 - d) < 1e-6
+            };
+            if self.shapes.iter().any(|s| same(&s.orient)) {
+                continue;
+            }
+            let o = Orient {
+                angle_deg: deg,
+                mirror: false,
+            };
+            self.shapes
+                .push(Arc::new(Shape::new(&self.rings, &self.poles, o)));
+            added += 1;
         }
     }
 
