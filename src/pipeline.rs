@@ -77,9 +77,20 @@ pub struct Toolpath {
 /// Surfaces → flats → pieces for a spec; prints the surfaces' warnings to stderr unless
 /// `quiet`.
 pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
-    let mut flats = Vec::new();
+    flatten_surfaces(spec, sized_surfaces(spec)?, quiet)
+}
+
+/// The spec's surfaces built at their sizes (`size`, else `scale` × `units`), then the whole
+/// job at its `size`; without a size given, a model of implausible size is refused
+/// (`surface::size`).
+pub fn sized_surfaces(spec: &Spec) -> Result<Vec<crate::surface::Surface>, Error> {
+    let mut surfaces = Vec::new();
     for s in &spec.surfaces {
-        let surface = crate::surface::build(&s.for_material(&spec.material)).map_err(|e| {
+        let mut s = s.for_material(&spec.material);
+        if spec.surfaces.len() == 1 && spec.size.is_some() {
+            s.size = spec.size;
+        }
+        let surface = crate::surface::build(&s).map_err(|e| {
             if s.line > 0 {
                 Error::At {
                     file: spec.path.clone(),
@@ -90,6 +101,28 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
                 e.into()
             }
         })?;
+        surfaces.push(surface);
+    }
+    // The whole job at `size`; one surface was sized as it was read.
+    let extent = crate::surface::size::extent_of(&surfaces);
+    if let (Some(size), true) = (spec.size, spec.surfaces.len() > 1) {
+        let f = crate::surface::size::factor_for(extent, size);
+        surfaces.iter_mut().for_each(|s| s.scale(f));
+    } else if spec.size.is_none() && spec.surfaces.iter().any(|s| s.size.is_none()) {
+        let units = spec.surfaces.first().map_or(Default::default(), |s| s.units);
+        crate::surface::size::check_plausible(&spec.path, extent, units)?;
+    }
+    Ok(surfaces)
+}
+
+/// Surfaces → flats → pieces (after [`sized_surfaces`]).
+fn flatten_surfaces(
+    spec: &Spec,
+    surfaces: Vec<crate::surface::Surface>,
+    quiet: bool,
+) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
+    let mut flats = Vec::new();
+    for surface in surfaces {
         if !quiet {
             for w in &surface.warnings {
                 eprintln!("flatcut: warning: {w}");
@@ -394,7 +427,7 @@ pub fn nest_instance(
 
 /// `flatcut check`: a mesh read without repairs and its figures.
 pub fn check_mesh(path: &Path) -> Result<crate::surface::obj::MeshStats, Error> {
-    let raw = crate::surface::obj::read(path)?;
+    let raw = crate::surface::import::read(path)?;
     Ok(crate::surface::obj::stats(&raw))
 }
 

@@ -167,3 +167,206 @@ pub fn ask_alternatives(spec: &mut Spec, n: Option<usize>) {
         }
     }
 }
+
+/// `--size`, `--scale`, `--units`: the model's size (`cut`, `flatten`); they override the
+/// spec's `size`, `scale` and `units`, and apply to a bare mesh file as its model.
+#[derive(Debug, Clone, Default, Args)]
+pub struct SizeArgs {
+    /// The assembled model's largest dimension in mm (all surfaces together, aspect kept;
+    /// over the spec's `size`, `scale` and `units`).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true, value_parser = positive_number)]
+    pub size: Option<f64>,
+    /// Factor on every surface's coordinates (over the spec's `scale`).
+    #[arg(long, value_name = "F", allow_negative_numbers = true, value_parser = positive_number)]
+    pub scale: Option<f64>,
+    /// Units of the model's coordinates: mm, cm, m or in (over the spec's `units`).
+    #[arg(long, value_name = "mm|cm|m|in", value_parser = parse_units)]
+    pub units: Option<crate::spec::Units>,
+}
+
+impl SizeArgs {
+    /// Puts the flags into the spec (flags win: `--scale` and `--units` replace every
+    /// surface's own `size`, `--size` the job's).
+    pub fn apply(&self, spec: &mut Spec) {
+        if self.size.is_some() {
+            spec.size = self.size;
+        }
+        for s in &mut spec.surfaces {
+            if let Some(f) = self.scale {
+                s.scale = f;
+                s.size = None;
+            }
+            if let Some(u) = self.units {
+                s.units = u;
+                s.size = None;
+            }
+        }
+    }
+}
+
+/// A number more than 0 (`--size`, `--scale`).
+pub fn positive_number(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("must be a number more than 0, got {s:?}")),
+    }
+}
+
+/// A number at least 0 (`--margin`, `--spacing`).
+pub fn non_negative_mm(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("must be a length in mm, at least 0, got {s:?}")),
+    }
+}
+
+/// `mm`, `cm`, `m` or `in`.
+pub fn parse_units(s: &str) -> Result<crate::spec::Units, String> {
+    use crate::spec::Units;
+    match s.trim().to_ascii_lowercase().as_str() {
+        "mm" => Ok(Units::Mm),
+        "cm" => Ok(Units::Cm),
+        "m" => Ok(Units::M),
+        "in" | "inch" | "inches" => Ok(Units::In),
+        _ => Err(format!("expected mm, cm, m or in, got {s:?}")),
+    }
+}
+
+/// Named sheets, portrait (width × height, mm): ISO 216 A sizes, ANSI letter, legal and
+/// tabloid, and the 12 × 12 in and 12 × 24 in mats of desktop cutters.
+pub const SHEETS: [(&str, f64, f64); 10] = [
+    ("a4", 210.0, 297.0),
+    ("a3", 297.0, 420.0),
+    ("a2", 420.0, 594.0),
+    ("a1", 594.0, 841.0),
+    ("a0", 841.0, 1189.0),
+    ("letter", 215.9, 279.4),
+    ("legal", 215.9, 355.6),
+    ("tabloid", 279.4, 431.8),
+    ("mat12x12", 304.8, 304.8),
+    ("mat12x24", 304.8, 609.6),
+];
+
+/// A length in mm, or in inches with `in` after it (`610`, `24in`).
+pub fn parse_length(s: &str) -> Result<f64, String> {
+    let t = s.trim().to_ascii_lowercase();
+    let (num, k) = match t.strip_suffix("in") {
+        Some(n) => (n.trim().to_string(), 25.4),
+        None => (t.strip_suffix("mm").unwrap_or(&t).trim().to_string(), 1.0),
+    };
+    match num.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * k),
+        _ => Err(format!(
+            "expected a width in mm more than 0, or in inches like `24in`, got {s:?}"
+        )),
+    }
+}
+
+/// A sheet name or `WxH` in mm (`300x200`) or inches (`12x18in`): (width, height) in mm.
+pub fn parse_sheet(s: &str) -> Result<(f64, f64), String> {
+    let t = s.trim().to_ascii_lowercase();
+    if let Some(&(_, w, h)) = SHEETS.iter().find(|(n, _, _)| *n == t) {
+        return Ok((w, h));
+    }
+    let names: Vec<&str> = SHEETS.iter().map(|s| s.0).collect();
+    let bad = || {
+        format!(
+            "expected {} or WIDTHxHEIGHT in mm (300x200) or inches (12x18in), got {s:?}",
+            names.join(", ")
+        )
+    };
+    let (dims, k) = match t.strip_suffix("in") {
+        Some(d) => (d, 25.4),
+        None => (t.strip_suffix("mm").unwrap_or(&t), 1.0),
+    };
+    let (w, h) = dims.split_once(['x', '×']).ok_or_else(bad)?;
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+    };
+    match (num(w), num(h)) {
+        (Some(w), Some(h)) => Ok((w * k, h * k)),
+        _ => Err(bad()),
+    }
+}
+
+/// Sheet flags (`cut`, `flatten`, `fitting`): over the spec's `[sheet]`, which is over a
+/// roll-fed device's roll.
+#[derive(Debug, Clone, Default, Args)]
+pub struct SheetArgs {
+    /// The sheet: a4, a3, a2, a1, a0, letter, legal, tabloid, mat12x12, mat12x24 (cutter
+    /// mats), or WIDTHxHEIGHT in mm (300x200) or inches (12x18in); portrait unless
+    /// --landscape.
+    #[arg(long, value_name = "NAME|WxH", value_parser = parse_sheet)]
+    pub sheet: Option<(f64, f64)>,
+    /// Turn the sheet so that its long side runs along x.
+    #[arg(long)]
+    pub landscape: bool,
+    /// A roll WIDTH mm wide (or `24in`), of unlimited length, instead of a sheet.
+    #[arg(long, value_name = "WIDTH", value_parser = parse_length, conflicts_with = "sheet")]
+    pub roll: Option<f64>,
+    /// Blank border kept on every side of the sheet, mm.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true, value_parser = non_negative_mm)]
+    pub margin: Option<f64>,
+    /// Smallest gap between two pieces, mm.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true, value_parser = non_negative_mm)]
+    pub spacing: Option<f64>,
+}
+
+impl SheetArgs {
+    /// The sheet of a job: the spec's, else a roll-fed device's roll (`profile`: its
+    /// `media_width`, when its x and y are exchanged because the media is fed along x), then
+    /// the flags on top; refuses a margin that leaves no room.
+    pub fn apply(
+        &self,
+        spec: &mut Spec,
+        profile: Option<&crate::profile::Profile>,
+    ) -> Result<(), Error> {
+        let sheet = &mut spec.sheet;
+        if let Some(p) = profile.filter(|p| !spec.sheet_given && p.axes.swap_xy) {
+            if p.media_width > 0.0 {
+                sheet.width = p.media_width;
+                sheet.height = None;
+            }
+        }
+        if let Some((w, h)) = self.sheet {
+            sheet.width = w;
+            sheet.height = Some(h);
+        }
+        if let Some(w) = self.roll {
+            sheet.width = w;
+            sheet.height = None;
+        }
+        if self.landscape {
+            match sheet.height {
+                Some(h) if h > sheet.width => {
+                    sheet.height = Some(sheet.width);
+                    sheet.width = h;
+                }
+                Some(_) => {}
+                None => {
+                    return Err(Error::Usage(
+                        "--landscape: the job is on a roll, which has no landscape; give --sheet"
+                            .into(),
+                    ))
+                }
+            }
+        }
+        if let Some(m) = self.margin {
+            sheet.margin = m;
+        }
+        if let Some(s) = self.spacing {
+            sheet.spacing = s;
+        }
+        let short = sheet.height.map_or(sheet.width, |h| h.min(sheet.width));
+        if 2.0 * sheet.margin >= short {
+            return Err(Error::Usage(format!(
+                "--margin {}: must be less than half the sheet's {} mm side",
+                sheet.margin, short
+            )));
+        }
+        Ok(())
+    }
+}

@@ -8,7 +8,9 @@
 //! [`super::link`]). The files are written before anything is sent, so a failed or
 //! interrupted send loses nothing.
 
-use super::args::{ask_alternatives, PatternArgs, SearchArgs, SmoothArgs, ToolpathArgs};
+use super::args::{
+    ask_alternatives, PatternArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs, ToolpathArgs,
+};
 use super::link::LinkArgs;
 use crate::pipeline::Extras;
 use crate::spec::MaterialKind;
@@ -18,7 +20,8 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct CutArgs {
-    /// Spec file (`.toml`) or a mesh (`.obj`) to cut with default settings.
+    /// Spec file (`.toml`) or a mesh (`.obj`, `.stl`, `.ply`, `.off`) to cut with default
+    /// settings.
     pub input: PathBuf,
     /// Directory for the program, pictures and report (default: out/<name>).
     #[arg(short, long)]
@@ -32,6 +35,10 @@ pub struct CutArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    #[command(flatten)]
+    pub size: SizeArgs,
+    #[command(flatten)]
+    pub sheet: SheetArgs,
     #[command(flatten)]
     pub toolpath: ToolpathArgs,
     #[command(flatten)]
@@ -61,6 +68,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         spec.material.kind = m;
     }
     a.pattern.apply(&mut spec)?;
+    a.size.apply(&mut spec);
     ask_alternatives(&mut spec, a.alternatives);
     a.smooth.apply(&mut spec);
     let device = a
@@ -69,6 +77,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
     let profile = a.toolpath.device(&device)?;
+    a.sheet.apply(&mut spec, Some(&profile))?;
     super::link::need_port(&profile, &a.link, a.dry_run)?;
     let extras = Extras {
         output: a.output.clone(),

@@ -2,7 +2,7 @@
 //! PNG (laid side by side on one long strip, no sheet limits) plus `report.json`
 //! ([`crate::pipeline::flatten`]).
 
-use super::args::{ask_alternatives, PatternArgs, SearchArgs, SmoothArgs};
+use super::args::{ask_alternatives, PatternArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs};
 use crate::pipeline::Extras;
 use crate::Error;
 use clap::Args;
@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct FlattenArgs {
-    /// Spec file (`.toml`) or a mesh (`.obj`).
+    /// Spec file (`.toml`) or a mesh (`.obj`, `.stl`, `.ply`, `.off`).
     pub input: PathBuf,
     /// Directory for the pictures and report (default: out/<name>).
     #[arg(short, long)]
@@ -18,6 +18,10 @@ pub struct FlattenArgs {
     /// Material: paper, fabric or metal (overrides the spec).
     #[arg(long)]
     pub material: Option<crate::spec::MaterialKind>,
+    #[command(flatten)]
+    pub size: SizeArgs,
+    #[command(flatten)]
+    pub sheet: SheetArgs,
     #[command(flatten)]
     pub pattern: PatternArgs,
     #[command(flatten)]
@@ -42,6 +46,8 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         spec.material.kind = m;
     }
     a.pattern.apply(&mut spec)?;
+    a.size.apply(&mut spec);
+    a.sheet.apply(&mut spec, None)?;
     ask_alternatives(&mut spec, a.alternatives);
     a.smooth.apply(&mut spec);
     let search = a.search.search()?;

@@ -335,6 +335,7 @@ impl Ctx<'_> {
             path: self.path.to_path_buf(),
             scale: 1.0,
             units: Units::Mm,
+            size: None,
             name,
             line: line_no,
             strip: None,

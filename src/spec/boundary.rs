@@ -91,6 +91,7 @@ impl Ctx<'_> {
             path: self.path.to_path_buf(),
             scale: 1.0,
             units: Units::Mm,
+            size: None,
             name,
             line: raw_loops.first().map_or(header_line, |r| r.2),
             strip: None,

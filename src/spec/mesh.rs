@@ -76,6 +76,7 @@ impl Ctx<'_> {
             path,
             scale,
             units,
+            size: None,
             name,
             line,
             strip: None,

@@ -4,6 +4,8 @@
 //! ```toml
 //! name = "cube"            # optional; default: the spec file's stem
 //! device = "hpgl-pens"     # optional device profile name
+//! size = 200               # optional, mm > 0: the whole job's largest dimension (all
+//!                          # surfaces together, aspect kept; `--size` wins)
 //!
 //! [[surface]]              # one or more
 //! kind = "mesh"            # required: "mesh", "strip", "bent-sheet" or "boundary"
@@ -11,6 +13,8 @@
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
 //! name = "box"             # optional; default: the mesh file stem
+//! size = 150               # optional, mm > 0: the surface's largest dimension (any kind),
+//!                          # aspect kept; replaces scale and units
 //! segment = "dcharts"      # optional: "faces" | "dcharts" (smooth meshes, issue 7); see
 //!                          # `spec::mesh` for this and `charts`, `f_max`, `approximate`,
 //!                          # `simplify`
@@ -19,7 +23,7 @@
 //! kind = "paper"           # "paper" | "fabric" | "metal"; default paper
 //! thickness = 0.25         # mm, > 0, finite; default by kind: paper 0.25, fabric 0.5, metal 1.0
 //!
-//! [sheet]                  # optional table
+//! [sheet]                  # optional table; without it a roll-fed device's roll is used
 //! width = 210              # mm > 0; default 210 (A4 portrait)
 //! height = 297             # mm > 0; default 297; not allowed together with roll = true
 //! roll = false             # true: a roll of `width`, unlimited length
@@ -37,9 +41,9 @@
 //! bend_notches = false     # V notches where bend lines meet the outline; default false
 //! ```
 //!
-//! [`load`] reads a spec file; a `.obj` file (any letter case) given instead stands for a
-//! spec with that one mesh and every default ([`Spec::from_mesh`]). Every other extension is
-//! read as TOML.
+//! [`load`] reads a spec file; a mesh file (`.obj`, `.stl`, `.ply` or `.off`, any letter case)
+//! given instead stands for a spec with that one mesh and every default ([`Spec::from_mesh`]).
+//! Every other extension is read as TOML.
 //!
 //! # Layout
 //!
@@ -182,6 +186,12 @@ pub struct Spec {
     pub device: Option<String>,
     /// One or more surfaces to flatten, in file order.
     pub surfaces: Vec<SurfaceSpec>,
+    /// The size (mm) of the whole job's largest dimension, all surfaces together, aspect kept
+    /// (top-level `size`, `--size`); `None`: the surfaces as their own settings make them.
+    pub size: Option<f64>,
+    /// Whether the spec file has a `[sheet]` table; without one a device profile's media
+    /// (a roll cutter's roll) is the sheet.
+    pub sheet_given: bool,
     pub material: Material,
     pub sheet: SheetSpec,
     pub pattern: PatternSpec,
@@ -264,11 +274,14 @@ impl Spec {
             name: name.clone(),
             path: path.to_path_buf(),
             device: None,
+            size: None,
+            sheet_given: false,
             surfaces: vec![SurfaceSpec {
                 kind: SurfaceKind::Mesh,
                 path: path.to_path_buf(),
                 scale: 1.0,
                 units: Units::Mm,
+                size: None,
                 name,
                 line: 0,
                 strip: None,
@@ -316,13 +329,10 @@ impl Spec {
     }
 }
 
-/// Reads a spec file. A `.obj` path (any case) gives [`Spec::from_mesh`]; anything else is
-/// read as TOML.
+/// Reads a spec file. A mesh file (`.obj`, `.stl`, `.ply`, `.off`, any case) gives
+/// [`Spec::from_mesh`]; anything else is read as TOML.
 pub fn load(path: &Path) -> Result<Spec, SpecError> {
-    let is_obj = path
-        .extension()
-        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("obj"));
-    if is_obj {
+    if crate::surface::import::is_mesh_path(path) {
         return Ok(Spec::from_mesh(path));
     }
     let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io {
@@ -348,6 +358,9 @@ impl Ctx<'_> {
         let device = self.string(&raw.device, "device", "a non-empty device profile name")?;
 
         let surfaces = self.surfaces(&raw.surface)?;
+        let size = self
+            .number(&raw.size, "size", MM_POSITIVE, |v| v > 0.0)?
+            .map(|(v, _)| v);
         let material = self.material(&raw.material)?;
         let sheet = self.sheet(&raw.sheet)?;
         let pattern = self.pattern(&raw.pattern)?;
@@ -357,6 +370,8 @@ impl Ctx<'_> {
             path: self.path.to_path_buf(),
             device,
             surfaces,
+            size,
+            sheet_given: raw.sheet.is_some(),
             material,
             sheet,
             pattern,
@@ -428,14 +443,16 @@ impl Ctx<'_> {
             if kind != SurfaceKind::Boundary {
                 self.no_boundary_keys(s, &key)?;
             }
-            match kind {
-                SurfaceKind::BentSheet => out.push(self.bent_surface(s, &key, header_line, dir)?),
-                SurfaceKind::Strip => out.push(self.strip_surface(s, &key, header_line, dir)?),
-                SurfaceKind::Boundary => {
-                    out.push(self.boundary_surface(s, &key, header_line, dir)?)
-                }
-                SurfaceKind::Mesh => out.push(self.mesh_surface(s, &key, header_line, dir)?),
-            }
+            let mut surface = match kind {
+                SurfaceKind::BentSheet => self.bent_surface(s, &key, header_line, dir)?,
+                SurfaceKind::Strip => self.strip_surface(s, &key, header_line, dir)?,
+                SurfaceKind::Boundary => self.boundary_surface(s, &key, header_line, dir)?,
+                SurfaceKind::Mesh => self.mesh_surface(s, &key, header_line, dir)?,
+            };
+            surface.size = self
+                .number(&s.size, &format!("{key}.size"), MM_POSITIVE, |v| v > 0.0)?
+                .map(|(v, _)| v);
+            out.push(surface);
         }
         Ok(out)
     }

@@ -19,6 +19,7 @@ use toml::Spanned;
 pub(super) struct RawSpec {
     pub(super) name: Option<Spanned<Val>>,
     pub(super) device: Option<Spanned<Val>>,
+    pub(super) size: Option<Spanned<Val>>,
     pub(super) surface: Option<Spanned<List<Spanned<Tab<RawSurface>>>>>,
     pub(super) material: Option<Spanned<Tab<RawMaterial>>>,
     pub(super) sheet: Option<Spanned<Tab<RawSheet>>>,
@@ -31,6 +32,7 @@ pub(super) struct RawSurface {
     pub(super) kind: Option<Spanned<Val>>,
     pub(super) path: Option<Spanned<Val>>,
     pub(super) scale: Option<Spanned<Val>>,
+    pub(super) size: Option<Spanned<Val>>,
     pub(super) units: Option<Spanned<Val>>,
     pub(super) name: Option<Spanned<Val>>,
     pub(super) p: Option<Spanned<toml::Value>>,

@@ -439,6 +439,7 @@ mod tests {
             path: "fitting".into(),
             scale: 1.0,
             units: Units::Mm,
+            size: None,
             name: f.kind().into(),
             line: 0,
             strip: Some(f.strip_spec(opts).unwrap()),

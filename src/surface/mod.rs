@@ -22,11 +22,16 @@ pub mod boundary;
 pub mod dcharts;
 pub mod dcs;
 pub mod fittings;
+pub mod import;
 pub mod geodesic;
 pub mod material;
 pub mod obj;
+pub mod off;
+pub mod ply;
 pub mod segment;
+pub mod size;
 pub mod solids;
+pub mod stl;
 pub mod source;
 pub mod strip;
 
@@ -126,12 +131,30 @@ pub enum SurfaceError {
     NonOrientable { path: PathBuf, line: Option<usize> },
 }
 
-/// Build the surface a spec entry describes.
+/// Build the surface a spec entry describes, at its size (`size`, else `scale` × `units`).
 pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
+    let mut surface = build_as_given(spec)?;
+    if spec.kind != SurfaceKind::Mesh {
+        let f = match spec.size {
+            Some(s) => size::factor_for(size::extent(&surface.mesh), s),
+            None => spec.scale * spec.units.mm(),
+        };
+        if f != 1.0 {
+            surface.scale(f);
+        }
+    }
+    Ok(surface)
+}
+
+/// [`build`] before a non-mesh surface is scaled (a mesh is scaled as it is read).
+fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
     match spec.kind {
         SurfaceKind::Mesh => {
-            let scale = spec.scale * spec.units.mm();
-            let raw = obj::read(&spec.path)?;
+            let raw = import::read(&spec.path)?;
+            let scale = match spec.size {
+                Some(s) => size::factor_for(size::extent(&raw.mesh), s),
+                None => spec.scale * spec.units.mm(),
+            };
             let (mesh, warnings) = obj::validate(raw, scale)?;
             let mut surface = Surface {
                 name: spec.name.clone(),

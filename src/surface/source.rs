@@ -24,6 +24,9 @@ pub struct SurfaceSpec {
     pub scale: f64,
     /// Units the file's coordinates are in.
     pub units: Units,
+    /// The size (mm) of the surface's largest dimension (its bounding box's longest side),
+    /// aspect kept; given, it replaces `scale` and `units`. `None`: as `scale` and `units` say.
+    pub size: Option<f64>,
     /// Name shown in labels; default: the source file's stem.
     pub name: String,
     /// 1-based line of this entry's `path` value in the spec; 0 when there is no spec file.
