@@ -114,6 +114,12 @@ pub struct FittingArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// Units of the dimensions and the thickness: mm (default), cm, m or in (the
+    /// tolerance and the sheet flags stay in mm).
+    #[arg(long, value_name = "mm|cm|m|in", value_parser = super::args::parse_units)]
+    pub units: Option<Units>,
+    #[command(flatten)]
+    pub sheet: super::args::SheetArgs,
     #[command(flatten)]
     pub link: super::link::LinkArgs,
     /// Print nothing but errors.
@@ -148,41 +154,42 @@ pub fn fitting(a: &FittingArgs) -> Result<Fitting, Error> {
         FittingKind::PipeMiter => "pipe-miter",
         FittingKind::Lampshade => "lampshade",
     };
+    let u = a.units.map_or(1.0, |u| u.mm());
     Ok(match a.kind {
         FittingKind::Cone => Fitting::Cone {
-            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)?,
-            top_diameter: need(a.top_diameter, "top-diameter", k)?,
-            height: need(a.height, "height", k)?,
-            offset: a.offset,
+            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)? * u,
+            top_diameter: need(a.top_diameter, "top-diameter", k)? * u,
+            height: need(a.height, "height", k)? * u,
+            offset: a.offset * u,
         },
         FittingKind::SquareToRound => Fitting::SquareToRound {
-            width: need(a.width, "width", k)?,
-            depth: need(a.depth, "depth", k)?,
-            diameter: need(a.diameter, "diameter", k)?,
-            height: need(a.height, "height", k)?,
-            offset_x: a.offset_x,
-            offset_y: a.offset_y,
+            width: need(a.width, "width", k)? * u,
+            depth: need(a.depth, "depth", k)? * u,
+            diameter: need(a.diameter, "diameter", k)? * u,
+            height: need(a.height, "height", k)? * u,
+            offset_x: a.offset_x * u,
+            offset_y: a.offset_y * u,
         },
         FittingKind::RectToRect => Fitting::RectToRect {
-            width: need(a.width, "width", k)?,
-            depth: need(a.depth, "depth", k)?,
-            top_width: need(a.top_width, "top-width", k)?,
-            top_depth: need(a.top_depth, "top-depth", k)?,
-            height: need(a.height, "height", k)?,
-            offset_x: a.offset_x,
-            offset_y: a.offset_y,
+            width: need(a.width, "width", k)? * u,
+            depth: need(a.depth, "depth", k)? * u,
+            top_width: need(a.top_width, "top-width", k)? * u,
+            top_depth: need(a.top_depth, "top-depth", k)? * u,
+            height: need(a.height, "height", k)? * u,
+            offset_x: a.offset_x * u,
+            offset_y: a.offset_y * u,
         },
         FittingKind::PipeMiter => Fitting::PipeMiter {
-            diameter: need(a.diameter, "diameter", k)?,
-            length: need(a.length, "length", k)?,
+            diameter: need(a.diameter, "diameter", k)? * u,
+            length: need(a.length, "length", k)? * u,
             angle_deg: need(a.angle, "angle", k)?,
         },
         FittingKind::Lampshade => Fitting::Lampshade {
-            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)?,
-            bottom_depth: a.bottom_depth,
-            top_diameter: need(a.top_diameter, "top-diameter", k)?,
-            top_depth: a.top_depth,
-            height: need(a.height, "height", k)?,
+            bottom_diameter: need(a.bottom_diameter, "bottom-diameter", k)? * u,
+            bottom_depth: a.bottom_depth.map(|v| v * u),
+            top_diameter: need(a.top_diameter, "top-diameter", k)? * u,
+            top_depth: a.top_depth.map(|v| v * u),
+            height: need(a.height, "height", k)? * u,
         },
     })
 }
@@ -191,7 +198,7 @@ pub fn fitting(a: &FittingArgs) -> Result<Fitting, Error> {
 pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
     let f = fitting(a)?;
     let opts = FittingOptions {
-        thickness: a.thickness,
+        thickness: a.thickness * a.units.map_or(1.0, |u| u.mm()),
         k_factor: a.k_factor,
         bend_lines: a.bend_lines,
         tolerance: a.tolerance,
@@ -243,7 +250,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
         material: Material {
             kind,
             thickness: if a.thickness > 0.0 {
-                a.thickness
+                a.thickness * a.units.map_or(1.0, |u| u.mm())
             } else {
                 kind.default_thickness()
             },
@@ -259,9 +266,10 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
 }
 
 pub fn run(a: &FittingArgs) -> Result<(), Error> {
-    let spec = spec(a)?;
+    let mut spec = spec(a)?;
     let device = a.device.clone().unwrap_or_else(|| "sim".to_string());
     let profile = crate::pipeline::device(&device, None, None)?;
+    a.sheet.apply(&mut spec, Some(&profile))?;
     super::link::need_port(&profile, &a.link, a.dry_run)?;
     let extras = Extras {
         output: a.output.clone(),

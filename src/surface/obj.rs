@@ -523,6 +523,8 @@ pub struct MeshStats {
     /// Largest |2π − Σ angles| over interior vertices, in degrees: 0 for a developable mesh.
     pub max_angle_defect_deg: f64,
     pub non_planar_faces: usize,
+    /// The bounding box's sides (x, y, z) in file units.
+    pub extent: [f64; 3],
 }
 
 /// Count what `flatcut check` reports, on a raw (unvalidated) mesh.
@@ -567,6 +569,7 @@ pub fn stats(raw: &RawMesh) -> MeshStats {
         non_manifold_edges: topo.edges.iter().filter(|e| e.uses.len() > 2).count(),
         max_angle_defect_deg: max_defect.to_degrees(),
         non_planar_faces: non_planar,
+        extent: super::size::extent(mesh).to_array(),
     }
 }
 
