@@ -319,7 +319,8 @@ pub fn cut(
     files.extend(write_dxf(&dir, &spec.name, &layout)?);
     files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    write_report(&dir, spec, &profile.name, &files, &flats, &layout)?;
+    let warnings = cuttable(&layout, profile.knife_offset, spec, extras.quiet);
+    write_report(&dir, spec, &profile.name, &files, &flats, &layout, warnings)?;
     Ok(CutRun {
         flats,
         layout,
@@ -374,7 +375,8 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
     let mut files = write_pictures(&dir, &spec.name, &job)?;
     files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    write_report(&dir, spec, "", &files, &flats, &layout)?;
+    let warnings = cuttable(&layout, 0.0, spec, extras.quiet);
+    write_report(&dir, spec, "", &files, &flats, &layout, warnings)?;
     Ok(FlattenRun {
         flats,
         layout,
@@ -473,6 +475,25 @@ fn write_extras(flats: &[Flat], extras: &Extras) -> Result<(), Error> {
     Ok(())
 }
 
+/// The features of the pieces a device with this knife offset cannot make, printed to stderr
+/// unless `quiet` (`toolpath::cuttable`).
+fn cuttable(
+    layout: &Layout,
+    knife_offset: f64,
+    spec: &Spec,
+    quiet: bool,
+) -> Vec<crate::toolpath::cuttable::Warning> {
+    use crate::toolpath::cuttable::{check, CuttableOptions};
+    let o = CuttableOptions::for_device(knife_offset, spec.pattern_options().kerf);
+    let warnings = check(&layout.pieces, &o);
+    if !quiet {
+        for w in &warnings {
+            eprintln!("flatcut: warning: {}", w.message);
+        }
+    }
+    warnings
+}
+
 /// report.json: the run, its pieces, seams, sheets and per-surface figures.
 fn write_report(
     dir: &Path,
@@ -481,6 +502,7 @@ fn write_report(
     files: &[String],
     flats: &[Flat],
     layout: &Layout,
+    warnings: Vec<crate::toolpath::cuttable::Warning>,
 ) -> Result<(), Error> {
     let info = RunInfo {
         name: spec.name.clone(),
@@ -489,6 +511,7 @@ fn write_report(
         material: spec.material.kind.to_string(),
         thickness_mm: spec.material.thickness,
         files: files.to_vec(),
+        warnings,
     };
     let rep = report::build(&info, flats, layout);
     let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";

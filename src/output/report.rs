@@ -30,6 +30,8 @@ pub struct RunInfo {
     pub material: String,
     pub thickness_mm: f64,
     pub files: Vec<String>,
+    /// Features the device cannot make (`toolpath::cuttable`), as `warnings`; none: no key.
+    pub warnings: Vec<crate::toolpath::cuttable::Warning>,
 }
 
 fn r6(v: f64) -> f64 {
@@ -111,7 +113,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     let surfaces = surfaces_json(flats);
     let seams = seams_json(layout);
     let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
-    json!({
+    let mut report = json!({
         "name": info.name,
         "spec": info.spec,
         "device": info.device,
@@ -133,7 +135,11 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             "fold_length_mm": total(&|p| p.fold_length()),
         },
         "files": info.files,
-    })
+    });
+    if !info.warnings.is_empty() {
+        report["warnings"] = json!(info.warnings);
+    }
+    report
 }
 
 /// The `surfaces` entries: one per surface, with the figures its source measured.

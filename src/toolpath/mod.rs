@@ -24,6 +24,7 @@ use glam::DVec2;
 use serde::Serialize;
 
 mod collect;
+pub mod cuttable;
 pub mod knife;
 pub mod order;
 pub mod weed;
