@@ -109,7 +109,10 @@ pub fn sized_surfaces(spec: &Spec) -> Result<Vec<crate::surface::Surface>, Error
         let f = crate::surface::size::factor_for(extent, size);
         surfaces.iter_mut().for_each(|s| s.scale(f));
     } else if spec.size.is_none() && spec.surfaces.iter().any(|s| s.size.is_none()) {
-        let units = spec.surfaces.first().map_or(Default::default(), |s| s.units);
+        let units = spec
+            .surfaces
+            .first()
+            .map_or(Default::default(), |s| s.units);
         crate::surface::size::check_plausible(&spec.path, extent, units)?;
     }
     Ok(surfaces)

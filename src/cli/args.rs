@@ -305,7 +305,7 @@ pub struct SheetArgs {
     #[arg(long)]
     pub landscape: bool,
     /// A roll WIDTH mm wide (or `24in`), of unlimited length, instead of a sheet.
-    #[arg(long, value_name = "WIDTH", value_parser = parse_length, conflicts_with = "sheet")]
+    #[arg(long, value_name = "WIDTH", allow_negative_numbers = true, value_parser = parse_length, conflicts_with = "sheet")]
     pub roll: Option<f64>,
     /// Blank border kept on every side of the sheet, mm.
     #[arg(long, value_name = "MM", allow_negative_numbers = true, value_parser = non_negative_mm)]

@@ -197,7 +197,12 @@ pub(super) fn coord(
 }
 
 /// The error of a vertex coordinate that is NaN or infinite.
-pub(super) fn non_finite(path: &Path, line: Option<usize>, vertex: usize, text: &str) -> SurfaceError {
+pub(super) fn non_finite(
+    path: &Path,
+    line: Option<usize>,
+    vertex: usize,
+    text: &str,
+) -> SurfaceError {
     match line {
         Some(line) => SurfaceError::NonFinite {
             path: path.to_path_buf(),

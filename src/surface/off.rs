@@ -31,7 +31,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
         .next()
         .ok_or_else(|| err(path, None, "not an OFF file: it is empty"))?;
     let kw = header[0];
-    let prefix = kw.strip_suffix("OFF").filter(|p| p.chars().all(|c| "STCN".contains(c)));
+    let prefix = kw
+        .strip_suffix("OFF")
+        .filter(|p| p.chars().all(|c| "STCN".contains(c)));
     if prefix.is_none() {
         return Err(err(
             path,
@@ -39,35 +41,68 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
             format!("not a 3D OFF file: it begins with `{kw}`, not `OFF` (or COFF, NOFF, STOFF…)"),
         ));
     }
-    if header.get(1).is_some_and(|w| w.eq_ignore_ascii_case("binary")) {
-        return Err(err(path, Some(hline), "binary OFF is not read; export the model as ASCII OFF"));
+    if header
+        .get(1)
+        .is_some_and(|w| w.eq_ignore_ascii_case("binary"))
+    {
+        return Err(err(
+            path,
+            Some(hline),
+            "binary OFF is not read; export the model as ASCII OFF",
+        ));
     }
     let (cline, counts) = if header.len() >= 3 {
         (hline, header[1..].to_vec())
     } else {
-        lines
-            .next()
-            .ok_or_else(|| err(path, Some(hline), "the counts `vertices faces edges` are missing"))?
+        lines.next().ok_or_else(|| {
+            err(
+                path,
+                Some(hline),
+                "the counts `vertices faces edges` are missing",
+            )
+        })?
     };
     let count = |i: usize, what: &str| -> Result<usize, SurfaceError> {
         counts
             .get(i)
             .and_then(|w| w.parse::<usize>().ok())
-            .ok_or_else(|| err(path, Some(cline), format!("the number of {what} is missing or not a whole number")))
+            .ok_or_else(|| {
+                err(
+                    path,
+                    Some(cline),
+                    format!("the number of {what} is missing or not a whole number"),
+                )
+            })
     };
     let nv = count(0, "vertices")?;
     let nf = count(1, "faces")?;
     const LIMIT: usize = 100_000_000;
     if nv > LIMIT || nf > LIMIT {
-        return Err(err(path, Some(cline), format!("{nv} vertices and {nf} faces: more than {LIMIT}")));
+        return Err(err(
+            path,
+            Some(cline),
+            format!("{nv} vertices and {nf} faces: more than {LIMIT}"),
+        ));
     }
     let mut points = Vec::with_capacity(nv.min(1 << 20));
     for v in 0..nv {
         let (line, w) = lines.next().ok_or_else(|| {
-            err(path, None, format!("the file ends after {v} of its {nv} vertices"))
+            err(
+                path,
+                None,
+                format!("the file ends after {v} of its {nv} vertices"),
+            )
         })?;
         if w.len() < 3 {
-            return Err(err(path, Some(line), format!("vertex {} needs three coordinates, found `{}`", v + 1, w.join(" "))));
+            return Err(err(
+                path,
+                Some(line),
+                format!(
+                    "vertex {} needs three coordinates, found `{}`",
+                    v + 1,
+                    w.join(" ")
+                ),
+            ));
         }
         let mut p = [0.0; 3];
         for i in 0..3 {
@@ -78,16 +113,42 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
     let mut faces = Vec::with_capacity(nf.min(1 << 20));
     for f in 0..nf {
         let (line, w) = lines.next().ok_or_else(|| {
-            err(path, None, format!("the file ends after {f} of its {nf} faces"))
+            err(
+                path,
+                None,
+                format!("the file ends after {f} of its {nf} faces"),
+            )
         })?;
-        let n = w[0].parse::<usize>().ok().filter(|&n| n + 1 <= w.len()).ok_or_else(|| {
-            err(path, Some(line), format!("face {} must be `n i1 … in`, found `{}`", f + 1, w.join(" ")))
-        })?;
+        let n = w[0]
+            .parse::<usize>()
+            .ok()
+            .filter(|&n| n + 1 <= w.len())
+            .ok_or_else(|| {
+                err(
+                    path,
+                    Some(line),
+                    format!(
+                        "face {} must be `n i1 … in`, found `{}`",
+                        f + 1,
+                        w.join(" ")
+                    ),
+                )
+            })?;
         let refs = w[1..=n]
             .iter()
             .map(|t| t.parse::<i64>())
             .collect::<Result<Vec<i64>, _>>()
-            .map_err(|_| err(path, Some(line), format!("face {}: vertex indices must be whole numbers, found `{}`", f + 1, w.join(" "))))?;
+            .map_err(|_| {
+                err(
+                    path,
+                    Some(line),
+                    format!(
+                        "face {}: vertex indices must be whole numbers, found `{}`",
+                        f + 1,
+                        w.join(" ")
+                    ),
+                )
+            })?;
         faces.push((refs, Some(line), f));
     }
     indexed(path, &points, faces)
@@ -104,15 +165,20 @@ mod tests {
         assert_eq!((m.mesh.vertices.len(), m.mesh.faces.len()), (4, 1));
         assert_eq!(m.mesh.faces[0].verts, vec![0, 1, 2, 3]);
         assert_eq!(m.mesh.faces[0].line, Some(8));
-        let e = parse(t.replace("4 0 1 2 3", "4 0 1 2 9").as_bytes(), Path::new("s.off"))
-            .unwrap_err()
-            .to_string();
+        let e = parse(
+            t.replace("4 0 1 2 3", "4 0 1 2 9").as_bytes(),
+            Path::new("s.off"),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.starts_with("s.off:8:") && e.contains("vertex 9"), "{e}");
         let e = parse(t.replace("1 1 0", "1 nan 0").as_bytes(), Path::new("s.off"))
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("s.off:6:"), "{e}");
-        let e = parse(b"OFF\n4 1 0\n0 0 0\n", Path::new("s.off")).unwrap_err().to_string();
+        let e = parse(b"OFF\n4 1 0\n0 0 0\n", Path::new("s.off"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("ends after 1 of its 4 vertices"), "{e}");
     }
 }

@@ -92,7 +92,11 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
     for el in &elements {
         let xyz: Vec<Option<usize>> = ["x", "y", "z"]
             .iter()
-            .map(|n| el.props.iter().position(|p| matches!(p, Prop::Scalar(_, m) if m == n)))
+            .map(|n| {
+                el.props
+                    .iter()
+                    .position(|p| matches!(p, Prop::Scalar(_, m) if m == n))
+            })
             .collect();
         let list = el.props.iter().position(
             |p| matches!(p, Prop::List(_, _, m) if m == "vertex_indices" || m == "vertex_index"),
@@ -100,10 +104,18 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
         let is_vertex = el.name == "vertex";
         let is_face = el.name == "face";
         if is_vertex && xyz.iter().any(|i| i.is_none()) {
-            return Err(err(path, None, "the `vertex` element has no `x`, `y` and `z` properties"));
+            return Err(err(
+                path,
+                None,
+                "the `vertex` element has no `x`, `y` and `z` properties",
+            ));
         }
         if is_face && list.is_none() {
-            return Err(err(path, None, "the `face` element has no `vertex_indices` list"));
+            return Err(err(
+                path,
+                None,
+                "the `face` element has no `vertex_indices` list",
+            ));
         }
         for k in 0..el.count {
             reader.start_record(path, &el.name, k)?;
@@ -116,7 +128,12 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
                         if is_vertex {
                             if let Some(c) = xyz.iter().position(|&j| j == Some(i)) {
                                 if !v.is_finite() {
-                                    return Err(non_finite(path, reader.text_line(), k, &v.to_string()));
+                                    return Err(non_finite(
+                                        path,
+                                        reader.text_line(),
+                                        k,
+                                        &v.to_string(),
+                                    ));
                                 }
                                 p[c] = v;
                             }
@@ -125,13 +142,23 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
                     Prop::List(ct, it, _) => {
                         let n = reader.value(*ct, path, &el.name, k)?;
                         if !(n >= 0.0 && n.fract() == 0.0 && n <= 1e6) {
-                            return Err(reader.bad(path, &el.name, k, format!("list length {n} is not a count")));
+                            return Err(reader.bad(
+                                path,
+                                &el.name,
+                                k,
+                                format!("list length {n} is not a count"),
+                            ));
                         }
                         for _ in 0..n as usize {
                             let v = reader.value(*it, path, &el.name, k)?;
                             if is_face && Some(i) == list {
                                 if v.fract() != 0.0 {
-                                    return Err(reader.bad(path, &el.name, k, format!("vertex index {v} is not a whole number")));
+                                    return Err(reader.bad(
+                                        path,
+                                        &el.name,
+                                        k,
+                                        format!("vertex index {v} is not a whole number"),
+                                    ));
                                 }
                                 refs.push(v as i64);
                             }
@@ -152,7 +179,10 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
 }
 
 /// The header: encoding, elements, where the body starts (byte offset) and its first line.
-fn header(bytes: &[u8], path: &Path) -> Result<(Encoding, Vec<Element>, usize, usize), SurfaceError> {
+fn header(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<(Encoding, Vec<Element>, usize, usize), SurfaceError> {
     let mut at = 0usize;
     let mut line = 0usize;
     let mut enc = None;
@@ -182,18 +212,27 @@ fn header(bytes: &[u8], path: &Path) -> Result<(Encoding, Vec<Element>, usize, u
                     Some("ascii") => Encoding::Ascii,
                     Some("binary_little_endian") => Encoding::Little,
                     Some("binary_big_endian") => Encoding::Big,
-                    other => return Err(bad(format!("unknown PLY format `{}`", other.unwrap_or("")))),
+                    other => {
+                        return Err(bad(format!("unknown PLY format `{}`", other.unwrap_or(""))))
+                    }
                 });
             }
             Some("element") => {
-                let count = w.get(2).and_then(|c| c.parse::<usize>().ok()).filter(|&c| c <= LIMIT);
+                let count = w
+                    .get(2)
+                    .and_then(|c| c.parse::<usize>().ok())
+                    .filter(|&c| c <= LIMIT);
                 match (w.get(1), count) {
                     (Some(name), Some(count)) => elements.push(Element {
                         name: name.to_string(),
                         count,
                         props: Vec::new(),
                     }),
-                    _ => return Err(bad(format!("`{text}`: expected `element NAME COUNT` (count at most {LIMIT})"))),
+                    _ => {
+                        return Err(bad(format!(
+                            "`{text}`: expected `element NAME COUNT` (count at most {LIMIT})"
+                        )))
+                    }
                 }
             }
             Some("property") => {
@@ -250,7 +289,11 @@ impl Body<'_> {
         }
         loop {
             if self.at >= self.bytes.len() {
-                return Err(err(path, None, format!("the file ends before {el} {}", k + 1)));
+                return Err(err(
+                    path,
+                    None,
+                    format!("the file ends before {el} {}", k + 1),
+                ));
             }
             let end = self.bytes[self.at..]
                 .iter()
@@ -271,7 +314,12 @@ impl Body<'_> {
     fn end_record(&mut self, path: &Path, el: &str, k: usize) -> Result<(), SurfaceError> {
         if self.enc == Encoding::Ascii {
             if self.word < self.words.len() {
-                return Err(self.bad(path, el, k, format!("{el} {} has more values than its properties", k + 1)));
+                return Err(self.bad(
+                    path,
+                    el,
+                    k,
+                    format!("{el} {} has more values than its properties", k + 1),
+                ));
             }
             self.line += 1;
         }
@@ -281,16 +329,30 @@ impl Body<'_> {
     fn value(&mut self, t: Ty, path: &Path, el: &str, k: usize) -> Result<f64, SurfaceError> {
         if self.enc == Encoding::Ascii {
             let Some(w) = self.words.get(self.word) else {
-                return Err(self.bad(path, el, k, format!("{el} {} has fewer values than its properties", k + 1)));
+                return Err(self.bad(
+                    path,
+                    el,
+                    k,
+                    format!("{el} {} has fewer values than its properties", k + 1),
+                ));
             };
             self.word += 1;
             return w.parse::<f64>().map_err(|_| {
-                self.bad(path, el, k, format!("{el} {}: `{w}` is not a number", k + 1))
+                self.bad(
+                    path,
+                    el,
+                    k,
+                    format!("{el} {}: `{w}` is not a number", k + 1),
+                )
             });
         }
         let n = t.size();
         let Some(b) = self.bytes.get(self.at..self.at + n) else {
-            return Err(err(path, None, format!("the file ends inside {el} {}", k + 1)));
+            return Err(err(
+                path,
+                None,
+                format!("the file ends inside {el} {}", k + 1),
+            ));
         };
         self.at += n;
         let mut a = [0u8; 8];
@@ -319,8 +381,7 @@ mod tests {
 
     #[test]
     fn ascii_and_binary_read_the_same_square() {
-        let a = HEAD.replace("FORMAT", "ascii")
-            + "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n4 0 1 2 3\n";
+        let a = HEAD.replace("FORMAT", "ascii") + "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n4 0 1 2 3\n";
         let a = parse(a.as_bytes(), Path::new("s.ply")).unwrap();
         assert_eq!((a.mesh.vertices.len(), a.mesh.faces.len()), (4, 1));
         assert_eq!(a.mesh.faces[0].line, Some(16));
@@ -328,13 +389,21 @@ mod tests {
             let mut b = HEAD.replace("FORMAT", fmt).into_bytes();
             for p in [[0f32, 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]] {
                 for x in p {
-                    b.extend_from_slice(&if big { x.to_be_bytes() } else { x.to_le_bytes() });
+                    b.extend_from_slice(&if big {
+                        x.to_be_bytes()
+                    } else {
+                        x.to_le_bytes()
+                    });
                 }
                 b.push(7);
             }
             b.push(4);
             for i in 0i32..4 {
-                b.extend_from_slice(&if big { i.to_be_bytes() } else { i.to_le_bytes() });
+                b.extend_from_slice(&if big {
+                    i.to_be_bytes()
+                } else {
+                    i.to_le_bytes()
+                });
             }
             let m = parse(&b, Path::new("s.ply")).unwrap();
             assert_eq!(m.mesh.vertices, a.mesh.vertices);
@@ -343,8 +412,11 @@ mod tests {
             let e = parse(&b, Path::new("s.ply")).unwrap_err().to_string();
             assert!(e.contains("ends inside face 1"), "{e}");
         }
-        let bad = HEAD.replace("FORMAT", "ascii") + "0 0 0 1\n1 0 0 1\n1 x 0 1\n0 1 0 1\n4 0 1 2 3\n";
-        let e = parse(bad.as_bytes(), Path::new("s.ply")).unwrap_err().to_string();
+        let bad =
+            HEAD.replace("FORMAT", "ascii") + "0 0 0 1\n1 0 0 1\n1 x 0 1\n0 1 0 1\n4 0 1 2 3\n";
+        let e = parse(bad.as_bytes(), Path::new("s.ply"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("s.ply:14:"), "{e}");
     }
 }

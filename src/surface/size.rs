@@ -171,7 +171,10 @@ mod tests {
         assert!(!s.contains('\n'));
         let e = check_plausible(p, DVec3::new(25_000.0, 1.0, 1.0), Units::Mm).unwrap_err();
         let s = e.to_string();
-        assert!(s.contains("larger than 10 m") && s.contains("--scale 0.04"), "{s}");
+        assert!(
+            s.contains("larger than 10 m") && s.contains("--scale 0.04"),
+            "{s}"
+        );
         let e = check_plausible(p, DVec3::new(20_000.0, 1.0, 1.0), Units::M).unwrap_err();
         assert!(e.to_string().contains("--units mm"), "{e}");
     }

@@ -32,7 +32,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
     if is_binary(bytes) {
         return binary(bytes, path);
     }
-    let text = std::str::from_utf8(bytes).ok().filter(|t| !t.contains('\0'));
+    let text = std::str::from_utf8(bytes)
+        .ok()
+        .filter(|t| !t.contains('\0'));
     match text {
         Some(t) if t.trim_start().to_ascii_lowercase().starts_with("solid") => ascii(t, path),
         _ if bytes.len() >= 84 => {
@@ -57,7 +59,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
 
 fn binary(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
     let mut w = Welder::default();
-    let f32_at = |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    let f32_at =
+        |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
     let n = (bytes.len() - 84) / 50;
     for t in 0..n {
         let base = 84 + 50 * t + 12;
@@ -96,13 +99,21 @@ fn ascii(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
             "solid" | "endsolid" | "facet" | "endfacet" => {}
             "outer" => {
                 if open.is_some() {
-                    return Err(err(path, Some(line), "`outer loop` inside another loop: a facet is not closed with `endloop`"));
+                    return Err(err(
+                        path,
+                        Some(line),
+                        "`outer loop` inside another loop: a facet is not closed with `endloop`",
+                    ));
                 }
                 open = Some((Vec::new(), line));
             }
             "vertex" => {
                 let Some((verts, _)) = open.as_mut() else {
-                    return Err(err(path, Some(line), "`vertex` outside `outer loop` … `endloop`"));
+                    return Err(err(
+                        path,
+                        Some(line),
+                        "`vertex` outside `outer loop` … `endloop`",
+                    ));
                 };
                 let c: Vec<&str> = words.collect();
                 if c.len() != 3 {
@@ -142,7 +153,11 @@ fn ascii(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
         }
     }
     if let Some((_, at)) = open {
-        return Err(err(path, Some(at), "the file ends inside this facet's loop (no `endloop`)"));
+        return Err(err(
+            path,
+            Some(at),
+            "the file ends inside this facet's loop (no `endloop`)",
+        ));
     }
     w.finish(path)
 }
@@ -172,7 +187,10 @@ mod tests {
     #[test]
     fn ascii_and_binary_weld_to_the_same_mesh() {
         let a = parse(SQUARE.as_bytes(), Path::new("a.stl")).unwrap();
-        assert_eq!((a.mesh.vertices.len(), a.mesh.faces.len(), a.welded), (4, 2, 2));
+        assert_eq!(
+            (a.mesh.vertices.len(), a.mesh.faces.len(), a.welded),
+            (4, 2, 2)
+        );
         assert_eq!(a.mesh.faces[1].line, Some(10));
         let b = to_binary(&[
             [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
@@ -195,8 +213,13 @@ mod tests {
         let b = to_binary(&[[[0.0, f32::NAN, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]]);
         let e = parse(&b, Path::new("b.stl")).unwrap_err().to_string();
         assert!(e.contains("triangle 1, corner 1"), "{e}");
-        let t = SQUARE.replace("vertex 1 1 0\nendloop\nendfacet\nfacet", "vertex 1 x 0\nendloop\nendfacet\nfacet");
-        let e = parse(t.as_bytes(), Path::new("a.stl")).unwrap_err().to_string();
+        let t = SQUARE.replace(
+            "vertex 1 1 0\nendloop\nendfacet\nfacet",
+            "vertex 1 x 0\nendloop\nendfacet\nfacet",
+        );
+        let e = parse(t.as_bytes(), Path::new("a.stl"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("a.stl:6:"), "{e}");
         let e = parse(b"hello", Path::new("a.stl")).unwrap_err().to_string();
         assert!(e.contains("not an STL file"), "{e}");

@@ -133,7 +133,9 @@ fn text_height(t: &Text) -> Option<f64> {
             let (lo, hi) = s
                 .iter()
                 .map(|q| q.dot(n))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                });
             hi - lo
         })
         .max_by(f64::total_cmp)

@@ -18,5 +18,6 @@ mod nest;
 mod param;
 mod pattern;
 mod simplify;
+mod sizing;
 mod strip;
 mod toolpath;
