@@ -260,7 +260,8 @@ impl Error {
     /// 2 for a bug in flatcut, 1 for everything the user or the environment can fix.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Pattern(_) | Error::Nest(nest::NestError::Infeasible(_)) => 2,
+            Error::Pattern(e) if e.is_bug() => 2,
+            Error::Nest(nest::NestError::Infeasible(_)) => 2,
             Error::In { source, .. } | Error::At { source, .. } => source.exit_code(),
             _ => 1,
         }
