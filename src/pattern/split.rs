@@ -35,8 +35,9 @@
 //! long as fits) gives the fewest runs K that sequence allows; the runs are then balanced to
 //! equal areas (each cut moved, within a quarter of a part's area, to where its seam costs
 //! least). Of all feasible partitions the one with fewest parts wins, then the lowest cost:
-//! the seams' length over the square root of a part's area (edges that are not fold lines,
-//! bend lines or rulings count double, so seams run along existing lines), plus twice the
+//! the seams' length over the square root of a part's area (edges where the surface does not
+//! bend — the diagonal of a flat quad, of a cone's planar strip between two rulings — and that
+//! are no named bend line count double, so seams run along folds and rulings), plus twice the
 //! largest part's excess area over the mean. On a large cone this gives what a shop lays out:
 //! equal segments joined along rulings, each with its own bend lines.
 
@@ -45,6 +46,10 @@ use crate::flatten::Flat;
 use crate::geom::polygon;
 use glam::DVec2;
 use std::collections::HashSet;
+
+/// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
+/// would cross a panel rather than follow a line of the surface.
+const BENDS_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
 
 /// Whether pieces too large for the sheet are split (`--split`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -370,7 +375,7 @@ struct Island<'a> {
     area: Vec<f64>,
     adj: Vec<Vec<usize>>,
     /// (u, v, cost) with u < v: a joined edge, its length doubled where it is not a line of
-    /// the surface (fold, bend line, ruling).
+    /// the surface (where it does not bend and is no named bend line).
     links: Vec<(usize, usize, f64)>,
     grain: bool,
     room: Room,
@@ -384,8 +389,8 @@ impl<'a> Island<'a> {
         for (i, &f) in faces.iter().enumerate() {
             local.insert(f, i);
         }
-        let threshold = opts.fold_threshold_deg.to_radians();
-        let ruled = flat.surface.bends.is_some();
+        // Lines of the surface: where it bends at all, or a bend line it names.
+        let named = super::bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
         let mut adj = vec![Vec::new(); n];
         let mut links = Vec::new();
         for (u, &f) in faces.iter().enumerate() {
@@ -401,7 +406,7 @@ impl<'a> Island<'a> {
                     continue;
                 }
                 let (a, b) = flat.corner_edge(f, i);
-                let line = ruled || flat.dihedral[e].abs() > threshold;
+                let line = named[e].is_some() || flat.dihedral[e].abs() > BENDS_RAD;
                 let cost = a.distance(b) * if line { 1.0 } else { 2.0 };
                 adj[u].push(v);
                 adj[v].push(u);
@@ -526,7 +531,8 @@ impl<'a> Island<'a> {
             let d = (self.centroid[other] - self.centroid[end]).normalize_or_zero();
             let mut order: Vec<usize> = (0..n).collect();
             order.sort_by(|&u, &v| {
-                dist[u].cmp(&dist[v])
+                dist[u]
+                    .cmp(&dist[v])
                     .then(self.centroid[u].dot(d).total_cmp(&self.centroid[v].dot(d)))
                     .then(u.cmp(&v))
             });
@@ -618,7 +624,9 @@ fn partition(
             }
         }
     }
-    let parts = best.map(|(_, p)| p).unwrap_or_else(|| vec![(0..n).collect()]);
+    let parts = best
+        .map(|(_, p)| p)
+        .unwrap_or_else(|| vec![(0..n).collect()]);
     Ok(parts
         .into_iter()
         .map(|p| p.into_iter().map(|u| faces[u]).collect())

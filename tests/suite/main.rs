@@ -18,5 +18,6 @@ mod nest;
 mod param;
 mod pattern;
 mod simplify;
+mod split;
 mod strip;
 mod toolpath;
