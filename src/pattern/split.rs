@@ -565,7 +565,7 @@ fn partition(
     let n = faces.len();
     let mut stamp = vec![0usize; n];
     let mut mark = 1;
-    let mut best: Option<((usize, f64), Vec<Vec<usize>>)> = None;
+    let mut best: Best = None;
     let orders = isl.orders();
     // Runs [cuts[i], cuts[i + 1]) of an order, as parts if each fits.
     let mut parts_of = |order: &[usize], cuts: &[usize]| -> Option<Vec<Vec<usize>>> {
@@ -608,7 +608,7 @@ fn partition(
         }
         greedy_runs.push(cuts.len() - 1);
         if let Some(parts) = parts_of(order, &cuts) {
-            consider(&isl, parts, total, &mut best);
+            consider(&isl, merge(&isl, parts), total, &mut best);
         }
     }
     let k_min = greedy_runs.iter().copied().min().unwrap_or(1);
@@ -620,7 +620,7 @@ fn partition(
         for k in ks {
             let cuts = balanced(&isl, order, k, total);
             if let Some(parts) = parts_of(order, &cuts) {
-                consider(&isl, parts, total, &mut best);
+                consider(&isl, merge(&isl, parts), total, &mut best);
             }
         }
     }
@@ -633,15 +633,64 @@ fn partition(
         .collect())
 }
 
+/// Fewer parts: the smallest part that can join a neighbour (through a joined edge) and
+/// still fit does, into the neighbour it shares the longest seam with, until none can. A run
+/// of a sequence can fall apart into pieces, and a small one is better joined to another.
+fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    let mut part_of = vec![0; isl.faces.len()];
+    loop {
+        for (k, p) in parts.iter().enumerate() {
+            for &u in p {
+                part_of[u] = k;
+            }
+        }
+        let area = |p: &Vec<usize>| p.iter().map(|&u| isl.area[u]).sum::<f64>();
+        let mut by_size: Vec<usize> = (0..parts.len()).collect();
+        by_size.sort_by(|&a, &b| area(&parts[a]).total_cmp(&area(&parts[b])).then(a.cmp(&b)));
+        let mut joined = None;
+        'parts: for &k in &by_size {
+            // Neighbours by shared seam length, longest first.
+            let mut shared: Vec<(usize, f64)> = Vec::new();
+            for &(u, v, c) in &isl.links {
+                let (pu, pv) = (part_of[u], part_of[v]);
+                let other = if pu == k && pv != k {
+                    pv
+                } else if pv == k && pu != k {
+                    pu
+                } else {
+                    continue;
+                };
+                match shared.iter_mut().find(|x| x.0 == other) {
+                    Some(x) => x.1 += c,
+                    None => shared.push((other, c)),
+                }
+            }
+            shared.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            for (j, _) in shared {
+                let mut union = parts[k].clone();
+                union.extend_from_slice(&parts[j]);
+                if isl.overflow(&union) <= 0.0 {
+                    joined = Some((k, j, union));
+                    break 'parts;
+                }
+            }
+        }
+        let Some((k, j, mut union)) = joined else {
+            return parts;
+        };
+        union.sort_unstable();
+        let (keep, drop) = (k.min(j), k.max(j));
+        parts[keep] = union;
+        parts.remove(drop);
+    }
+}
+
+/// The best partition so far: (number of parts, cost) and the parts.
+type Best = Option<((usize, f64), Vec<Vec<usize>>)>;
+
 /// Keep `parts` if it beats the best so far: fewer parts, then a lower cost (seam length over
 /// a part's typical size, twice the largest part's excess area over the mean).
-#[allow(clippy::type_complexity)]
-fn consider(
-    isl: &Island,
-    parts: Vec<Vec<usize>>,
-    total: f64,
-    best: &mut Option<((usize, f64), Vec<Vec<usize>>)>,
-) {
+fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
     let mut part_of = vec![0; isl.faces.len()];
     for (k, p) in parts.iter().enumerate() {
         for &u in p {
