@@ -13,7 +13,8 @@
 //! 3. [`flatten`] lays it into the plane as a [`flatten::Flat`]: exact unfolding into islands
 //!    of faces moved by rigid motions, or LSCM / ABF++ charts of nearly developable meshes.
 //! 4. [`pattern`] turns islands into [`pattern::Piece`]s: cut outline, fold and bend lines,
-//!    seam ids, notches, labels, glue tabs, allowance and kerf.
+//!    seam ids, notches, labels, glue tabs, allowance and kerf; pieces too large for the sheet
+//!    are split along their own lines first.
 //! 5. [`nest`] places pieces on sheets or a roll as a [`nest::Layout`].
 //! 6. [`toolpath`] orders each sheet's strokes into a [`toolpath::Job`] and prepares it for the
 //!    machine (perforation, overcut, drag-knife offset).
@@ -128,6 +129,7 @@
 //!   bends.rs                   Which joined edges of a flat become fold (score) or bend lines, and at which angle
 //!   marks.rs                   Marks that tell a person which edge goes where and which way up a piece goes
 //!   simplify.rs                Simplified seams for pieces laid out from D-Charts (issue 7, thesis §5.3 "Simplifying boundarie…
+//!   split.rs                   Splitting pieces that do not fit the sheet (issue 21, items 4 and 5): a piece larger than the s…
 //! profile/
 //!   mod.rs                     Device profiles, the configuration several stages read (toolpath, output, device)
 //!   read.rs                    Reading a profile
@@ -260,7 +262,8 @@ impl Error {
     /// 2 for a bug in flatcut, 1 for everything the user or the environment can fix.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Pattern(_) | Error::Nest(nest::NestError::Infeasible(_)) => 2,
+            Error::Pattern(e) if e.is_bug() => 2,
+            Error::Nest(nest::NestError::Infeasible(_)) => 2,
             Error::In { source, .. } | Error::At { source, .. } => source.exit_code(),
             _ => 1,
         }

@@ -3,7 +3,8 @@
 //! through these functions (the benches time single stages on their own inputs); no stage calls another stage's entry point, and `cli`
 //! only parses flags, fills the options below and prints.
 //!
-//! - [`pieces`]: spec → surfaces → flats → pieces (surface, flatten and pattern stages).
+//! - [`pieces`]: spec → surfaces → flats → pieces (surface, flatten and pattern stages);
+//!   pieces too large for the spec's sheet are split to fit unless `split = none`.
 //! - [`plan`] / [`plan_job`]: pieces → layout → job (nest and toolpath stages), with the
 //!   device deciding which stroke kinds are drawn at all.
 //! - [`machine_job`]: the job as the device makes it (perforation dashes, overcut, drag-knife
@@ -150,7 +151,14 @@ fn flatten_surfaces(
         flats.push(flat);
     }
     let opts = spec.pattern_options();
-    let pieces = crate::pattern::build(&flats, &opts)?;
+    let pieces = match spec.pattern.split.unwrap_or_default() {
+        crate::pattern::split::Split::None => crate::pattern::build(&flats, &opts)?,
+        crate::pattern::split::Split::Auto => {
+            let s = &spec.sheet;
+            let room = crate::pattern::split::Room::inside(s.width, s.height, s.margin);
+            crate::pattern::split::build_to_fit(&mut flats, &opts, &room)?
+        }
+    };
     Ok((flats, pieces))
 }
 

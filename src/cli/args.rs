@@ -27,6 +27,10 @@ pub struct PatternArgs {
     /// V notches in the outline where bend lines meet it (sheet metal).
     #[arg(long)]
     pub bend_notches: bool,
+    /// Pieces too large for the sheet: auto (split them along their fold lines, interior
+    /// edges or rulings so that every part fits) or none (refuse them). Default: auto.
+    #[arg(long, value_enum)]
+    pub split: Option<crate::pattern::split::Split>,
 }
 
 impl PatternArgs {
@@ -49,6 +53,7 @@ impl PatternArgs {
         if self.bend_notches {
             p.bend_notches = Some(true);
         }
+        p.split = self.split.or(p.split);
         Ok(())
     }
 }

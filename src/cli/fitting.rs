@@ -99,6 +99,10 @@ pub struct FittingArgs {
     /// Sheet height (mm).
     #[arg(long, default_value_t = 1250.0)]
     pub sheet_height: f64,
+    /// A blank too large for the sheet: auto (made of segments joined along rulings, each
+    /// with its bend lines) or none (refused). Default: auto.
+    #[arg(long, value_enum)]
+    pub split: Option<crate::pattern::split::Split>,
     /// Job name (file names, labels); default: the kind.
     #[arg(long)]
     pub name: Option<String>,
@@ -261,7 +265,10 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             margin: 10.0,
             spacing: 5.0,
         },
-        pattern: PatternSpec::default(),
+        pattern: PatternSpec {
+            split: a.split,
+            ..PatternSpec::default()
+        },
     })
 }
 

@@ -2,7 +2,8 @@
 //! its source file, area, cut and fold lengths, every fold line with its kind and bend angle,
 //! sheet and placement), seams (`{id, piece_a, piece_b, length_a_mm, length_b_mm, notches}`:
 //! notch positions in mm from side A's start, and `notches_b_mm` from side B's start, which is
-//! A's end; `tab` says which side has the glue tab), sheets (size, pieces, utilisation; on a
+//! A's end; `tab` says which side has the glue tab; `"split": true` on the seams made by
+//! splitting a piece too large for the sheet), sheets (size, pieces, utilisation; on a
 //! roll the length used, on sheets the rectangle left free on the last sheet),
 //! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
 //! it measured some) and the files written. Pieces and surfaces laid out from charts of a
@@ -185,7 +186,7 @@ fn seams_json(layout: &Layout) -> Vec<Value> {
         let Some((pb, b)) = sides().find(|(_, s)| s.id == a.id && !s.is_a) else {
             continue;
         };
-        seams.push(json!({
+        let mut v = json!({
             "id": a.id,
             "piece_a": pa.id,
             "piece_b": pb.id,
@@ -200,7 +201,13 @@ fn seams_json(layout: &Layout) -> Vec<Value> {
                 (false, true) => "b",
                 (false, false) => "none",
             },
-        }));
+        });
+        // Seams made by splitting a piece too large for the sheet: only there, so that the
+        // report of a job that needed no split stays as it was.
+        if a.split || b.split {
+            v["split"] = json!(true);
+        }
+        seams.push(v);
     }
     seams.sort_by_key(|s| s["id"].as_u64());
     seams

@@ -75,6 +75,8 @@ pub struct SeamSide {
     pub notches: Vec<f64>,
     /// A glue tab was put on this side.
     pub tab: bool,
+    /// The seam was made by splitting a piece too large for the sheet ([`super::split`]).
+    pub split: bool,
 }
 
 /// Finds the seams of one flat's pieces: each piece gets its side of every seam it has, in
@@ -187,6 +189,7 @@ pub(super) fn find(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize) {
                 length,
                 notches: Vec::new(),
                 tab: false,
+                split: false,
             }
         };
         let sa = side(a, true, pieces[b.0].id);

@@ -30,6 +30,7 @@ use serde::Serialize;
 pub mod allowance;
 pub mod marks;
 pub mod simplify;
+pub mod split;
 
 pub use marks::{SeamSide, Text};
 
@@ -310,21 +311,56 @@ impl Piece {
 pub enum PatternError {
     #[error("surface `{surface}`, piece {piece}: its outline could not be traced (flatcut bug)")]
     Outline { surface: String, piece: String },
+    /// A piece that cannot be split to fit: one face larger than the room ([`split`]).
+    #[error("surface `{surface}`, piece {piece}: face {face} alone is {w:.1} × {h:.1} mm and does not fit on the {what} ({uw:.1} × {uh} mm inside the margins), so the piece cannot be split to fit; use a larger sheet or roll, or scale the surface down")]
+    TooLarge {
+        surface: String,
+        piece: String,
+        /// 1-based.
+        face: usize,
+        w: f64,
+        h: f64,
+        what: &'static str,
+        uw: f64,
+        uh: String,
+    },
+}
+
+impl PatternError {
+    /// A fault of flatcut itself (exit code 2), not of the input.
+    pub fn is_bug(&self) -> bool {
+        matches!(self, PatternError::Outline { .. })
+    }
 }
 
 /// Build the pieces of every flattened surface, numbering pieces and seams across the job.
 pub fn build(flats: &[Flat], opts: &PatternOptions) -> Result<Vec<Piece>, PatternError> {
+    build_tagged(flats, &[], opts)
+}
+
+/// [`build`], naming island `k` of flat `f` by `tags[f][k]` where given instead of `k + 1`
+/// (the parts of a split piece: `3a`, `3b`, …).
+pub(crate) fn build_tagged(
+    flats: &[Flat],
+    tags: &[Vec<String>],
+    opts: &PatternOptions,
+) -> Result<Vec<Piece>, PatternError> {
     let mut pieces: Vec<Piece> = Vec::new();
     let mut next_seam = 1;
     let multi = flats.len() > 1;
-    for flat in flats {
+    for (fi, flat) in flats.iter().enumerate() {
         let first = pieces.len();
         for (k, faces) in flat.islands.iter().enumerate() {
             let id = pieces.len() + 1;
+            let tag = tags
+                .get(fi)
+                .and_then(|t| t.get(k))
+                .cloned()
+                .unwrap_or_else(|| format!("{}", k + 1));
             let name = if multi {
-                format!("{}-{}", flat.surface.name, k + 1)
+                format!("{}-{tag}", flat.surface.name)
             } else {
-                format!("{}", k + 1)
+                tag
             };
             pieces.push(net(flat, faces, id, name, opts)?);
         }

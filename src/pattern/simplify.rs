@@ -548,6 +548,7 @@ mod tests {
             points,
             notches: Vec::new(),
             tab: false,
+            split: false,
         };
         a.seams.push(side(true, 2, 1, chain.to_vec()));
         b.seams

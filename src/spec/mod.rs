@@ -222,6 +222,8 @@ pub struct PatternSpec {
     pub notches: Option<f64>,
     pub kerf: Option<f64>,
     pub bend_notches: Option<bool>,
+    /// Split pieces too large for the sheet (`--split`; `None`: auto).
+    pub split: Option<crate::pattern::split::Split>,
 }
 
 impl Default for SheetSpec {
@@ -253,6 +255,7 @@ impl Default for PatternSpec {
             notches: None,
             kerf: None,
             bend_notches: None,
+            split: None,
         }
     }
 }
@@ -583,6 +586,7 @@ impl Ctx<'_> {
             )?,
             kerf: mm(&p.kerf, "pattern.kerf", "a width in mm, at least 0", false)?,
             bend_notches: self.boolean(&p.bend_notches, "pattern.bend_notches")?,
+            split: None,
         })
     }
 }

@@ -282,7 +282,7 @@ fn bad_input_is_exit_1_with_one_line() {
         &["typo.toml:6", "widht"],
     );
 
-    // Piece larger than the sheet: both sizes.
+    // Piece larger than the sheet, and splitting turned off: both sizes.
     std::fs::write(
         dir.join("big.toml"),
         format!(
@@ -292,7 +292,16 @@ fn bad_input_is_exit_1_with_one_line() {
     )
     .unwrap();
     expect_user_error(
-        &["cut", &p("big.toml"), "--tabs", "none", "-o", &out],
+        &[
+            "cut",
+            &p("big.toml"),
+            "--tabs",
+            "none",
+            "--split",
+            "none",
+            "-o",
+            &out,
+        ],
         &["big.toml", "400.0 × 300.0 mm", "200.0 × 287.0 mm"],
     );
 

@@ -19,5 +19,6 @@ mod param;
 mod pattern;
 mod simplify;
 mod sizing;
+mod split;
 mod strip;
 mod toolpath;

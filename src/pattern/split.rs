@@ -1,0 +1,794 @@
+//! Splitting pieces that do not fit the sheet (issue 21, items 4 and 5): a piece larger than
+//! the sheet inside its margins (or wider than the roll) at every orientation the nest tries is
+//! cut into parts along its own interior edges — the fold lines and flat interior edges of an
+//! unfolded mesh or chart, the rulings of a strip, a fitting or a bent sheet — so that every
+//! part fits; a part too large only because it is one face is an error naming both sizes.
+//!
+//! **Where.** The split changes the flat, not the pieces: the faces of the island stay where
+//! the flatten stage laid them (the unfolding is isometric, so a part of it is the unfolding of
+//! that part), the edges between two parts stop being joined (`Flat::joined`), and the parts
+//! become islands of their own. The pieces are then built again by [`super::build`], so a new
+//! seam is a seam like any other: found on both borders by [`super::marks`], with its id on
+//! both sides, notches, glue tabs or seam allowance by [`super::allowance`], its two sides
+//! measured on their own faces (equal lengths) and listed in report.json (with `"split":
+//! true`). Splitting the face set along mesh edges of the whole mesh and unfolding the parts
+//! again could join faces the unfolding had cut apart, but would redo the flatten stage's
+//! work and lose the chart layouts; parts of the existing layout keep them.
+//!
+//! **What fits.** The nest's construction places a piece turned so that its cut outline's
+//! minimum-area rectangle is axis-aligned, at one of four quarter turns (a piece with a grain
+//! line: grain along the sheet's y axis, either way); a piece fits when one of those boxes
+//! lies within the room. The same test is applied to the built pieces, so that a piece that
+//! fits today is never split and the bundled patterns' outputs do not change. Before a part is
+//! built, its size is estimated from its faces' corners grown on every side by what the
+//! material adds (tab height or seam allowance, half the kerf); a part that then does not fit
+//! once built has its island split again with the estimate grown by the overflow.
+//!
+//! **How** (the issue asks for few parts, straight and short seams, parts of similar size;
+//! the choices below are ours). The faces of the island are put in a sequence, in several
+//! ways: by their centroids along each of 12 directions 15° apart and along the axes of the
+//! island's minimum-area rectangle (ties broken along the perpendicular, so a sequence sweeps
+//! a straight front across the piece), and by their distance through joined edges from one end
+//! of the island (on a strip — a path of faces between rulings — that is the order along the
+//! strip, and every cut is one ruling). A partition is a cut of the sequence into runs; the
+//! parts are the runs' connected pieces. For each sequence the greedy partition (each run as
+//! long as fits) gives the fewest runs K that sequence allows; the runs are then balanced to
+//! equal areas (each cut moved, within a quarter of a part's area, to where its seam costs
+//! least). Of all feasible partitions the one with fewest parts wins, then the lowest cost:
+//! the seams' length over the square root of a part's area (edges where the surface does not
+//! bend — the diagonal of a flat quad, of a cone's planar strip between two rulings — and that
+//! are no named bend line count double, so seams run along folds and rulings), plus twice the
+//! largest part's excess area over the mean. On a large cone this gives what a shop lays out:
+//! equal segments joined along rulings, each with its own bend lines.
+
+use super::{PatternError, PatternOptions, Piece, Tabs};
+use crate::flatten::Flat;
+use crate::geom::polygon;
+use glam::DVec2;
+use std::collections::HashSet;
+
+/// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
+/// would cross a panel rather than follow a line of the surface.
+const BENDS_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
+
+/// Whether pieces too large for the sheet are split (`--split`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Split {
+    /// Split them along their own lines so that every part fits.
+    #[default]
+    Auto,
+    /// Never: a piece that does not fit is refused by the nest.
+    None,
+}
+
+/// The room a piece must fit in (mm): the sheet inside its margins, or the roll's width
+/// inside its margins (`height: None`, unlimited length).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Room {
+    pub width: f64,
+    pub height: Option<f64>,
+}
+
+impl Room {
+    /// The room of a sheet (`height: None` for a roll) with `margin` kept on every side.
+    pub fn inside(width: f64, height: Option<f64>, margin: f64) -> Room {
+        Room {
+            width: width - 2.0 * margin,
+            height: height.map(|h| h - 2.0 * margin),
+        }
+    }
+
+    /// Positive and finite (a roll's length aside): something can be placed at all.
+    fn usable(&self) -> bool {
+        self.width.is_finite()
+            && self.width > 0.0
+            && self.height.is_none_or(|h| h.is_finite() && h > 0.0)
+    }
+
+    /// How far (mm) a box of this size sticks out of the room; ≤ 0 when it fits (within the
+    /// nest's 1e-9 mm).
+    fn overflow(&self, size: DVec2) -> f64 {
+        let over_y = self.height.map_or(f64::NEG_INFINITY, |h| size.y - h);
+        (size.x - self.width).max(over_y) - 1e-9
+    }
+
+    fn what(&self) -> &'static str {
+        if self.height.is_some() {
+            "sheet"
+        } else {
+            "roll"
+        }
+    }
+
+    fn height_text(&self) -> String {
+        self.height.map_or("∞".into(), |h| format!("{h:.1}"))
+    }
+}
+
+/// The least overflow (mm) of a point set over the orientations given (degrees): ≤ 0 fits.
+fn overflow(points: &[DVec2], angles_deg: &[f64], room: &Room) -> f64 {
+    angles_deg
+        .iter()
+        .map(|&deg| {
+            let r = turn(deg);
+            let (lo, hi) = polygon::bounds(points.iter().map(|p| r.rotate(*p))).unwrap_or_default();
+            room.overflow(hi - lo)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Rotation by `deg` degrees, exact for quarter turns (as the nest turns pieces).
+fn turn(deg: f64) -> DVec2 {
+    let q = deg.rem_euclid(360.0);
+    match q {
+        0.0 => DVec2::X,
+        90.0 => DVec2::Y,
+        180.0 => DVec2::NEG_X,
+        270.0 => DVec2::NEG_Y,
+        _ => DVec2::from_angle(q.to_radians()),
+    }
+}
+
+/// The orientations (degrees) the nest's construction tries for points whose minimum-area
+/// rectangle is at `angle` (radians): its four quarter turns, or with a grain the two that
+/// put the long side along y.
+fn rect_angles(angle: f64, grain: bool) -> Vec<f64> {
+    let quarters: &[f64] = if grain {
+        &[1.0, 3.0]
+    } else {
+        &[0.0, 1.0, 2.0, 3.0]
+    };
+    let a = angle.to_degrees();
+    quarters
+        .iter()
+        .map(|q| (a + 90.0 * q).rem_euclid(360.0))
+        .collect()
+}
+
+/// How far (mm) a built piece overflows the room at the nest's orientations: ≤ 0 fits.
+pub fn piece_overflow(piece: &Piece, room: &Room) -> f64 {
+    let Some(outer) = piece.outline.first() else {
+        return 0.0;
+    };
+    let angles = match piece.grain {
+        Some(g) => [90.0, 270.0]
+            .iter()
+            .map(|b| (b - g.to_degrees()).rem_euclid(360.0))
+            .collect(),
+        None => rect_angles(polygon::min_area_rect_angle(outer), false),
+    };
+    let pts: Vec<DVec2> = piece
+        .outline
+        .iter()
+        .filter(|r| r.len() >= 3)
+        .flatten()
+        .copied()
+        .collect();
+    overflow(&pts, &angles, room)
+}
+
+/// Whether a built piece fits the room in an orientation the nest tries.
+pub fn fits(piece: &Piece, room: &Room) -> bool {
+    piece_overflow(piece, room) <= 0.0
+}
+
+/// Build the pieces of every flat ([`super::build`]) so that each fits `room`: pieces that do
+/// not are split (see the module docs), changing their flat's islands and joined edges. When
+/// every piece fits as it is, the pieces are exactly [`super::build`]'s and the flats are
+/// untouched. A part that is a single face too large for the room is
+/// [`PatternError::TooLarge`].
+pub fn build_to_fit(
+    flats: &mut [Flat],
+    opts: &PatternOptions,
+    room: &Room,
+) -> Result<Vec<Piece>, PatternError> {
+    let pieces = super::build(flats, opts)?;
+    if !room.usable() || pieces.iter().all(|p| fits(p, room)) {
+        return Ok(pieces);
+    }
+    let originals: Vec<(Vec<Vec<usize>>, Vec<bool>)> = flats
+        .iter()
+        .map(|f| (f.islands.clone(), f.joined.clone()))
+        .collect();
+    // The growth estimate of every island that must be split (None: it fits as it is).
+    let base = grow_estimate(opts);
+    let mut grow: Vec<Vec<Option<f64>>> = Vec::new();
+    let mut k = 0;
+    for f in flats.iter() {
+        grow.push(
+            (0..f.islands.len())
+                .map(|_| {
+                    k += 1;
+                    (!fits(&pieces[k - 1], room)).then_some(base)
+                })
+                .collect(),
+        );
+    }
+    let mut last = pieces;
+    for _round in 0..8 {
+        let mut tags = Vec::new();
+        let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
+        let mut split_edges: Vec<HashSet<usize>> = Vec::new();
+        for (fi, flat) in flats.iter_mut().enumerate() {
+            let (islands, joined) = &originals[fi];
+            flat.islands = islands.clone();
+            flat.joined = joined.clone();
+            let mut plans = Vec::new();
+            for (ii, faces) in islands.iter().enumerate() {
+                plans.push(match grow[fi][ii] {
+                    Some(g) => Some(partition(flat, faces, g, opts, room, ii)?),
+                    None => None,
+                });
+            }
+            let (t, o, cut) = apply(flat, &plans);
+            tags.push(t);
+            origin.extend(o.into_iter().map(|(ii, one)| (fi, ii, one)));
+            split_edges.push(cut);
+        }
+        let mut pieces = super::build_tagged(flats, &tags, opts)?;
+        let mut again = false;
+        for (p, &(fi, ii, one)) in pieces.iter().zip(&origin) {
+            let over = piece_overflow(p, room);
+            if over <= 0.0 {
+                continue;
+            }
+            if one {
+                return Err(too_large(p, room));
+            }
+            // Grown by the overflow (an island that fit as a whole now needs splitting too:
+            // possible only when the piece changed, which the same faces cannot).
+            let g = grow[fi][ii].get_or_insert(base);
+            *g += 0.5 * over + 0.5;
+            again = true;
+        }
+        let offset: Vec<usize> = flats
+            .iter()
+            .scan(0, |n, f| {
+                let at = *n;
+                *n += f.islands.len();
+                Some(at)
+            })
+            .collect();
+        for (fi, cut) in split_edges.iter().enumerate() {
+            let n = flats[fi].islands.len();
+            for p in &mut pieces[offset[fi]..offset[fi] + n] {
+                mark_split_seams(p, cut);
+            }
+        }
+        last = pieces;
+        if !again {
+            break;
+        }
+    }
+    Ok(last)
+}
+
+/// What the material adds around a part at most (mm): tabs or seam allowance, half the kerf.
+fn grow_estimate(opts: &PatternOptions) -> f64 {
+    let tabs = if opts.tabs == Tabs::None {
+        0.0
+    } else {
+        opts.tab_height
+    };
+    tabs.max(opts.allowance).max(0.0) + 0.5 * opts.kerf.max(0.0)
+}
+
+/// Seam sides running along an edge the split cut are marked `split`.
+fn mark_split_seams(p: &mut Piece, cut: &HashSet<usize>) {
+    for s in &mut p.seams {
+        let Some(ring) = p.border_edges.get(s.ring).filter(|r| !r.is_empty()) else {
+            continue;
+        };
+        let n = ring.len();
+        s.split = (0..s.count).any(|i| cut.contains(&ring[(s.first + i) % n]));
+    }
+}
+
+/// The error for a single face that cannot fit, with its size and the room's.
+fn too_large(p: &Piece, room: &Room) -> PatternError {
+    let pts: Vec<DVec2> = p.outline.iter().flatten().copied().collect();
+    let r = turn(polygon::min_area_rect_angle(&pts).to_degrees());
+    let (lo, hi) = polygon::bounds(pts.iter().map(|q| r.rotate(*q))).unwrap_or_default();
+    let size = hi - lo;
+    PatternError::TooLarge {
+        surface: p.surface.clone(),
+        piece: p.name.clone(),
+        face: p.faces.first().map_or(0, |f| f + 1),
+        w: size.x.max(size.y),
+        h: size.x.min(size.y),
+        what: room.what(),
+        uw: room.width,
+        uh: room.height_text(),
+    }
+}
+
+/// Puts the parts of the split islands into the flat: edges between two parts are no longer
+/// joined, each part is an island (after the parts of the islands before it). Returns the
+/// islands' name tags (`3`, or `3a`, `3b`, … for the parts of island 3), each island's
+/// original island and whether it is a single face of a split island, and the edges cut.
+#[allow(clippy::type_complexity)]
+fn apply(
+    flat: &mut Flat,
+    plans: &[Option<Vec<Vec<usize>>>],
+) -> (Vec<String>, Vec<(usize, bool)>, HashSet<usize>) {
+    let mut islands = Vec::new();
+    let mut tags = Vec::new();
+    let mut origin = Vec::new();
+    for (ii, faces) in flat.islands.iter().enumerate() {
+        match &plans[ii] {
+            Some(parts) if parts.len() > 1 => {
+                for (j, part) in parts.iter().enumerate() {
+                    islands.push(part.clone());
+                    tags.push(format!("{}{}", ii + 1, letters(j)));
+                    origin.push((ii, part.len() == 1));
+                }
+            }
+            _ => {
+                islands.push(faces.clone());
+                tags.push(format!("{}", ii + 1));
+                origin.push((ii, faces.len() == 1));
+            }
+        }
+    }
+    for (k, faces) in islands.iter().enumerate() {
+        for &f in faces {
+            flat.face_island[f] = k;
+        }
+    }
+    let mut cut = HashSet::new();
+    for (e, edge) in flat.topology.edges.iter().enumerate() {
+        if flat.joined[e] && edge.uses.len() == 2 {
+            let (a, b) = (edge.uses[0].0, edge.uses[1].0);
+            if flat.face_island[a] != flat.face_island[b] {
+                flat.joined[e] = false;
+                cut.insert(e);
+            }
+        }
+    }
+    if let Some(charts) = flat.surface.charts.as_mut() {
+        charts.clone_from(&flat.face_island);
+    }
+    flat.islands = islands;
+    (tags, origin, cut)
+}
+
+/// `a`, `b`, … `z`, `aa`, `ab`, …
+fn letters(mut j: usize) -> String {
+    let mut s = Vec::new();
+    loop {
+        s.push(b'a' + (j % 26) as u8);
+        if j < 26 {
+            break;
+        }
+        j = j / 26 - 1;
+    }
+    s.reverse();
+    String::from_utf8(s).unwrap_or_default()
+}
+
+/// One island being split: its faces (local indices), their centroids, areas and corners,
+/// and the joined edges between them with their seam cost.
+struct Island<'a> {
+    flat: &'a Flat,
+    faces: &'a [usize],
+    centroid: Vec<DVec2>,
+    area: Vec<f64>,
+    adj: Vec<Vec<usize>>,
+    /// (u, v, cost) with u < v: a joined edge, its length doubled where it is not a line of
+    /// the surface (where it does not bend and is no named bend line).
+    links: Vec<(usize, usize, f64)>,
+    grain: bool,
+    room: Room,
+    grow: f64,
+}
+
+impl<'a> Island<'a> {
+    fn new(flat: &'a Flat, faces: &'a [usize], opts: &PatternOptions, room: &Room) -> Self {
+        let n = faces.len();
+        let mut local = std::collections::HashMap::new();
+        for (i, &f) in faces.iter().enumerate() {
+            local.insert(f, i);
+        }
+        // Lines of the surface: where it bends at all, or a bend line it names.
+        let named = super::bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
+        let mut adj = vec![Vec::new(); n];
+        let mut links = Vec::new();
+        for (u, &f) in faces.iter().enumerate() {
+            for (i, &e) in flat.topology.face_edges[f].iter().enumerate() {
+                let edge = &flat.topology.edges[e];
+                if !flat.joined[e] || edge.uses.len() != 2 || edge.uses[0] != (f, i) {
+                    continue;
+                }
+                let Some(&v) = local.get(&edge.uses[1].0) else {
+                    continue;
+                };
+                if v == u {
+                    continue;
+                }
+                let (a, b) = flat.corner_edge(f, i);
+                let line = named[e].is_some() || flat.dihedral[e].abs() > BENDS_RAD;
+                let cost = a.distance(b) * if line { 1.0 } else { 2.0 };
+                adj[u].push(v);
+                adj[v].push(u);
+                links.push((u.min(v), u.max(v), cost));
+            }
+        }
+        let centroid = faces
+            .iter()
+            .map(|&f| {
+                let c = &flat.face_2d[f];
+                c.iter().copied().sum::<DVec2>() / c.len().max(1) as f64
+            })
+            .collect();
+        let area = faces
+            .iter()
+            .map(|&f| flat.surface.mesh.face_area(f))
+            .collect();
+        Island {
+            flat,
+            faces,
+            centroid,
+            area,
+            adj,
+            links,
+            grain: opts.grain,
+            room: *room,
+            grow: 0.0,
+        }
+    }
+
+    /// Overflow (mm) of a set of local faces, grown by `self.grow` unless it is one face.
+    fn overflow(&self, set: &[usize]) -> f64 {
+        let pts: Vec<DVec2> = set
+            .iter()
+            .flat_map(|&u| self.flat.face_2d[self.faces[u]].iter().copied())
+            .collect();
+        let grow = if set.len() == 1 { 0.0 } else { self.grow };
+        let angles = rect_angles(polygon::min_area_rect_angle(&pts), self.grain);
+        let room = Room {
+            width: self.room.width - 2.0 * grow,
+            height: self.room.height.map(|h| h - 2.0 * grow),
+        };
+        overflow(&pts, &angles, &room)
+    }
+
+    /// Connected pieces (through joined edges) of a set of local faces, each in set order.
+    fn components(&self, set: &[usize], stamp: &mut [usize], mark: usize) -> Vec<Vec<usize>> {
+        for &u in set {
+            stamp[u] = mark;
+        }
+        let mut out = Vec::new();
+        let done = mark + 1;
+        for &u0 in set {
+            if stamp[u0] != mark {
+                continue;
+            }
+            stamp[u0] = done;
+            let mut comp = vec![u0];
+            let mut i = 0;
+            while i < comp.len() {
+                let u = comp[i];
+                i += 1;
+                for &v in &self.adj[u] {
+                    if stamp[v] == mark {
+                        stamp[v] = done;
+                        comp.push(v);
+                    }
+                }
+            }
+            comp.sort_unstable();
+            out.push(comp);
+        }
+        out
+    }
+
+    /// The sequences of faces the partitions cut (see the module docs), without repeats.
+    fn orders(&self) -> Vec<Vec<usize>> {
+        let n = self.faces.len();
+        let (lo, hi) = polygon::bounds(self.centroid.iter().copied()).unwrap_or_default();
+        let quantum = 1e-6 * (hi - lo).length().max(1e-9);
+        let mut dirs: Vec<DVec2> = (0..12)
+            .map(|j| DVec2::from_angle(j as f64 * std::f64::consts::PI / 12.0))
+            .collect();
+        let a = polygon::min_area_rect_angle(&self.centroid);
+        let axis = DVec2::from_angle(-a);
+        dirs.push(axis);
+        dirs.push(axis.perp());
+        let mut out: Vec<Vec<usize>> = Vec::new();
+        for d in dirs {
+            let mut order: Vec<usize> = (0..n).collect();
+            let key = |u: usize| {
+                let c = self.centroid[u];
+                ((c.dot(d) / quantum).round() as i64, c.perp_dot(d))
+            };
+            order.sort_by(|&u, &v| {
+                let (a, b) = (key(u), key(v));
+                a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)).then(u.cmp(&v))
+            });
+            out.push(order);
+        }
+        // Through joined edges from one end: the face farthest from face 0, then the order
+        // of distance from it (ties along the line between the two ends).
+        let far = |s: usize| -> (Vec<usize>, usize) {
+            let mut dist = vec![usize::MAX; n];
+            dist[s] = 0;
+            let mut queue = std::collections::VecDeque::from([s]);
+            let mut last = s;
+            while let Some(u) = queue.pop_front() {
+                last = u;
+                for &v in &self.adj[u] {
+                    if dist[v] == usize::MAX {
+                        dist[v] = dist[u] + 1;
+                        queue.push_back(v);
+                    }
+                }
+            }
+            (dist, last)
+        };
+        if n > 0 {
+            let (_, end) = far(0);
+            let (dist, other) = far(end);
+            let d = (self.centroid[other] - self.centroid[end]).normalize_or_zero();
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&u, &v| {
+                dist[u]
+                    .cmp(&dist[v])
+                    .then(self.centroid[u].dot(d).total_cmp(&self.centroid[v].dot(d)))
+                    .then(u.cmp(&v))
+            });
+            out.push(order);
+        }
+        let mut seen = HashSet::new();
+        out.retain(|o| seen.insert(o.clone()));
+        out
+    }
+}
+
+/// Partition of one island into parts (global face ids) that each fit, estimated with
+/// `grow`; a single face that does not fit on its own is [`PatternError::TooLarge`].
+fn partition(
+    flat: &Flat,
+    faces: &[usize],
+    grow: f64,
+    opts: &PatternOptions,
+    room: &Room,
+    island: usize,
+) -> Result<Vec<Vec<usize>>, PatternError> {
+    let mut isl = Island::new(flat, faces, opts, room);
+    isl.grow = grow;
+    for u in 0..faces.len() {
+        if isl.overflow(&[u]) > 0.0 {
+            return Err(face_too_large(&isl, u, island));
+        }
+    }
+    let total: f64 = isl.area.iter().sum();
+    let n = faces.len();
+    let mut stamp = vec![0usize; n];
+    let mut mark = 1;
+    let mut best: Best = None;
+    let orders = isl.orders();
+    // Runs [cuts[i], cuts[i + 1]) of an order, as parts if each fits.
+    let mut parts_of = |order: &[usize], cuts: &[usize]| -> Option<Vec<Vec<usize>>> {
+        let mut parts = Vec::new();
+        for w in cuts.windows(2) {
+            mark += 2;
+            for comp in isl.components(&order[w[0]..w[1]], &mut stamp, mark) {
+                if isl.overflow(&comp) > 0.0 {
+                    return None;
+                }
+                parts.push(comp);
+            }
+        }
+        Some(parts)
+    };
+    let mut greedy_runs = Vec::new();
+    for order in &orders {
+        // Greedy: each run as long as fits (binary search on its end).
+        let mut cuts = vec![0];
+        let mut s = 0;
+        while s < n {
+            let mut ok = |t: usize| parts_of(order, &[s, t]).is_some();
+            let t = if ok(n) {
+                n
+            } else {
+                // ok(lo) holds (every face fits alone, checked above), ok(hi) does not.
+                let (mut lo, mut hi) = (s + 1, n);
+                while hi - lo > 1 {
+                    let mid = (lo + hi) / 2;
+                    if ok(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                lo
+            };
+            cuts.push(t);
+            s = t;
+        }
+        greedy_runs.push(cuts.len() - 1);
+        if let Some(parts) = parts_of(order, &cuts) {
+            consider(&isl, merge(&isl, parts), total, &mut best);
+        }
+    }
+    let k_min = greedy_runs.iter().copied().min().unwrap_or(1);
+    for (order, &k_own) in orders.iter().zip(&greedy_runs) {
+        let mut ks = vec![k_min];
+        if k_own != k_min {
+            ks.push(k_own);
+        }
+        for k in ks {
+            let cuts = balanced(&isl, order, k, total);
+            if let Some(parts) = parts_of(order, &cuts) {
+                consider(&isl, merge(&isl, parts), total, &mut best);
+            }
+        }
+    }
+    let parts = best
+        .map(|(_, p)| p)
+        .unwrap_or_else(|| vec![(0..n).collect()]);
+    Ok(parts
+        .into_iter()
+        .map(|p| p.into_iter().map(|u| faces[u]).collect())
+        .collect())
+}
+
+/// Fewer parts: the smallest part that can join a neighbour (through a joined edge) and
+/// still fit does, into the neighbour it shares the longest seam with, until none can. A run
+/// of a sequence can fall apart into pieces, and a small one is better joined to another.
+fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    let mut part_of = vec![0; isl.faces.len()];
+    loop {
+        for (k, p) in parts.iter().enumerate() {
+            for &u in p {
+                part_of[u] = k;
+            }
+        }
+        let area = |p: &Vec<usize>| p.iter().map(|&u| isl.area[u]).sum::<f64>();
+        let mut by_size: Vec<usize> = (0..parts.len()).collect();
+        by_size.sort_by(|&a, &b| area(&parts[a]).total_cmp(&area(&parts[b])).then(a.cmp(&b)));
+        let mut joined = None;
+        'parts: for &k in &by_size {
+            // Neighbours by shared seam length, longest first.
+            let mut shared: Vec<(usize, f64)> = Vec::new();
+            for &(u, v, c) in &isl.links {
+                let (pu, pv) = (part_of[u], part_of[v]);
+                let other = if pu == k && pv != k {
+                    pv
+                } else if pv == k && pu != k {
+                    pu
+                } else {
+                    continue;
+                };
+                match shared.iter_mut().find(|x| x.0 == other) {
+                    Some(x) => x.1 += c,
+                    None => shared.push((other, c)),
+                }
+            }
+            shared.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            for (j, _) in shared {
+                let mut union = parts[k].clone();
+                union.extend_from_slice(&parts[j]);
+                if isl.overflow(&union) <= 0.0 {
+                    joined = Some((k, j, union));
+                    break 'parts;
+                }
+            }
+        }
+        let Some((k, j, mut union)) = joined else {
+            return parts;
+        };
+        union.sort_unstable();
+        let (keep, drop) = (k.min(j), k.max(j));
+        parts[keep] = union;
+        parts.remove(drop);
+    }
+}
+
+/// The best partition so far: (number of parts, cost) and the parts.
+type Best = Option<((usize, f64), Vec<Vec<usize>>)>;
+
+/// Keep `parts` if it beats the best so far: fewer parts, then a lower cost (seam length over
+/// a part's typical size, twice the largest part's excess area over the mean).
+fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
+    let mut part_of = vec![0; isl.faces.len()];
+    for (k, p) in parts.iter().enumerate() {
+        for &u in p {
+            part_of[u] = k;
+        }
+    }
+    let mean = total / parts.len() as f64;
+    let seam: f64 = isl
+        .links
+        .iter()
+        .filter(|(u, v, _)| part_of[*u] != part_of[*v])
+        .map(|l| l.2)
+        .sum();
+    let largest = parts
+        .iter()
+        .map(|p| p.iter().map(|&u| isl.area[u]).sum::<f64>())
+        .fold(0.0, f64::max);
+    let cost = seam / mean.sqrt().max(1e-9) + 2.0 * (largest / mean.max(1e-300) - 1.0);
+    let score = (parts.len(), cost);
+    let better = match best {
+        None => true,
+        Some((s, _)) => score.0 < s.0 || (score.0 == s.0 && score.1 < s.1 - 1e-12),
+    };
+    if better {
+        *best = Some((score, parts));
+    }
+}
+
+/// Cuts of an order into `k` runs of about equal area, each cut moved within a quarter of a
+/// run's area to where the edges it crosses cost least.
+fn balanced(isl: &Island, order: &[usize], k: usize, total: f64) -> Vec<usize> {
+    let n = order.len();
+    let mut rank = vec![0; n];
+    for (r, &u) in order.iter().enumerate() {
+        rank[u] = r;
+    }
+    // Area before position q, and the cost of the edges a cut at q crosses.
+    let mut before = vec![0.0; n + 1];
+    for (r, &u) in order.iter().enumerate() {
+        before[r + 1] = before[r] + isl.area[u];
+    }
+    let mut diff = vec![0.0; n + 2];
+    for &(u, v, c) in &isl.links {
+        let (a, b) = (rank[u].min(rank[v]), rank[u].max(rank[v]));
+        diff[a + 1] += c;
+        diff[b + 1] -= c;
+    }
+    let mut crossing = vec![0.0; n + 1];
+    let mut acc = 0.0;
+    for q in 0..=n {
+        acc += diff[q];
+        crossing[q] = acc;
+    }
+    let share = total / k as f64;
+    let size = share.sqrt().max(1e-9);
+    let mut cuts = vec![0];
+    for j in 1..k {
+        let target = share * j as f64;
+        let prev = *cuts.last().unwrap_or(&0);
+        let q = (prev + 1..n)
+            .filter(|&q| (before[q] - target).abs() <= 0.25 * share)
+            .min_by(|&a, &b| {
+                let f = |q: usize| crossing[q] / size + 2.0 * (before[q] - target).abs() / share;
+                f(a).total_cmp(&f(b)).then(a.cmp(&b))
+            })
+            .unwrap_or_else(|| {
+                (prev + 1..n)
+                    .min_by(|&a, &b| {
+                        (before[a] - target)
+                            .abs()
+                            .total_cmp(&(before[b] - target).abs())
+                    })
+                    .unwrap_or(n)
+            });
+        if q >= n {
+            break;
+        }
+        cuts.push(q);
+    }
+    cuts.push(n);
+    cuts
+}
+
+/// The error for face `u` of an island, too large for the room on its own.
+fn face_too_large(isl: &Island, u: usize, island: usize) -> PatternError {
+    let f = isl.faces[u];
+    let pts = &isl.flat.face_2d[f];
+    let r = turn(polygon::min_area_rect_angle(pts).to_degrees());
+    let (lo, hi) = polygon::bounds(pts.iter().map(|q| r.rotate(*q))).unwrap_or_default();
+    let size = hi - lo;
+    PatternError::TooLarge {
+        surface: isl.flat.surface.name.clone(),
+        piece: format!("{}", island + 1),
+        face: f + 1,
+        w: size.x.max(size.y),
+        h: size.x.min(size.y),
+        what: isl.room.what(),
+        uw: isl.room.width,
+        uh: isl.room.height_text(),
+    }
+}
