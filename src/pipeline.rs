@@ -407,10 +407,7 @@ pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let expected: &[&str] = match profile.language {
-        crate::profile::Language::Hpgl => &["plt", "hpgl", "hpg"],
-        crate::profile::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
-    };
+    let expected = profile.language.extensions();
     if !expected.contains(&ext.as_str()) {
         return Err(Error::Usage(format!(
             "{}: device `{}` speaks {}, which is sent from a .{} file; this file is `.{ext}`",

@@ -20,7 +20,7 @@
 //!   `flow_violations`. (Only stops longer than the grace can catch a host this way; the
 //!   grace is long enough for a loaded machine's kernel to act on XOFF.) This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
 //!   stream into the simulator.
-//! - **Execution.** HP-GL instructions are executed one at a time, each when the previous
+//! - **Execution.** HP-GL and GP-GL (`gpgl`) instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the
 //!   interpreters compute (`hpgl`, [`grbl`]) divided by the time factor (`None`: no time).
@@ -32,6 +32,7 @@
 //! Everything it cuts is recorded (`record`) and, on [`SimHandle::finish`], summarised in a
 //! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
 
+pub(crate) mod gpgl;
 pub mod grbl;
 pub(crate) mod hpgl;
 pub(crate) mod record;
@@ -305,6 +306,7 @@ impl Line {
 enum Interp {
     Hpgl(hpgl::Hpgl),
     Grbl(grbl::Grbl),
+    Gpgl(gpgl::Gpgl),
 }
 
 struct Device {
@@ -359,10 +361,10 @@ impl Device {
         } else {
             p.serial.flow_control
         };
-        let interp = if grbl {
-            Interp::Grbl(grbl::Grbl::new(p))
-        } else {
-            Interp::Hpgl(hpgl::Hpgl::new(p))
+        let interp = match p.language {
+            Language::Gcode => Interp::Grbl(grbl::Grbl::new(p)),
+            Language::Hpgl => Interp::Hpgl(hpgl::Hpgl::new(p)),
+            Language::Gpgl => Interp::Gpgl(gpgl::Gpgl::new(p)),
         };
         let rep = SimReport {
             device: p.name.clone(),
@@ -528,6 +530,9 @@ impl Device {
                 crate::output::hpgl::read::next_instruction(self.rx.iter()).is_some()
             }
             Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
+            Interp::Gpgl(_) => {
+                crate::output::gpgl::next_instruction(self.rx.iter()).is_some()
+            }
         }
     }
 
@@ -661,6 +666,20 @@ impl Device {
                         self.motion.push_back(s);
                     }
                 }
+                Interp::Gpgl(m) => {
+                    if !self.motion.is_empty() {
+                        return;
+                    }
+                    let Some(n) = crate::output::gpgl::next_instruction(self.rx.iter()) else {
+                        return;
+                    };
+                    let instr: Vec<u8> = self.rx.drain(..n).collect();
+                    let t = m.execute(&instr);
+                    self.rep.simulated_time_s += t;
+                    if let Some(s) = self.scaled(t) {
+                        self.motion.push_back(s);
+                    }
+                }
                 Interp::Grbl(g) => {
                     if self.held || self.motion.len() >= PLANNER_BLOCKS {
                         return;
@@ -774,6 +793,12 @@ impl Device {
     fn close(mut self) -> SimReport {
         let (rec, upm) = match &self.interp {
             Interp::Hpgl(m) => {
+                self.rep.executed = m.instructions;
+                self.rep.tool_down_at_end = m.tool_down();
+                self.rep.ignored = m.ignored.clone();
+                (m.rec.clone(), self.cfg.profile.units_per_mm)
+            }
+            Interp::Gpgl(m) => {
                 self.rep.executed = m.instructions;
                 self.rep.tool_down_at_end = m.tool_down();
                 self.rep.ignored = m.ignored.clone();
