@@ -40,5 +40,12 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    deliver_and_print(&[(name, bytes)], &profile, &a.link, &dir, a.quiet)
+    deliver_and_print(
+        &[(name, bytes)],
+        &[crate::pipeline::Before::Start],
+        &profile,
+        &a.link,
+        &dir,
+        a.quiet,
+    )
 }

@@ -74,7 +74,9 @@ fn check_tool(profile: &Profile, kind: &str, tool: &Tool) -> Result<GpglTool, Ou
         .pen
         .ok_or_else(|| err("no `pen`: GP-GL selects the tool with `J<pen>`".into()))?;
     if !PENS.contains(&pen) {
-        return Err(err(format!("`pen` must be 1 to 8 for GP-GL `J`, got {pen}")));
+        return Err(err(format!(
+            "`pen` must be 1 to 8 for GP-GL `J`, got {pen}"
+        )));
     }
     let speed = match tool.speed {
         Some(v) if !(v.is_finite() && v.round() >= 1.0 && v < 1e4) => {
@@ -266,7 +268,8 @@ pub fn parse(program: &[u8]) -> Result<Vec<ParsedStroke>, String> {
     let mut down = false;
     for (n, raw) in program.split(|&b| ends_instruction(b)).enumerate() {
         let Some(it) = instruction(raw) else { continue };
-        let (op, nums) = it.map_err(|bad| format!("instruction {}: `{bad}` is not a number", n + 1))?;
+        let (op, nums) =
+            it.map_err(|bad| format!("instruction {}: `{bad}` is not a number", n + 1))?;
         match op.as_str() {
             "H" => {
                 down = false;
@@ -278,7 +281,12 @@ pub fn parse(program: &[u8]) -> Result<Vec<ParsedStroke>, String> {
             }
             "!" => speed = nums.first().copied(),
             "FX" => force = nums.first().copied(),
-            "O" | "E" => return Err(format!("instruction {}: relative moves are not read", n + 1)),
+            "O" | "E" => {
+                return Err(format!(
+                    "instruction {}: relative moves are not read",
+                    n + 1
+                ))
+            }
             "M" | "D" => {
                 if nums.len() % 2 != 0 {
                     return Err(format!("instruction {}: odd coordinates", n + 1));
@@ -395,12 +403,19 @@ mod tests {
         let p = parse_profile(CUTTER, "t.toml").unwrap();
         let far = sheet(vec![stroke(StrokeRole::Cut, &[(0.0, 0.0), (1e6, 0.0)])]);
         let e = emit(&far, &p).unwrap_err().on_sheet(2).to_string();
-        assert!(e.contains("sheet 2, stroke 1 (cut)") && e.contains("GP-GL steps"), "{e}");
+        assert!(
+            e.contains("sheet 2, stroke 1 (cut)") && e.contains("GP-GL steps"),
+            "{e}"
+        );
         let job = sheet(vec![stroke(StrokeRole::Cut, &[(0.0, 0.0), (1.0, 0.0)])]);
         for (key, bad, says) in [
             ("force=14", "force=60", "force level from 1 to 48"),
             ("force=14", "force=0.2", "force level"),
-            ("speed=20\n[tools.score]", "speed=0.4\n[tools.score]", "whole number of cm/s"),
+            (
+                "speed=20\n[tools.score]",
+                "speed=0.4\n[tools.score]",
+                "whole number of cm/s",
+            ),
             ("pen=1\nforce=14", "pen=9\nforce=14", "1 to 8"),
         ] {
             let p = parse_profile(&CUTTER.replacen(key, bad, 1), "t.toml").unwrap();

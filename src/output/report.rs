@@ -13,6 +13,10 @@
 //! the simplified border; the largest length difference between the two sides of one of its
 //! seams); exact unfoldings have no such key.
 //!
+//! When the device had no tool for some of a job's strokes, `dropped` lists per piece what was
+//! left out (`{piece, name, sheet, left_out: {label, edge_ids, …: count}, reason}`) and
+//! `warnings` says it in words; a job that lost nothing has neither key.
+//!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
 //! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
 
@@ -30,6 +34,9 @@ pub struct RunInfo {
     pub material: String,
     pub thickness_mm: f64,
     pub files: Vec<String>,
+    /// What the job left out for want of a tool, per piece (`dropped` and `warnings` in the
+    /// report, only when there is something).
+    pub dropped: Vec<crate::toolpath::passes::Dropped>,
 }
 
 fn r6(v: f64) -> f64 {
@@ -111,7 +118,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     let surfaces = surfaces_json(flats);
     let seams = seams_json(layout);
     let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
-    json!({
+    let mut rep = json!({
         "name": info.name,
         "spec": info.spec,
         "device": info.device,
@@ -133,7 +140,18 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
             "fold_length_mm": total(&|p| p.fold_length()),
         },
         "files": info.files,
-    })
+    });
+    // Only when something was left out, so that the report of a job that lost nothing stays
+    // as it was.
+    if !info.dropped.is_empty() {
+        rep["dropped"] = json!(info.dropped);
+        rep["warnings"] = json!(info
+            .dropped
+            .iter()
+            .map(|d| format!("left out: {} ({})", d.describe(), d.reason))
+            .collect::<Vec<_>>());
+    }
+    rep
 }
 
 /// The `surfaces` entries: one per surface, with the figures its source measured.

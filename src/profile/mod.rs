@@ -637,11 +637,17 @@ mod tests {
             "line 5: `units_per_mm` must be 10, 20, 40 or 100 for GP-GL",
         );
         let ok = parse(
-            &format!("{}[tools.cut]\npen=1\nforce=14\n", gpgl.replace("=40", "=10")),
+            &format!(
+                "{}[tools.cut]\npen=1\nforce=14\n",
+                gpgl.replace("=40", "=10")
+            ),
             "x.toml",
         )
         .unwrap();
-        assert_eq!((ok.language.label(), ok.language.extension()), ("GP-GL", "gpgl"));
+        assert_eq!(
+            (ok.language.label(), ok.language.extension()),
+            ("GP-GL", "gpgl")
+        );
         says(
             &format!("{}[tools.cut]\nforce=14\n", gpgl.replace("=40", "=10")),
             "`tools.cut.pen` is missing",

@@ -530,9 +530,7 @@ impl Device {
                 crate::output::hpgl::read::next_instruction(self.rx.iter()).is_some()
             }
             Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
-            Interp::Gpgl(_) => {
-                crate::output::gpgl::next_instruction(self.rx.iter()).is_some()
-            }
+            Interp::Gpgl(_) => crate::output::gpgl::next_instruction(self.rx.iter()).is_some(),
         }
     }
 
