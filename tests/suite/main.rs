@@ -20,4 +20,5 @@ mod param;
 mod pattern;
 mod simplify;
 mod strip;
+mod toolchange;
 mod toolpath;

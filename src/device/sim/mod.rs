@@ -177,6 +177,8 @@ pub struct SimHandle {
     expect: Arc<AtomicUsize>,
     /// Overruns plus flow-control violations so far, as the device counts them.
     violations: Arc<AtomicUsize>,
+    /// Bytes received so far.
+    received: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
 }
 
@@ -214,6 +216,12 @@ impl SimHandle {
         }
     }
 
+    /// Bytes the device has taken off the line so far (a test can see that nothing of a
+    /// sheet arrived before the operator said so).
+    pub fn bytes_received(&self) -> usize {
+        self.received.load(Ordering::SeqCst)
+    }
+
     /// Stop at once.
     pub fn stop(mut self) -> Result<SimReport, SimError> {
         self.ctl.store(STOP, Ordering::SeqCst);
@@ -244,10 +252,12 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let ctl = Arc::new(AtomicU8::new(RUN));
     let expect = Arc::new(AtomicUsize::new(0));
     let violations = Arc::new(AtomicUsize::new(0));
+    let received = Arc::new(AtomicUsize::new(0));
     let (c2, k2, e2, v2) = (cts.clone(), ctl.clone(), expect.clone(), violations.clone());
+    let r2 = received.clone();
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2)).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2, r2)).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
@@ -255,6 +265,7 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
         ctl,
         expect,
         violations,
+        received,
         thread: Some(thread),
     })
 }
@@ -318,6 +329,7 @@ struct Device {
     ctl: Arc<AtomicU8>,
     expect: Arc<AtomicUsize>,
     violations: Arc<AtomicUsize>,
+    received: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -350,7 +362,7 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
-        (expect, violations): (Arc<AtomicUsize>, Arc<AtomicUsize>),
+        (expect, violations, received): (Arc<AtomicUsize>, Arc<AtomicUsize>, Arc<AtomicUsize>),
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -382,6 +394,7 @@ impl Device {
             ctl,
             expect,
             violations,
+            received,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -516,6 +529,8 @@ impl Device {
             }
             self.violations
                 .store(self.rep.violations(), Ordering::SeqCst);
+            self.received
+                .store(self.rep.bytes_received, Ordering::SeqCst);
             let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
