@@ -102,23 +102,14 @@ pub fn deliver_run(
 /// A job whose strokes reach further across the media (sheet x) than the profile's
 /// `media_width` is an error naming both sizes; `media_width = 0` (unknown) passes.
 pub fn check_media(profile: &Profile, job: &crate::toolpath::Job) -> Result<(), Error> {
-    if !(profile.media_width > 0.0) {
+    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
         return Ok(());
     }
     for (i, sheet) in job.sheets.iter().enumerate() {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for q in sheet.strokes.iter().flat_map(|s| &s.points) {
-            lo = lo.min(q.y);
-            hi = hi.max(q.y);
-        }
-        let wide = sheet
-            .strokes
-            .iter()
-            .flat_map(|s| &s.points)
-            .map(|q| q.x)
-            .fold(0.0, f64::max);
+        let points = || sheet.strokes.iter().flat_map(|s| &s.points);
+        let wide = points().map(|q| q.x).fold(0.0, f64::max);
+        let long = points().map(|q| q.y).fold(0.0, f64::max);
         if wide > profile.media_width + 1e-6 {
-            let long = if hi >= lo { hi.max(0.0) } else { 0.0 };
             return Err(Error::Usage(format!(
                 "{} sheet {} is {wide:.1} × {long:.1} mm ({wide:.1} mm across the media), wider than the {:.0} mm media of device `{}` ({}): nothing was sent; nest it on a narrower sheet or split the piece",
                 job.name,
