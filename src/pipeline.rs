@@ -335,6 +335,8 @@ pub fn cut(
     choices: &Toolpath,
     extras: &Extras,
 ) -> Result<CutRun, Error> {
+    // A tool change is for a device without a pen of its own.
+    let tool_change = choices.tool_change && !profile.has(StrokeKind::Draw);
     let profile = &job_profile(profile, spec, choices);
     let (flats, layout, job) = plan(spec, profile, search, choices, extras.quiet)?;
     let machine = machine_job(&job, profile, spec);
@@ -362,7 +364,7 @@ pub fn cut(
     let n = job.sheets.len();
     for (i, sheet) in machine.sheets.iter().enumerate() {
         let name = sheet_file(&spec.name, i, n, ext);
-        let (pen, knife) = if choices.tool_change {
+        let (pen, knife) = if tool_change {
             crate::toolpath::passes::split(sheet, profile)
         } else {
             (sheet.clone(), sheet.clone())
@@ -372,7 +374,7 @@ pub fn cut(
         } else {
             Before::Sheet { k: i + 1, n }
         });
-        if choices.tool_change && !pen.strokes.is_empty() {
+        if tool_change && !pen.strokes.is_empty() {
             let pen_name = sheet_file(&format!("{}-pen", spec.name), i, n, ext);
             let bytes = crate::output::program(&pen, profile).map_err(|e| e.on_sheet(i + 1))?;
             write_atomic(&dir.join(&pen_name), &bytes)?;
