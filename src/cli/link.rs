@@ -123,6 +123,42 @@ pub fn check_media(profile: &Profile, job: &crate::toolpath::Job) -> Result<(), 
     Ok(())
 }
 
+/// `send`: an HP-GL or GP-GL program that reaches further across the media than the profile's
+/// `media_width` is refused before the first byte, as [`check_media`] does for a job (its
+/// tool-down points, in the machine's axes: across the media is the machine's Y when the
+/// profile exchanges the axes, else X). G-code programs are not read here.
+pub fn check_program_media(profile: &Profile, name: &str, bytes: &[u8]) -> Result<(), Error> {
+    use crate::profile::Language;
+    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
+        return Ok(());
+    }
+    let points: Vec<(i64, i64)> = match profile.language {
+        Language::Hpgl => crate::output::hpgl::parse(&String::from_utf8_lossy(bytes))
+            .map(|v| v.into_iter().flat_map(|s| s.points).collect())
+            .unwrap_or_default(),
+        Language::Gpgl => crate::output::gpgl::parse(bytes)
+            .map(|v| v.into_iter().flat_map(|s| s.points).collect())
+            .unwrap_or_default(),
+        Language::Gcode => return Ok(()),
+    };
+    let across = |p: &(i64, i64)| if profile.axes.swap_xy { p.1 } else { p.0 };
+    let (lo, hi) = points
+        .iter()
+        .map(across)
+        .fold((i64::MAX, i64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    if hi < lo {
+        return Ok(());
+    }
+    let wide = (hi - lo) as f64 / profile.units_per_mm;
+    if wide > profile.media_width + 1e-6 {
+        return Err(Error::Usage(format!(
+            "{name}: its cuts span {wide:.1} mm across the media, wider than the {:.0} mm media of device `{}` ({}): nothing was sent",
+            profile.media_width, profile.name, profile.source
+        )));
+    }
+    Ok(())
+}
+
 /// [`deliver`], printing what it says unless `quiet`.
 pub fn deliver_and_print(
     programs: &[(String, Vec<u8>)],

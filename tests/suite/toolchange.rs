@@ -345,6 +345,22 @@ fn a_blank_wider_than_the_media_is_refused_before_the_first_byte() {
             && e.contains("nothing was sent"),
         "{e}"
     );
+    // `send` reads the program's own extent and refuses it too.
+    let plt = out.join("cone.plt");
+    let o = flatcut(&[
+        "send",
+        plt.to_str().unwrap(),
+        "--device",
+        "roland-gx24",
+        "--port",
+        &h.path,
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(
+        e.contains("mm across the media") && e.contains("584 mm media"),
+        "{e}"
+    );
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(h.bytes_received(), 0);
     let rep = h.stop().unwrap();
