@@ -66,6 +66,7 @@
 //!   stream.rs                  Streaming a program into a device without ever overrunning it
 //!   sim/
 //!     mod.rs                   The simulated cutter
+//!     gpgl.rs                  The simulated cutter's GP-GL interpreter (Graphtec cutters in native mode)
 //!     grbl.rs                  The simulated cutter's GRBL 1.1 interpreter
 //!     hpgl.rs                  The simulated cutter's HP-GL interpreter
 //!     record.rs                What the simulated cutter remembers of a job
@@ -115,6 +116,7 @@
 //!   mod.rs                     Output stage
 //!   dxf.rs                     DXF output for sheet-metal shops (issue 4, item 6)
 //!   files.rs                   Writing a run's files
+//!   gpgl.rs                    GP-GL programs for Graphtec cutting plotters (CE6000 / CE7000 / FC series) in their native …
 //!   gcode.rs                   GRBL 1.1 G-code programs (dialect `grbl`) for a drag knife on Z, a servo-lifted pen or a laser,…
 //!   obj.rs                     Wavefront OBJ writer
 //!   png.rs                     PNG output
@@ -194,6 +196,7 @@
 //!   collect.rs                 The strokes of one sheet, unordered
 //!   knife.rs                   What a machine's tools need beyond the ordered design
 //!   order.rs                   Travel optimisation inside one group of strokes
+//!   passes.rs                  Machines with one tool (issue 23)
 //!   weed.rs                    Weed lines for vinyl (and any material whose waste is peeled off the carrier)
 //! ```
 

@@ -64,9 +64,13 @@ pub enum Folds {
     None,
 }
 
-/// Toolpath choices a run can make over the defaults (`--folds`, `--per-piece`, `--weed`).
+/// Toolpath choices a run can make over the defaults (`--folds`, `--per-piece`, `--weed`,
+/// `--tool-change`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Toolpath {
+    /// A device with no draw tool draws the marks in a first pass with a pen in the knife
+    /// holder, then cuts after a tool change (`toolpath::passes`).
+    pub tool_change: bool,
     /// The tool that makes folds; `None`: the device's best (score, else perforate, else draw).
     pub folds: Option<Folds>,
     /// Finish each piece before the next; `None`: on for fabric, which may shift.
@@ -234,6 +238,33 @@ pub fn plan(
         file: spec.path.clone(),
         source: Box::new(e.into()),
     })?;
+    let profile = &job_profile(profile, spec, choices);
+    let tp = toolpath_options(spec, profile, choices);
+    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+    Ok((flats, layout, job))
+}
+
+/// The device profile as a job uses it (encode the job with this one):
+/// - with `--tool-change` on a device without a draw tool, the knife holder's tool doubles as
+///   the pen (`toolpath::passes::with_pen`);
+/// - fabric, unless `--folds` says how: folds are not given to a knife (the scoring and
+///   perforating tools are taken out of the job's copy), so they are drawn when the device has
+///   a draw tool (a pen or chalk), else left out with a note ([`dropped`]).
+pub fn job_profile(profile: &Profile, spec: &Spec, choices: &Toolpath) -> Profile {
+    let mut p = if choices.tool_change {
+        crate::toolpath::passes::with_pen(profile)
+    } else {
+        profile.clone()
+    };
+    if spec.material.kind == MaterialKind::Fabric && choices.folds.is_none() {
+        p.tools.remove(StrokeKind::Score.name());
+        p.tools.remove(StrokeKind::Perforate.name());
+    }
+    p
+}
+
+/// The toolpath stage's options for a job on `profile` (the job's, [`job_profile`]).
+fn toolpath_options(spec: &Spec, profile: &Profile, choices: &Toolpath) -> ToolpathOptions {
     let mut tp = ToolpathOptions {
         skip_folds: crate::toolpath::fold_kind(|k| profile.has(k)).is_none(),
         skip_drawing: !profile.has(StrokeKind::Draw),
@@ -249,8 +280,34 @@ pub fn plan(
     if choices.weed {
         tp.weed = Some(crate::toolpath::weed::WeedOptions::default());
     }
-    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
-    Ok((flats, layout, job))
+    tp
+}
+
+/// What the job leaves out, per piece, because `profile` (the job's) has no tool for it:
+/// drawn marks on a device without a draw tool, folds on one that cannot make them (or on
+/// fabric, which does not give them to a knife). `--folds none` is the user's choice and is
+/// not listed.
+pub fn dropped(
+    spec: &Spec,
+    profile: &Profile,
+    choices: &Toolpath,
+    layout: &Layout,
+) -> Vec<crate::toolpath::passes::Dropped> {
+    let tp = toolpath_options(spec, profile, choices);
+    let folds = tp.skip_folds && choices.folds != Some(Folds::None);
+    let why_drawing = format!(
+        "device `{}` has no draw tool (use --tool-change to draw with a pen in the knife holder)",
+        profile.name
+    );
+    let why_folds = if spec.material.kind == MaterialKind::Fabric {
+        format!(
+            "fabric folds are not given to the knife and device `{}` has no draw tool (--folds score cuts them)",
+            profile.name
+        )
+    } else {
+        format!("device `{}` has no tool for folds", profile.name)
+    };
+    crate::toolpath::passes::dropped(layout, tp.skip_drawing, folds, &why_drawing, &why_folds)
 }
 
 /// The job as the device makes it: folds as the profile's tools make them (perforation
@@ -282,6 +339,17 @@ pub struct Extras {
     pub quiet: bool,
 }
 
+/// What the operator does before a program of a run is sent (`cli::link` waits for it).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Before {
+    /// Nothing: the first program.
+    Start,
+    /// Load sheet `k` (1-based) of `n`.
+    Sheet { k: usize, n: usize },
+    /// Tool change on sheet `k` (1-based): take the pen out of the holder and put the knife in.
+    ToolChange { k: usize },
+}
+
 /// `cut` up to its files: what was made and written.
 #[derive(Debug)]
 pub struct CutRun {
@@ -293,8 +361,12 @@ pub struct CutRun {
     pub dir: PathBuf,
     /// Every file written, in the order written (report.json last).
     pub files: Vec<String>,
-    /// The device programs, one per sheet: (file name, bytes).
+    /// The device programs, one per sheet, or two with a tool change: (file name, bytes).
     pub programs: Vec<(String, Vec<u8>)>,
+    /// What comes before each program.
+    pub before: Vec<Before>,
+    /// What the job left out for want of a tool (also in report.json).
+    pub dropped: Vec<crate::toolpath::passes::Dropped>,
 }
 
 /// The whole of `flatcut cut` but the sending: plan the job for the device, write the program
@@ -307,8 +379,22 @@ pub fn cut(
     choices: &Toolpath,
     extras: &Extras,
 ) -> Result<CutRun, Error> {
+    // A tool change is for a device without a pen of its own.
+    let tool_change = choices.tool_change && !profile.has(StrokeKind::Draw);
+    let profile = &job_profile(profile, spec, choices);
     let (flats, layout, job) = plan(spec, profile, search, choices, extras.quiet)?;
     let machine = machine_job(&job, profile, spec);
+    let dropped = dropped(spec, profile, choices, &layout);
+    if !extras.quiet {
+        for d in &dropped {
+            eprintln!(
+                "flatcut: warning: left out of {}: {} ({})",
+                spec.name,
+                d.describe(),
+                d.reason
+            );
+        }
+    }
     write_extras(&flats, extras)?;
     let dir = extras
         .output
@@ -317,11 +403,30 @@ pub fn cut(
     create_dir(&dir)?;
     let mut files = Vec::new();
     let mut programs = Vec::new();
+    let mut before = Vec::new();
     let ext = profile.language.extension();
     let n = job.sheets.len();
     for (i, sheet) in machine.sheets.iter().enumerate() {
         let name = sheet_file(&spec.name, i, n, ext);
-        let bytes = crate::output::program(sheet, profile).map_err(|e| e.on_sheet(i + 1))?;
+        let (pen, knife) = if tool_change {
+            crate::toolpath::passes::split(sheet, profile)
+        } else {
+            (sheet.clone(), sheet.clone())
+        };
+        before.push(if i == 0 {
+            Before::Start
+        } else {
+            Before::Sheet { k: i + 1, n }
+        });
+        if tool_change && !pen.strokes.is_empty() {
+            let pen_name = sheet_file(&format!("{}-pen", spec.name), i, n, ext);
+            let bytes = crate::output::program(&pen, profile).map_err(|e| e.on_sheet(i + 1))?;
+            write_atomic(&dir.join(&pen_name), &bytes)?;
+            files.push(pen_name.clone());
+            programs.push((pen_name, bytes));
+            before.push(Before::ToolChange { k: i + 1 });
+        }
+        let bytes = crate::output::program(&knife, profile).map_err(|e| e.on_sheet(i + 1))?;
         write_atomic(&dir.join(&name), &bytes)?;
         files.push(name.clone());
         programs.push((name, bytes));
@@ -330,8 +435,12 @@ pub fn cut(
     files.extend(write_dxf(&dir, &spec.name, &layout)?);
     files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    let warnings = cuttable(&layout, profile.knife_offset, spec, extras.quiet);
-    write_report(&dir, spec, &profile.name, &files, &flats, &layout, warnings)?;
+    let info = RunInfo {
+        dropped: dropped.clone(),
+        warnings: cuttable(&layout, profile.knife_offset, spec, extras.quiet),
+        ..run_info(spec, &profile.name, &files)
+    };
+    write_report(&dir, &info, &flats, &layout)?;
     Ok(CutRun {
         flats,
         layout,
@@ -339,6 +448,8 @@ pub fn cut(
         dir,
         files,
         programs,
+        before,
+        dropped,
     })
 }
 
@@ -386,8 +497,11 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
     let mut files = write_pictures(&dir, &spec.name, &job)?;
     files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    let warnings = cuttable(&layout, 0.0, spec, extras.quiet);
-    write_report(&dir, spec, "", &files, &flats, &layout, warnings)?;
+    let info = RunInfo {
+        warnings: cuttable(&layout, 0.0, spec, extras.quiet),
+        ..run_info(spec, "", &files)
+    };
+    write_report(&dir, &info, &flats, &layout)?;
     Ok(FlattenRun {
         flats,
         layout,
@@ -453,10 +567,7 @@ pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let expected: &[&str] = match profile.language {
-        crate::profile::Language::Hpgl => &["plt", "hpgl", "hpg"],
-        crate::profile::Language::Gcode => &["gcode", "nc", "ngc", "gc"],
-    };
+    let expected = profile.language.extensions();
     if !expected.contains(&ext.as_str()) {
         return Err(Error::Usage(format!(
             "{}: device `{}` speaks {}, which is sent from a .{} file; this file is `.{ext}`",
@@ -505,26 +616,23 @@ fn cuttable(
     warnings
 }
 
-/// report.json: the run, its pieces, seams, sheets and per-surface figures.
-fn write_report(
-    dir: &Path,
-    spec: &Spec,
-    device: &str,
-    files: &[String],
-    flats: &[Flat],
-    layout: &Layout,
-    warnings: Vec<crate::toolpath::cuttable::Warning>,
-) -> Result<(), Error> {
-    let info = RunInfo {
+/// What report.json says about a run of `spec` on `device` that wrote `files`.
+fn run_info(spec: &Spec, device: &str, files: &[String]) -> RunInfo {
+    RunInfo {
         name: spec.name.clone(),
         spec: spec.path.display().to_string(),
         device: device.to_string(),
         material: spec.material.kind.to_string(),
         thickness_mm: spec.material.thickness,
         files: files.to_vec(),
-        warnings,
-    };
-    let rep = report::build(&info, flats, layout);
+        warnings: Vec::new(),
+        dropped: Vec::new(),
+    }
+}
+
+/// report.json: the run, its pieces, seams, sheets and per-surface figures.
+fn write_report(dir: &Path, info: &RunInfo, flats: &[Flat], layout: &Layout) -> Result<(), Error> {
+    let rep = report::build(info, flats, layout);
     let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
     Ok(write_atomic(&dir.join("report.json"), text.as_bytes())?)
 }

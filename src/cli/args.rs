@@ -129,6 +129,7 @@ impl ToolpathArgs {
             folds: self.folds,
             per_piece: self.per_piece,
             weed: self.weed,
+            ..Toolpath::default()
         }
     }
 }

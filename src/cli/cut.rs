@@ -6,7 +6,8 @@
 //! unless `--dry-run`, the program is streamed to the device: the simulated cutter for `sim`
 //! (the default) or with `--simulate`, else the serial port given by `--port` (see
 //! [`super::link`]). The files are written before anything is sent, so a failed or
-//! interrupted send loses nothing.
+//! interrupted send loses nothing. `--tool-change` makes the marks of a knife-only device in
+//! a pen pass before the knife pass (see [`super::link`] for the pause between them).
 
 use super::args::{
     ask_alternatives, PatternArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs, ToolpathArgs,
@@ -35,6 +36,11 @@ pub struct CutArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// A device without a pen (a knife-only cutter): draw the labels and ids first with a pen
+    /// in the knife holder (`<name>-pen.plt`), stop with the tool up for the knife (Enter, or
+    /// a line on standard input), then cut. Without it they are left out, with a warning.
+    #[arg(long)]
+    pub tool_change: bool,
     #[command(flatten)]
     pub size: SizeArgs,
     #[command(flatten)]
@@ -87,12 +93,16 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         quiet: a.quiet,
     };
     let search = a.search.search()?;
-    let run = crate::pipeline::cut(&spec, &profile, &search, &a.toolpath.choices(), &extras)?;
+    let choices = crate::pipeline::Toolpath {
+        tool_change: a.tool_change,
+        ..a.toolpath.choices()
+    };
+    let run = crate::pipeline::cut(&spec, &profile, &search, &choices, &extras)?;
     if !a.quiet {
         super::print_cut(&spec, &run, &profile.name, a.dry_run);
     }
     if !a.dry_run {
-        super::link::deliver_and_print(&run.programs, &profile, &a.link, &run.dir, a.quiet)?;
+        super::link::deliver_run(&run, &profile, &a.link, a.quiet)?;
     }
     Ok(())
 }

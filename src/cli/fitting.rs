@@ -294,7 +294,7 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         super::print_cut(&spec, &run, &profile.name, a.dry_run);
     }
     if !a.dry_run {
-        super::link::deliver_and_print(&run.programs, &profile, &a.link, &run.dir, a.quiet)?;
+        super::link::deliver_run(&run, &profile, &a.link, a.quiet)?;
     }
     Ok(())
 }

@@ -6,9 +6,23 @@
 //! `--simulate`, and otherwise needs `--port`. With the simulator, its picture and report are
 //! written beside the program (`sim.png`, `sim.json`; `sim-<k>.*` per sheet when there are
 //! several) and their paths printed.
+//!
+//! **Pauses.** On a real machine the job stops with the tool up (every program ends with it
+//! lifted) before each sheet after the first, and before the knife pass of a tool change
+//! (`--tool-change`), and waits for the operator: on a terminal for Enter; when standard input
+//! is not a terminal, for a line on it (a script or a FIFO writes `\n` when the sheet is
+//! loaded; `-q` does not skip the wait). If standard input is closed (end of file) the job
+//! stops there with a message naming what is left, which `--sheets` sends later. Two sheets
+//! are never sent back to back. Ctrl-C during a wait stops the job. The simulator needs no
+//! operator: each sheet goes to a simulated machine of its own, the passes of a tool change to
+//! the same one.
+//!
+//! **Media.** Before the first byte, a job wider than the profile's `media_width` (the largest
+//! x of its strokes, across the media) is refused, naming both sizes.
 
 use crate::device::sim::{self, SimConfig};
 use crate::device::stream::{self, StreamOptions};
+use crate::pipeline::{Before, CutRun};
 use crate::profile::Profile;
 use crate::Error;
 use clap::Args;
@@ -35,6 +49,11 @@ pub struct LinkArgs {
     /// Give up when the machine makes no progress for this many seconds.
     #[arg(long, default_value_t = 60.0)]
     pub timeout: f64,
+    /// Send only these sheets (1-based: `2`, `1,3`, `2-4`); every sheet's files are written.
+    /// Between sheets flatcut waits for Enter, or a line on standard input when it is not a
+    /// terminal.
+    #[arg(long, value_name = "LIST")]
+    pub sheets: Option<String>,
 }
 
 /// The process-wide Ctrl-C flag; the handler is installed on first use.
@@ -68,15 +87,88 @@ pub fn need_port(profile: &Profile, link: &LinkArgs, dry_run: bool) -> Result<()
     Ok(())
 }
 
+/// `cut` and `fitting`: refuse a job wider than the device's media before the first byte, then
+/// [`deliver_and_print`] the run's programs with their pauses.
+pub fn deliver_run(
+    run: &CutRun,
+    profile: &Profile,
+    link: &LinkArgs,
+    quiet: bool,
+) -> Result<(), Error> {
+    check_media(profile, &run.job)?;
+    deliver_and_print(&run.programs, &run.before, profile, link, &run.dir, quiet)
+}
+
+/// A job whose strokes reach further across the media (sheet x) than the profile's
+/// `media_width` is an error naming both sizes; `media_width = 0` (unknown) passes.
+pub fn check_media(profile: &Profile, job: &crate::toolpath::Job) -> Result<(), Error> {
+    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
+        return Ok(());
+    }
+    for (i, sheet) in job.sheets.iter().enumerate() {
+        let points = || sheet.strokes.iter().flat_map(|s| &s.points);
+        let wide = points().map(|q| q.x).fold(0.0, f64::max);
+        let long = points().map(|q| q.y).fold(0.0, f64::max);
+        if wide > profile.media_width + 1e-6 {
+            return Err(Error::Usage(format!(
+                "{} sheet {} is {wide:.1} × {long:.1} mm ({wide:.1} mm across the media), wider than the {:.0} mm media of device `{}` ({}): nothing was sent; nest it on a narrower sheet or split the piece",
+                job.name,
+                i + 1,
+                profile.media_width,
+                profile.name,
+                profile.source
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `send`: an HP-GL or GP-GL program that reaches further across the media than the profile's
+/// `media_width` is refused before the first byte, as [`check_media`] does for a job (its
+/// tool-down points, in the machine's axes: across the media is the machine's Y when the
+/// profile exchanges the axes, else X). G-code programs are not read here.
+pub fn check_program_media(profile: &Profile, name: &str, bytes: &[u8]) -> Result<(), Error> {
+    use crate::profile::Language;
+    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
+        return Ok(());
+    }
+    let points: Vec<(i64, i64)> = match profile.language {
+        Language::Hpgl => crate::output::hpgl::parse(&String::from_utf8_lossy(bytes))
+            .map(|v| v.into_iter().flat_map(|s| s.points).collect())
+            .unwrap_or_default(),
+        Language::Gpgl => crate::output::gpgl::parse(bytes)
+            .map(|v| v.into_iter().flat_map(|s| s.points).collect())
+            .unwrap_or_default(),
+        Language::Gcode => return Ok(()),
+    };
+    let across = |p: &(i64, i64)| if profile.axes.swap_xy { p.1 } else { p.0 };
+    let (lo, hi) = points
+        .iter()
+        .map(across)
+        .fold((i64::MAX, i64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    if hi < lo {
+        return Ok(());
+    }
+    let wide = (hi - lo) as f64 / profile.units_per_mm;
+    if wide > profile.media_width + 1e-6 {
+        return Err(Error::Usage(format!(
+            "{name}: its cuts span {wide:.1} mm across the media, wider than the {:.0} mm media of device `{}` ({}): nothing was sent",
+            profile.media_width, profile.name, profile.source
+        )));
+    }
+    Ok(())
+}
+
 /// [`deliver`], printing what it says unless `quiet`.
 pub fn deliver_and_print(
     programs: &[(String, Vec<u8>)],
+    before: &[Before],
     profile: &Profile,
     link: &LinkArgs,
     dir: &Path,
     quiet: bool,
 ) -> Result<(), Error> {
-    for line in deliver(programs, profile, link, dir, quiet)? {
+    for line in deliver(programs, before, profile, link, dir, quiet)? {
         if !quiet {
             println!("{line}");
         }
@@ -84,9 +176,57 @@ pub fn deliver_and_print(
     Ok(())
 }
 
-/// Send each program (name, bytes) in turn; returns the lines to print.
+/// The sheet (1-based) of each program, from what comes before it.
+fn sheet_of(before: &[Before], count: usize) -> Vec<usize> {
+    let mut k = 1;
+    (0..count)
+        .map(|i| {
+            match before.get(i) {
+                Some(Before::Sheet { k: s, .. }) | Some(Before::ToolChange { k: s }) => k = *s,
+                _ => {}
+            }
+            k
+        })
+        .collect()
+}
+
+/// The sheets `--sheets` names (1-based), of `n`; all when it is not given.
+pub fn chosen_sheets(list: Option<&str>, n: usize) -> Result<Vec<usize>, Error> {
+    let Some(list) = list else {
+        return Ok((1..=n).collect());
+    };
+    let bad = |why: String| Error::Usage(format!("--sheets {list}: {why}"));
+    let mut out = Vec::new();
+    for part in list.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (a, b) = part.split_once('-').unwrap_or((part, part));
+        let num = |t: &str| {
+            t.trim().parse::<usize>().map_err(|_| {
+                bad(format!(
+                    "`{part}` is not a sheet number or a range like 2-4"
+                ))
+            })
+        };
+        let (a, b) = (num(a)?, num(b)?);
+        if a == 0 || a > b || b > n {
+            return Err(bad(format!(
+                "`{part}`: the job has sheets 1 to {n} (1-based, ranges low-high)"
+            )));
+        }
+        out.extend(a..=b);
+    }
+    out.sort_unstable();
+    out.dedup();
+    if out.is_empty() {
+        return Err(bad("names no sheet".into()));
+    }
+    Ok(out)
+}
+
+/// Send each program (name, bytes) in turn, pausing as `before` says (see the module
+/// documentation); returns the lines to print.
 pub fn deliver(
     programs: &[(String, Vec<u8>)],
+    before: &[Before],
     profile: &Profile,
     link: &LinkArgs,
     dir: &Path,
@@ -110,80 +250,180 @@ pub fn deliver(
         cancel: cancel_flag(),
         ..StreamOptions::default()
     };
+    let sheets = sheet_of(before, programs.len());
+    let n = sheets.last().copied().unwrap_or(1);
+    let chosen = chosen_sheets(link.sheets.as_deref(), n)?;
+    // (sheet, program index) of what is sent, in order.
+    let todo: Vec<(usize, usize)> = sheets
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| chosen.contains(k))
+        .map(|(i, k)| (*k, i))
+        .collect();
+    if simulated(profile, link) {
+        return deliver_simulated(programs, &todo, n, profile, link, dir, &opts);
+    }
+    let Some(path) = link.port.as_deref() else {
+        return Err(Error::Usage(format!(
+            "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
+            profile.name
+        )));
+    };
     let mut said = Vec::new();
-    let several = programs.len() > 1;
-    for (k, (name, bytes)) in programs.iter().enumerate() {
-        if simulated(profile, link) {
-            let mut cfg = SimConfig::new(profile.clone());
-            // The simulated line runs at the rate the host uses.
-            if let Some(b) = link.baud {
-                cfg.profile.serial.baud = b;
-            }
-            cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
-            // The simulated machine works off what it has buffered, as a real one would (after
-            // Ctrl-C that includes the tool-up command, queued behind the buffer).
-            let (sent, report) = stream::stream_job(cfg, bytes, &opts, Duration::from_secs(600))?;
-            let stem = if several {
-                format!("sim-{}", k + 1)
+    for (j, &(k, i)) in todo.iter().enumerate() {
+        let name = &programs[i].0;
+        if j > 0 {
+            let left: Vec<String> = todo[j..]
+                .iter()
+                .map(|(_, i)| programs[*i].0.clone())
+                .collect();
+            let what = if todo[j - 1].0 != k {
+                format!("load sheet {k} of {n}")
             } else {
-                "sim".into()
+                format!("sheet {k}: take the pen out of the holder and put the knife in")
             };
-            let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
-            let rep = sent?;
-            if report.violations() > 0 {
-                return Err(Error::Usage(format!(
-                    "the simulated {} lost data: {} bytes overran its {}-byte buffer and {} were sent while it asked to stop (see {}); a real machine would have cut this job wrong",
-                    profile.name,
-                    report.overruns,
-                    report.buffer,
-                    report.flow_violations,
-                    json.display()
-                )));
-            }
-            said.push(format!(
-                "sent {name} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud); it cut {} paths, {:.0} mm, {} overruns",
-                profile.name,
-                rep.bytes,
-                rep.strokes,
-                rep.seconds,
-                report.baud,
-                report.paths.len(),
-                report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
-                report.violations(),
-            ));
-            said.push(format!(
-                "picture of the cut: {} (report {})",
-                png.display(),
-                json.display()
-            ));
-        } else {
-            let Some(path) = link.port.as_deref() else {
-                return Err(Error::Usage(format!(
-                    "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
-                    profile.name
-                )));
-            };
-            if several && k > 0 {
-                wait_for_sheet(k + 1, programs.len(), quiet);
-            }
-            let mut port = crate::device::serial::open(profile, path, link.baud)?;
-            let rep = stream::send(&mut port, profile, bytes, &opts)?;
-            said.push(format!(
-                "sent {name} to {} on {path}: {} bytes, {} strokes in {:.1} s ({:.0} bytes/s)",
-                profile.name, rep.bytes, rep.strokes, rep.seconds, rep.rate
-            ));
+            wait_for_operator(&what, &left, &opts)?;
         }
+        let mut port = crate::device::serial::open(profile, path, link.baud)?;
+        let rep = stream::send(&mut port, profile, &programs[i].1, &opts)?;
+        said.push(format!(
+            "sent {name} to {} on {path}: {} bytes, {} strokes in {:.1} s ({:.0} bytes/s)",
+            profile.name, rep.bytes, rep.strokes, rep.seconds, rep.rate
+        ));
     }
     Ok(said)
 }
 
-/// Before sheet k of n on a real machine: ask for the sheet when someone is there to load it.
-fn wait_for_sheet(k: usize, n: usize, quiet: bool) {
-    use std::io::IsTerminal;
-    if quiet || !std::io::stdin().is_terminal() {
-        return;
+/// The simulated path of [`deliver`]: one simulated machine per sheet, the passes of a tool
+/// change streamed into the same one; no operator is waited for.
+fn deliver_simulated(
+    programs: &[(String, Vec<u8>)],
+    todo: &[(usize, usize)],
+    n: usize,
+    profile: &Profile,
+    link: &LinkArgs,
+    dir: &Path,
+    opts: &StreamOptions,
+) -> Result<Vec<String>, Error> {
+    let mut said = Vec::new();
+    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
+    for &(k, i) in todo {
+        match groups.last_mut() {
+            Some((g, v)) if *g == k => v.push(i),
+            _ => groups.push((k, vec![i])),
+        }
     }
-    eprintln!("load sheet {k} of {n} and press Enter");
-    let mut s = String::new();
-    let _ = std::io::stdin().read_line(&mut s);
+    for (k, group) in &groups {
+        let mut cfg = SimConfig::new(profile.clone());
+        // The simulated line runs at the rate the host uses.
+        if let Some(b) = link.baud {
+            cfg.profile.serial.baud = b;
+        }
+        cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
+        let handle = sim::spawn(cfg.clone())?;
+        let mut written = 0;
+        let mut results = Vec::new();
+        for (j, &i) in group.iter().enumerate() {
+            if j > 0 {
+                said.push(format!(
+                    "sheet {k}: tool change (the simulated machine changes tools itself)"
+                ));
+            }
+            let mut port = crate::device::serial::open(&cfg.profile, &handle.path, None)?
+                .with_virtual_cts(handle.cts.clone());
+            let sent = stream::send(&mut port, &cfg.profile, &programs[i].1, opts);
+            written += port.written;
+            drop(port);
+            let failed = sent.is_err();
+            results.push((i, sent));
+            if failed {
+                break;
+            }
+        }
+        // The simulated machine works off what it has buffered, as a real one would (after
+        // Ctrl-C that includes the tool-up command, queued behind the buffer).
+        let wait = if opts.cancel.load(Ordering::SeqCst) {
+            Duration::from_secs(30)
+        } else {
+            Duration::from_secs(600)
+        };
+        let report = handle.finish(written, wait)?;
+        let stem = if n > 1 {
+            format!("sim-{k}")
+        } else {
+            "sim".into()
+        };
+        let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
+        for (i, sent) in results {
+            let rep = sent?;
+            said.push(format!(
+                "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud)",
+                programs[i].0, profile.name, rep.bytes, rep.strokes, rep.seconds, report.baud,
+            ));
+        }
+        if report.violations() > 0 {
+            return Err(Error::Usage(format!(
+                "the simulated {} lost data: {} bytes overran its {}-byte buffer and {} were sent while it asked to stop (see {}); a real machine would have cut this job wrong",
+                profile.name,
+                report.overruns,
+                report.buffer,
+                report.flow_violations,
+                json.display()
+            )));
+        }
+        said.push(format!(
+            "the simulated {} cut {} paths, {:.0} mm, {} overruns",
+            profile.name,
+            report.paths.len(),
+            report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
+            report.violations(),
+        ));
+        said.push(format!(
+            "picture of the cut: {} (report {})",
+            png.display(),
+            json.display()
+        ));
+    }
+    Ok(said)
+}
+
+/// Stop for the operator (`what` to do) before the programs `left` are sent: on a terminal
+/// Enter, otherwise a line on standard input; closed input or Ctrl-C stops the job.
+fn wait_for_operator(what: &str, left: &[String], opts: &StreamOptions) -> Result<(), Error> {
+    use std::io::IsTerminal;
+    let how = if std::io::stdin().is_terminal() {
+        "press Enter"
+    } else {
+        "send a line to flatcut's standard input"
+    };
+    eprintln!("flatcut: the tool is up: {what}, then {how} (Ctrl-C stops)");
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = tx.send(std::io::stdin().read_line(&mut s).map(|n| n > 0));
+    });
+    let stopped = |why: &str| {
+        Error::Usage(format!(
+            "stopped before \"{what}\": {why}; not sent: {} (send them later with --sheets)",
+            left.join(", ")
+        ))
+    };
+    loop {
+        if opts.cancel.load(Ordering::SeqCst) {
+            return Err(stopped("Ctrl-C"));
+        }
+        match rx.recv_timeout(Duration::from_millis(100)) {
+            Ok(Ok(true)) => return Ok(()),
+            Ok(Ok(false)) => {
+                return Err(stopped(
+                    "standard input is closed, so nothing can say the operator is done",
+                ))
+            }
+            Ok(Err(e)) => return Err(stopped(&format!("cannot read standard input: {e}"))),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(stopped("standard input failed"))
+            }
+        }
+    }
 }

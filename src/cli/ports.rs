@@ -1,4 +1,5 @@
-//! `flatcut ports` lists serial ports; `flatcut devices` lists device profiles with a line each.
+//! `flatcut ports` lists serial ports; `flatcut devices` lists device profiles with a line each:
+//! name, language (HP-GL, GP-GL, G-code) and description.
 
 use crate::Error;
 
@@ -17,7 +18,7 @@ pub fn devices() -> Result<(), Error> {
     let all = crate::profile::all()?;
     let w = all.iter().map(|p| p.name.len()).max().unwrap_or(0);
     for p in all {
-        println!("{:w$}  {}", p.name, p.description);
+        println!("{:w$}  {:6}  {}", p.name, p.language.label(), p.description);
     }
     if let Some(d) = crate::profile::user_dir() {
         println!("(your own profiles go in {})", d.display());

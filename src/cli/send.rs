@@ -1,7 +1,8 @@
 //! `flatcut send FILE --device D [--port P]`: stream an existing `.plt` or `.gcode` program to a
 //! machine (or, with `--simulate` or the `sim` device, to a simulated cutter, whose picture and
 //! report go to `-o DIR`, default `out/send`). The file's extension must match the device's
-//! language, so that G-code never reaches an HP-GL cutter by mistake.
+//! language, so that G-code never reaches an HP-GL cutter by mistake, and an HP-GL or GP-GL
+//! program wider than the device's media is refused before the first byte.
 
 use super::link::{deliver_and_print, LinkArgs};
 use crate::Error;
@@ -40,5 +41,13 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    deliver_and_print(&[(name, bytes)], &profile, &a.link, &dir, a.quiet)
+    super::link::check_program_media(&profile, &name, &bytes)?;
+    deliver_and_print(
+        &[(name, bytes)],
+        &[crate::pipeline::Before::Start],
+        &profile,
+        &a.link,
+        &dir,
+        a.quiet,
+    )
 }

@@ -213,6 +213,18 @@ pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
                 }
             }
         }
+        Language::Gpgl => {
+            // `M` with a coordinate at the start of an instruction.
+            for i in 0..program.len().saturating_sub(1) {
+                let starts = i == 0 || crate::output::gpgl::ends_instruction(program[i - 1]);
+                if starts
+                    && program[i] == b'M'
+                    && (program[i + 1].is_ascii_digit() || program[i + 1] == b'-')
+                {
+                    out.push(i);
+                }
+            }
+        }
         Language::Gcode => {
             let mut at = 0;
             for line in program.split(|&b| b == b'\n') {
@@ -344,11 +356,12 @@ fn buffered(
         let tool = if matches!(kind, Failure::HungUp(_)) {
             ToolState::Unknown
         } else {
+            let (ends, up) = tool_up(profile.language);
             let end = program[sent..]
                 .iter()
-                .position(|&b| b == b';')
+                .position(|&b| ends(b))
                 .map_or(total, |i| sent + i + 1);
-            lift_hpgl(link, &program[sent..end], stopped)
+            lift_hpgl(link, &program[sent..end], up, stopped)
         };
         kind.into_error(port.clone(), at, tool, opts.timeout)
     };
@@ -488,11 +501,24 @@ fn take_in(
 fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
     let rate = profile.serial.baud.max(1) as f64 / 10.0;
     let mut m = super::sim::hpgl::Hpgl::new(profile);
+    let mut g = super::sim::gpgl::Gpgl::new(profile);
+    let gpgl = profile.language == Language::Gpgl;
+    let next = |r: &[u8]| {
+        if gpgl {
+            crate::output::gpgl::next_instruction(r)
+        } else {
+            crate::output::hpgl::read::next_instruction(r)
+        }
+    };
     let (mut at, mut motion) = (0usize, 0.0f64);
     let mut out = Vec::new();
     let mut rest = program;
-    while let Some(n) = crate::output::hpgl::read::next_instruction(rest) {
-        motion += m.execute(&rest[..n]);
+    while let Some(n) = next(rest) {
+        motion += if gpgl {
+            g.execute(&rest[..n])
+        } else {
+            m.execute(&rest[..n])
+        };
         at += n;
         out.push((at, 1.1 * (motion + at as f64 / rate)));
         rest = &rest[n..];
@@ -522,13 +548,28 @@ impl Failure {
     }
 }
 
-/// Lift the tool of an HP-GL device: send the rest of the instruction in progress (a chunk may
+/// What ends an instruction of a plotter language, and the command that lifts the tool after
+/// it: HP-GL `;` then `PU;SP0;`; GP-GL ETX (or a line end) then `H` (tool up, home: GP-GL has
+/// no tool-up without a move).
+fn tool_up(language: Language) -> (fn(u8) -> bool, &'static [u8]) {
+    match language {
+        Language::Gpgl => (crate::output::gpgl::ends_instruction, b"\x03\nH\x03\n"),
+        _ => (|b| b == b';', b"\nPU;SP0;\n"),
+    }
+}
+
+/// Lift the tool of an HP-GL (or GP-GL) device: send the rest of the instruction in progress (a chunk may
 /// have ended inside a coordinate, which a bare `;` would turn into a stray cut), then pen up
 /// and put the pen away. Honours XOFF/CTS (starting from the state the stream was in) for a
 /// few seconds; the device lifts after working off its buffer, and the result says so.
-fn lift_hpgl(link: &mut Link, rest_of_instruction: &[u8], mut stopped: bool) -> ToolState {
+fn lift_hpgl(
+    link: &mut Link,
+    rest_of_instruction: &[u8],
+    tool_up: &[u8],
+    mut stopped: bool,
+) -> ToolState {
     let mut cmd = rest_of_instruction.to_vec();
-    cmd.extend_from_slice(b"\nPU;SP0;\n");
+    cmd.extend_from_slice(tool_up);
     let deadline = Instant::now() + Duration::from_secs(3);
     let mut sent = 0;
     let mut input = [0u8; 64];

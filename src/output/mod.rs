@@ -1,5 +1,6 @@
 //! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
-//! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in `gcode`), an SVG
+//! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in `gcode`, Graphtec
+//! GP-GL in [`gpgl`]), an SVG
 //! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
 //! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
@@ -24,6 +25,7 @@ use glam::DVec2;
 pub mod dxf;
 pub mod files;
 pub(crate) mod gcode;
+pub mod gpgl;
 pub mod hpgl;
 pub mod obj;
 pub mod png;
@@ -195,12 +197,13 @@ pub(crate) fn device_points(
 }
 
 /// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
-/// (`hpgl::emit`), or GRBL G-code (`gcode::emit`), by `profile.language` and
-/// `profile.dialect`.
+/// (`hpgl::emit`), GRBL G-code (`gcode::emit`) or Graphtec GP-GL ([`gpgl`]), by
+/// `profile.language` and `profile.dialect`.
 pub fn program(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, OutputError> {
     match profile.language {
         Language::Hpgl => hpgl::emit(sheet, profile),
         Language::Gcode => gcode::emit(sheet, profile),
+        Language::Gpgl => gpgl::emit(sheet, profile),
     }
 }
 

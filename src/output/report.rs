@@ -14,6 +14,10 @@
 //! the simplified border; the largest length difference between the two sides of one of its
 //! seams); exact unfoldings have no such key.
 //!
+//! When the device had no tool for some of a job's strokes, `dropped` lists per piece what was
+//! left out (`{piece, name, sheet, left_out: {label, edge_ids, …: count}, reason}`) and
+//! `warnings` says it in words; a job that lost nothing has neither key.
+//!
 //! Choices: lengths in mm and areas in mm², rounded to 1e-6 so that the file is stable across
 //! platforms; keys are written in a fixed order (serde_json without preserve_order sorts them).
 
@@ -33,6 +37,9 @@ pub struct RunInfo {
     pub files: Vec<String>,
     /// Features the device cannot make (`toolpath::cuttable`), as `warnings`; none: no key.
     pub warnings: Vec<crate::toolpath::cuttable::Warning>,
+    /// What the job left out for want of a tool, per piece (`dropped`, and one `warnings`
+    /// entry each, only when there is something).
+    pub dropped: Vec<crate::toolpath::passes::Dropped>,
 }
 
 fn r6(v: f64) -> f64 {
@@ -114,7 +121,7 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     let surfaces = surfaces_json(flats);
     let seams = seams_json(layout);
     let total = |g: &dyn Fn(&crate::pattern::Piece) -> f64| r6(layout.pieces.iter().map(g).sum());
-    let mut report = json!({
+    let mut rep = json!({
         "name": info.name,
         "spec": info.spec,
         "device": info.device,
@@ -137,10 +144,21 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
         },
         "files": info.files,
     });
-    if !info.warnings.is_empty() {
-        report["warnings"] = json!(info.warnings);
+    // Only when there is something, so that the report of a job that lost nothing stays as
+    // it was.
+    let mut warnings = info.warnings.clone();
+    warnings.extend(info.dropped.iter().map(|d| crate::toolpath::cuttable::Warning {
+        piece: d.name.clone(),
+        kind: "left-out",
+        message: format!("left out: {} ({})", d.describe(), d.reason),
+    }));
+    if !info.dropped.is_empty() {
+        rep["dropped"] = json!(info.dropped);
     }
-    report
+    if !warnings.is_empty() {
+        rep["warnings"] = json!(warnings);
+    }
+    rep
 }
 
 /// The `surfaces` entries: one per surface, with the figures its source measured.

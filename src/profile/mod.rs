@@ -53,6 +53,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         include_str!("../../devices/graphtec-ce6000.toml"),
     ),
     (
+        "graphtec-ce6000-gpgl.toml",
+        include_str!("../../devices/graphtec-ce6000-gpgl.toml"),
+    ),
+    (
         "uscutter-mh.toml",
         include_str!("../../devices/uscutter-mh.toml"),
     ),
@@ -70,6 +74,11 @@ pub const BUNDLED: &[(&str, &str)] = &[
 /// Dialects the output stage knows, per language.
 pub(crate) const HPGL_DIALECTS: &[&str] = &["hp-gl", "camm-gl2"];
 pub(crate) const GCODE_DIALECTS: &[&str] = &["grbl"];
+/// GP-GL: Graphtec's own language (CE6000 / CE7000 / FC series in native mode).
+pub(crate) const GPGL_DIALECTS: &[&str] = &["graphtec"];
+/// GP-GL step sizes a Graphtec cutter can be set to, as units per mm: 0.1 mm (the default),
+/// 0.05, 0.025 and 0.01 mm.
+pub(crate) const GPGL_UNITS_PER_MM: &[f64] = &[10.0, 20.0, 40.0, 100.0];
 
 /// Machine language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -77,23 +86,39 @@ pub(crate) const GCODE_DIALECTS: &[&str] = &["grbl"];
 pub enum Language {
     Hpgl,
     Gcode,
+    /// Graphtec GP-GL (`output::gpgl`).
+    Gpgl,
 }
 
 impl Language {
-    /// The language's name for people: `HP-GL`, `G-code`.
+    /// The language's name for people: `HP-GL`, `G-code`, `GP-GL`.
     pub fn label(self) -> &'static str {
         match self {
             Language::Hpgl => "HP-GL",
             Language::Gcode => "G-code",
+            Language::Gpgl => "GP-GL",
         }
     }
 
     /// File extension of programs in this language.
     pub fn extension(self) -> &'static str {
+        self.extensions()[0]
+    }
+
+    /// File extensions a program in this language is sent from (`flatcut send`), the one
+    /// flatcut writes first.
+    pub fn extensions(self) -> &'static [&'static str] {
         match self {
-            Language::Hpgl => "plt",
-            Language::Gcode => "gcode",
+            Language::Hpgl => &["plt", "hpgl", "hpg"],
+            Language::Gcode => &["gcode", "nc", "ngc", "gc"],
+            Language::Gpgl => &["gpgl", "gp"],
         }
+    }
+
+    /// Whether the language moves a pen or knife with plotter instructions under the buffered
+    /// protocol (HP-GL and GP-GL), rather than G-code lines.
+    pub fn is_plotter(self) -> bool {
+        matches!(self, Language::Hpgl | Language::Gpgl)
     }
 }
 
@@ -122,7 +147,7 @@ pub struct Profile {
     pub description: String,
     pub language: Language,
     /// HP-GL: `hp-gl` or `camm-gl2` (Roland CAMM-GL, mode 2: the HP-GL-like instruction set of
-    /// Roland's cutters; see `HPGL_DIALECTS`). G-code: `grbl`.
+    /// Roland's cutters; see `HPGL_DIALECTS`). G-code: `grbl`. GP-GL: `graphtec`.
     pub dialect: String,
     pub units_per_mm: f64,
     /// Largest width the machine can cut (mm); 0 when unknown.
@@ -198,7 +223,7 @@ impl Profile {
             return false;
         }
         match (self.tool(kind), self.language) {
-            (Some(_), Language::Hpgl) => true,
+            (Some(_), Language::Hpgl | Language::Gpgl) => true,
             (Some(t), Language::Gcode) => t.z_down.is_some(),
             (None, _) => false,
         }
@@ -325,6 +350,11 @@ mod tests {
                         assert_eq!(p.units_per_mm, 40.0, "{file}");
                         assert_eq!(p.protocol, Protocol::Buffered, "{file}");
                     }
+                    Language::Gpgl => {
+                        assert!(t.pen.is_some(), "{file}: GP-GL {kind:?} has no pen");
+                        assert_eq!(p.units_per_mm, 10.0, "{file}: GP-GL's 0.1 mm step");
+                        assert_eq!(p.protocol, Protocol::Buffered, "{file}");
+                    }
                     Language::Gcode => {
                         let knife = t.z_down.is_some() && t.z_up.is_some();
                         let servo = t.servo_down.is_some() && t.servo_up.is_some();
@@ -348,6 +378,7 @@ mod tests {
             "hpgl-pens",
             "roland-gx24",
             "graphtec-ce6000",
+            "graphtec-ce6000-gpgl",
             "uscutter-mh",
             "grbl-dragknife",
             "grbl-pen",
@@ -512,6 +543,7 @@ mod tests {
         for name in [
             "roland-gx24",
             "graphtec-ce6000",
+            "graphtec-ce6000-gpgl",
             "uscutter-mh",
             "grbl-dragknife",
         ] {
@@ -596,6 +628,33 @@ mod tests {
         says(
             &format!("{}[tools.cut]\npen=1\n", HPGL.replace("hp-gl", "camm-gl3")),
             "line 4: `dialect` `camm-gl3` is not a dialect",
+        );
+        let gpgl = HPGL
+            .replace("'hpgl'", "'gpgl'")
+            .replace("'hp-gl'", "'graphtec'");
+        says(
+            &format!("{}[tools.cut]\npen=1\n", gpgl.replace("=40", "=25")),
+            "line 5: `units_per_mm` must be 10, 20, 40 or 100 for GP-GL",
+        );
+        let ok = parse(
+            &format!(
+                "{}[tools.cut]\npen=1\nforce=14\n",
+                gpgl.replace("=40", "=10")
+            ),
+            "x.toml",
+        )
+        .unwrap();
+        assert_eq!(
+            (ok.language.label(), ok.language.extension()),
+            ("GP-GL", "gpgl")
+        );
+        says(
+            &format!("{}[tools.cut]\nforce=14\n", gpgl.replace("=40", "=10")),
+            "`tools.cut.pen` is missing",
+        );
+        says(
+            &format!("{}[tools.cut]\npen=1\n", gpgl.replace("graphtec", "hp-gl")),
+            "`dialect` `hp-gl` is not a dialect",
         );
         says(
             &format!("{HPGL}buffer=0\n[tools.cut]\npen=1\n"),

@@ -3,8 +3,8 @@
 
 use super::tools::check_tool;
 use super::{
-    problem, Language, Problem, Profile, ProfileError, Protocol, GCODE_DIALECTS, HPGL_DIALECTS,
-    TOOL_KINDS,
+    problem, Language, Problem, Profile, ProfileError, Protocol, GCODE_DIALECTS, GPGL_DIALECTS,
+    GPGL_UNITS_PER_MM, HPGL_DIALECTS, TOOL_KINDS,
 };
 
 /// Parse one profile and check it. Errors name `source_name` and the key at fault, with its
@@ -57,6 +57,7 @@ fn check(p: &Profile) -> Result<(), Problem> {
     let (dialects, gcode) = match p.language {
         Language::Hpgl => (HPGL_DIALECTS, false),
         Language::Gcode => (GCODE_DIALECTS, true),
+        Language::Gpgl => (GPGL_DIALECTS, false),
     };
     if !dialects.contains(&p.dialect.as_str()) {
         return Err(problem(
@@ -84,7 +85,18 @@ fn check(p: &Profile) -> Result<(), Problem> {
         return Err(problem(
             "",
             "protocol",
-            "must be buffered for an HP-GL profile (the grbl-* protocols are for G-code)",
+            "must be buffered for an HP-GL or GP-GL profile (the grbl-* protocols are for G-code)",
+        ));
+    }
+    if p.language == Language::Gpgl && !GPGL_UNITS_PER_MM.contains(&p.units_per_mm) {
+        return Err(problem(
+            "",
+            "units_per_mm",
+            format!(
+                "must be 10, 20, 40 or 100 for GP-GL (the cutter's step size of 0.1, 0.05, \
+                 0.025 or 0.01 mm), got {}",
+                p.units_per_mm
+            ),
         ));
     }
     if gcode && p.units_per_mm != 1.0 {

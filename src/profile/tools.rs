@@ -33,6 +33,8 @@ pub(crate) const TOOL_KINDS: &[&str] = &["cut", "score", "perforate", "draw", "e
 /// How one kind of stroke is made. Which fields matter depends on the language:
 ///
 /// - HP-GL: `pen` (required), `force` (`FS`, grams) and `speed` (`VS`, cm/s).
+/// - GP-GL (Graphtec): the same fields as HP-GL: `pen` (`J`, the tool holder / condition
+///   number), `force` (`FX`, the cutter's force level, not grams) and `speed` (`!`, cm/s).
 /// - G-code: `speed` (feed, mm/min) and exactly one way of putting the tool down: a knife on Z
 ///   (`z_down` and `z_up`), a servo pen (`servo_down` and `servo_up`, `M3 S`, with `dwell`), or
 ///   a laser (`power`, `M4 S`, more than 0 and at most the profile's `max_power`).
@@ -42,11 +44,12 @@ pub(crate) const TOOL_KINDS: &[&str] = &["cut", "score", "perforate", "draw", "e
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct Tool {
-    /// HP-GL pen (tool holder) number.
+    /// HP-GL pen (tool holder) number; GP-GL `J` number.
     pub pen: Option<u32>,
-    /// Knife force in grams (HP-GL `FS`; dialects scale it, see `output::hpgl`).
+    /// Knife force in grams (HP-GL `FS`; dialects scale it, see `output::hpgl`); GP-GL: the
+    /// `FX` force level of the cutter.
     pub force: Option<f64>,
-    /// HP-GL: velocity in cm/s (`VS`). G-code: feed rate in mm/min.
+    /// HP-GL: velocity in cm/s (`VS`); GP-GL: cm/s (`!`). G-code: feed rate in mm/min.
     pub speed: Option<f64>,
     /// Times each stroke is repeated (default 1).
     pub passes: Option<u32>,

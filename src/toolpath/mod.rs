@@ -13,7 +13,8 @@
 //! of it — folds as perforation dashes, overcut, drag-knife offset compensation with an
 //! alignment precut — is [`knife::prepare`], applied to the job that is encoded. Which tool makes
 //! a fold is `fold_kind`: the scoring tool, else the perforating one, else the pen.
-//! [`weed`] adds weed lines for vinyl.
+//! [`weed`] adds weed lines for vinyl. [`passes`] names what a device has no tool for and
+//! splits a job into the pen and knife passes of a tool change.
 //!
 //! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); notches
 //! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
@@ -27,6 +28,7 @@ mod collect;
 pub mod cuttable;
 pub mod knife;
 pub mod order;
+pub mod passes;
 pub mod weed;
 
 /// What a stroke is for; decides the SVG layer and, through [`StrokeKind`], the tool.

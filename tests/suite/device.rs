@@ -474,7 +474,7 @@ fn every_bundled_profile_cuts_the_house_through_the_simulator() {
         // With a drag knife the simulator records the trailing blade tip: what the design
         // asked for, not the holder's path. The precut comes first.
         let precut = usize::from(sheet.strokes.len() == design.sheets[0].strokes.len() + 1);
-        let hpgl = p.language == flatcut::profile::Language::Hpgl;
+        let hpgl = p.language != flatcut::profile::Language::Gcode;
         let round = |v: f64| {
             if hpgl {
                 v.round()

@@ -20,7 +20,7 @@
 //!   `flow_violations`. (Only stops longer than the grace can catch a host this way; the
 //!   grace is long enough for a loaded machine's kernel to act on XOFF.) This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
 //!   stream into the simulator.
-//! - **Execution.** HP-GL instructions are executed one at a time, each when the previous
+//! - **Execution.** HP-GL and GP-GL (`gpgl`) instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the
 //!   interpreters compute (`hpgl`, [`grbl`]) divided by the time factor (`None`: no time).
@@ -32,6 +32,7 @@
 //! Everything it cuts is recorded (`record`) and, on [`SimHandle::finish`], summarised in a
 //! [`SimReport`] (written as `sim.json`) and drawn as `sim.png`, in the machine's own axes.
 
+pub(crate) mod gpgl;
 pub mod grbl;
 pub(crate) mod hpgl;
 pub(crate) mod record;
@@ -176,6 +177,8 @@ pub struct SimHandle {
     expect: Arc<AtomicUsize>,
     /// Overruns plus flow-control violations so far, as the device counts them.
     violations: Arc<AtomicUsize>,
+    /// Bytes received so far.
+    received: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
 }
 
@@ -213,6 +216,12 @@ impl SimHandle {
         }
     }
 
+    /// Bytes the device has taken off the line so far (a test can see that nothing of a
+    /// sheet arrived before the operator said so).
+    pub fn bytes_received(&self) -> usize {
+        self.received.load(Ordering::SeqCst)
+    }
+
     /// Stop at once.
     pub fn stop(mut self) -> Result<SimReport, SimError> {
         self.ctl.store(STOP, Ordering::SeqCst);
@@ -243,10 +252,12 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let ctl = Arc::new(AtomicU8::new(RUN));
     let expect = Arc::new(AtomicUsize::new(0));
     let violations = Arc::new(AtomicUsize::new(0));
+    let received = Arc::new(AtomicUsize::new(0));
     let (c2, k2, e2, v2) = (cts.clone(), ctl.clone(), expect.clone(), violations.clone());
+    let r2 = received.clone();
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2)).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2, r2)).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
@@ -254,6 +265,7 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
         ctl,
         expect,
         violations,
+        received,
         thread: Some(thread),
     })
 }
@@ -305,6 +317,7 @@ impl Line {
 enum Interp {
     Hpgl(hpgl::Hpgl),
     Grbl(grbl::Grbl),
+    Gpgl(gpgl::Gpgl),
 }
 
 struct Device {
@@ -316,6 +329,7 @@ struct Device {
     ctl: Arc<AtomicU8>,
     expect: Arc<AtomicUsize>,
     violations: Arc<AtomicUsize>,
+    received: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -348,7 +362,7 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
-        (expect, violations): (Arc<AtomicUsize>, Arc<AtomicUsize>),
+        (expect, violations, received): (Arc<AtomicUsize>, Arc<AtomicUsize>, Arc<AtomicUsize>),
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -359,10 +373,10 @@ impl Device {
         } else {
             p.serial.flow_control
         };
-        let interp = if grbl {
-            Interp::Grbl(grbl::Grbl::new(p))
-        } else {
-            Interp::Hpgl(hpgl::Hpgl::new(p))
+        let interp = match p.language {
+            Language::Gcode => Interp::Grbl(grbl::Grbl::new(p)),
+            Language::Hpgl => Interp::Hpgl(hpgl::Hpgl::new(p)),
+            Language::Gpgl => Interp::Gpgl(gpgl::Gpgl::new(p)),
         };
         let rep = SimReport {
             device: p.name.clone(),
@@ -380,6 +394,7 @@ impl Device {
             ctl,
             expect,
             violations,
+            received,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -514,6 +529,8 @@ impl Device {
             }
             self.violations
                 .store(self.rep.violations(), Ordering::SeqCst);
+            self.received
+                .store(self.rep.bytes_received, Ordering::SeqCst);
             let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
@@ -528,6 +545,7 @@ impl Device {
                 crate::output::hpgl::read::next_instruction(self.rx.iter()).is_some()
             }
             Interp::Grbl(_) => self.rx.iter().any(|&b| b == b'\n' || b == b'\r'),
+            Interp::Gpgl(_) => crate::output::gpgl::next_instruction(self.rx.iter()).is_some(),
         }
     }
 
@@ -661,6 +679,20 @@ impl Device {
                         self.motion.push_back(s);
                     }
                 }
+                Interp::Gpgl(m) => {
+                    if !self.motion.is_empty() {
+                        return;
+                    }
+                    let Some(n) = crate::output::gpgl::next_instruction(self.rx.iter()) else {
+                        return;
+                    };
+                    let instr: Vec<u8> = self.rx.drain(..n).collect();
+                    let t = m.execute(&instr);
+                    self.rep.simulated_time_s += t;
+                    if let Some(s) = self.scaled(t) {
+                        self.motion.push_back(s);
+                    }
+                }
                 Interp::Grbl(g) => {
                     if self.held || self.motion.len() >= PLANNER_BLOCKS {
                         return;
@@ -774,6 +806,12 @@ impl Device {
     fn close(mut self) -> SimReport {
         let (rec, upm) = match &self.interp {
             Interp::Hpgl(m) => {
+                self.rep.executed = m.instructions;
+                self.rep.tool_down_at_end = m.tool_down();
+                self.rep.ignored = m.ignored.clone();
+                (m.rec.clone(), self.cfg.profile.units_per_mm)
+            }
+            Interp::Gpgl(m) => {
                 self.rep.executed = m.instructions;
                 self.rep.tool_down_at_end = m.tool_down();
                 self.rep.ignored = m.ignored.clone();
