@@ -55,6 +55,7 @@ fn fandisk_travel_at_least_30_percent_shorter_than_stroke_order() {
             let mut pen = glam::DVec2::ZERO;
             let greedy = flatcut::toolpath::travel(&order::order_with(all.clone(), &mut pen, 0));
             let t = std::time::Instant::now();
+            let mut pen = glam::DVec2::ZERO;
             let full = flatcut::toolpath::travel(&order::order(all, &mut pen));
             eprintln!(
                 "one group: nearest neighbour {greedy:.0} mm, with 2-opt {full:.0} mm \
