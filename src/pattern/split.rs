@@ -45,7 +45,10 @@ use super::{PatternError, PatternOptions, Piece, Tabs};
 use crate::flatten::Flat;
 use crate::geom::polygon;
 use glam::DVec2;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
+
+/// Parts of an island: faces each.
+type Parts = Vec<Vec<usize>>;
 
 /// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
 /// would cross a panel rather than follow a line of the surface.
@@ -205,8 +208,7 @@ pub fn build_to_fit(
         );
     }
     let mut last = pieces;
-    let mut cache: std::collections::HashMap<(usize, usize), (f64, Vec<Vec<usize>>)> =
-        Default::default();
+    let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
     for _round in 0..8 {
         let mut tags = Vec::new();
         let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
@@ -394,7 +396,7 @@ struct Island<'a> {
 impl<'a> Island<'a> {
     fn new(flat: &'a Flat, faces: &'a [usize], opts: &PatternOptions, room: &Room) -> Self {
         let n = faces.len();
-        let mut local = std::collections::HashMap::new();
+        let mut local = HashMap::new();
         for (i, &f) in faces.iter().enumerate() {
             local.insert(f, i);
         }
