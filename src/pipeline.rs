@@ -160,7 +160,12 @@ fn flatten_surfaces(
         crate::pattern::split::Split::Auto => {
             let s = &spec.sheet;
             let room = crate::pattern::split::Room::inside(s.width, s.height, s.margin);
-            crate::pattern::split::build_to_fit(&mut flats, &opts, &room)?
+            crate::pattern::split::build_to_fit(&mut flats, &opts, &room).map_err(|e| {
+                Error::In {
+                    file: spec.path.clone(),
+                    source: Box::new(e.into()),
+                }
+            })?
         }
     };
     Ok((flats, pieces))

@@ -45,7 +45,10 @@ use super::{PatternError, PatternOptions, Piece, Tabs};
 use crate::flatten::Flat;
 use crate::geom::polygon;
 use glam::DVec2;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
+
+/// Parts of an island: faces each.
+type Parts = Vec<Vec<usize>>;
 
 /// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
 /// would cross a panel rather than follow a line of the surface.
@@ -205,6 +208,7 @@ pub fn build_to_fit(
         );
     }
     let mut last = pieces;
+    let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
     for _round in 0..8 {
         let mut tags = Vec::new();
         let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
@@ -215,10 +219,17 @@ pub fn build_to_fit(
             flat.joined = joined.clone();
             let mut plans = Vec::new();
             for (ii, faces) in islands.iter().enumerate() {
-                plans.push(match grow[fi][ii] {
-                    Some(g) => Some(partition(flat, faces, g, opts, room, ii)?),
-                    None => None,
-                });
+                let Some(g) = grow[fi][ii] else {
+                    plans.push(None);
+                    continue;
+                };
+                // The same growth gives the same partition: made once.
+                let parts = match cache.get(&(fi, ii)) {
+                    Some((cg, parts)) if *cg == g => parts.clone(),
+                    _ => partition(flat, faces, g, opts, room, ii)?,
+                };
+                cache.insert((fi, ii), (g, parts.clone()));
+                plans.push(Some(parts));
             }
             let (t, o, cut) = apply(flat, &plans);
             tags.push(t);
@@ -385,7 +396,7 @@ struct Island<'a> {
 impl<'a> Island<'a> {
     fn new(flat: &'a Flat, faces: &'a [usize], opts: &PatternOptions, room: &Room) -> Self {
         let n = faces.len();
-        let mut local = std::collections::HashMap::new();
+        let mut local = HashMap::new();
         for (i, &f) in faces.iter().enumerate() {
             local.insert(f, i);
         }
@@ -790,5 +801,65 @@ fn face_too_large(isl: &Island, u: usize, island: usize) -> PatternError {
         what: isl.room.what(),
         uw: isl.room.width,
         uh: isl.room.height_text(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flatten::{unfold, UnfoldOptions};
+
+    #[test]
+    fn part_letters_run_on_past_z() {
+        let names: Vec<String> = [0, 1, 25, 26, 27, 701, 702].map(letters).into();
+        assert_eq!(names, ["a", "b", "z", "aa", "ab", "zz", "aaa"]);
+    }
+
+    /// A flat row of five 100 mm squares on a 250 × 250 mm room: three parts (two squares
+    /// at most each), cut along square edges, one new seam each, the faces kept.
+    #[test]
+    fn a_row_of_squares_is_cut_between_squares() {
+        let mut verts = Vec::new();
+        for i in 0..=5 {
+            verts.push(glam::DVec3::new(100.0 * i as f64, 0.0, 0.0));
+            verts.push(glam::DVec3::new(100.0 * i as f64, 100.0, 0.0));
+        }
+        let faces: Vec<[usize; 4]> = (0..5)
+            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
+            .collect();
+        let row = crate::surface::Surface {
+            name: "row".into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
+            ..Default::default()
+        };
+        let mut flats = vec![unfold(row, &UnfoldOptions::default()).unwrap()];
+        let room = Room {
+            width: 250.0,
+            height: Some(250.0),
+        };
+        let opts = PatternOptions::default();
+        assert!(!fits(
+            &super::super::build(&flats, &opts).unwrap()[0],
+            &room
+        ));
+        let pieces = build_to_fit(&mut flats, &opts, &room).unwrap();
+        assert_eq!(pieces.len(), 3);
+        assert!(pieces.iter().all(|p| fits(p, &room)));
+        let mut sizes: Vec<usize> = pieces.iter().map(|p| p.faces.len()).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, [1, 2, 2]);
+        let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["1a", "1b", "1c"]);
+        let split: Vec<_> = pieces
+            .iter()
+            .flat_map(|p| &p.seams)
+            .filter(|s| s.split)
+            .collect();
+        assert_eq!(split.len(), 4);
+        assert!(split
+            .iter()
+            .all(|s| s.count == 1 && (s.length - 100.0).abs() < 1e-9));
+        assert_eq!(flats[0].islands.len(), 3);
     }
 }
