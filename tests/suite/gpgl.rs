@@ -3,7 +3,8 @@
 //! simulated Graphtec cutter, whose recorded tool-down paths must equal the job's within one
 //! device unit (0.1 mm).
 //!
-//! The blade offset is set to 0 for the comparison, so that the recorded path is the holder's,
+//! The profile gets the pen of a tool change (`toolpath::passes::with_pen`), so that labels and
+//! seam ids are in the job too. The blade offset is set to 0 for the comparison, so that the recorded path is the holder's,
 //! which is the job's (with an offset the simulator records the trailing blade tip; the bundled
 //! profile with its offset is checked on the house in `device.rs`). The line runs at 460800
 //! baud and motion takes no time, so the 18 patterns stream in seconds.
@@ -27,7 +28,9 @@ fn sim_name(p: &Profile, kind: &str) -> String {
 
 #[test]
 fn every_bundled_pattern_on_gpgl_equals_the_job_within_one_step() {
-    let mut p = profile::find("graphtec-ce6000-gpgl").unwrap();
+    // With the knife holder's pen of a tool change, so that labels and seam ids are drawn too.
+    let mut p =
+        flatcut::toolpath::passes::with_pen(&profile::find("graphtec-ce6000-gpgl").unwrap());
     assert_eq!(p.language, profile::Language::Gpgl);
     p.knife_offset = 0.0;
     p.serial.baud = 460_800;
@@ -80,13 +83,22 @@ fn every_bundled_pattern_on_gpgl_equals_the_job_within_one_step() {
                     .collect();
                 pts.dedup_by(|a, b| a[0].round() == b[0].round() && a[1].round() == b[1].round());
                 let passes = p.tool(kind).unwrap().passes() as usize;
+                // The pen shares the knife's holder and sends no force: the simulator cannot
+                // tell it from the knife by its force, so its name is not compared.
+                let tool = if kind == profile::StrokeKind::Draw {
+                    String::new()
+                } else {
+                    sim_name(&p, kind.name())
+                };
                 for _ in 0..passes {
-                    expected.push((sim_name(&p, kind.name()), pts.clone()));
+                    expected.push((tool.clone(), pts.clone()));
                 }
             }
             assert_eq!(rep.paths.len(), expected.len(), "{at}: path count");
             for (i, (got, (tool, want))) in rep.paths.iter().zip(&expected).enumerate() {
-                assert_eq!(&got.tool, tool, "{at}: path {i}");
+                if !tool.is_empty() {
+                    assert_eq!(&got.tool, tool, "{at}: path {i}");
+                }
                 let want = if want.len() == 1 {
                     vec![want[0], want[0]]
                 } else {
@@ -104,7 +116,11 @@ fn every_bundled_pattern_on_gpgl_equals_the_job_within_one_step() {
             sheets_checked += 1;
         }
     }
-    assert!(paths_checked > 300, "{paths_checked} paths");
+    eprintln!(
+        "gpgl: {} patterns, {sheets_checked} sheets, {paths_checked} paths within one step",
+        patterns.len()
+    );
+    assert!(paths_checked > 1000, "{paths_checked} paths");
     assert!(sheets_checked >= patterns.len());
 }
 

@@ -8,7 +8,8 @@
 //! and goes to the origin; `J n` lifts the tool and takes tool n. A stray odd coordinate is
 //! ignored. Which tool of the profile is down is told as in the HP-GL interpreter: the tool
 //! with this number, and where several share it (one holder), the one whose force is nearest
-//! the last `FX`.
+//! the last `FX` (a tool with no force of its own only when none other is left, or no `FX` was
+//! sent).
 //!
 //! Motion time: tool-down moves at the `!` speed (cm/s; the profile's tool speed when the
 //! program sets none), tool-up moves at the HP-GL interpreter's travel speed.
@@ -77,9 +78,11 @@ impl Gpgl {
         };
         let mut best: Option<(f64, &String)> = None;
         for (name, force) in tools {
+            // A tool without a force of its own is the last guess once a force is set.
             let d = match (self.force, force) {
                 (Some(a), Some(b)) => (a - b).abs(),
-                _ => 0.0,
+                (Some(_), None) => f64::MAX,
+                (None, _) => 0.0,
             };
             if best.is_none_or(|(b, _)| d < b) {
                 best = Some((d, name));
