@@ -401,7 +401,7 @@ pub fn check_mesh(path: &Path) -> Result<crate::surface::obj::MeshStats, Error> 
 /// `flatcut send`: an existing program file, checked against the device's language (by its
 /// extension) and not empty.
 pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
-    let bytes = std::fs::read(path)
+    let bytes = crate::geom::input::read_bytes(path, crate::geom::input::DATA_LIMIT)
         .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", path.display())))?;
     let ext = path
         .extension()

@@ -241,7 +241,7 @@ pub fn all() -> Result<Vec<Profile>, ProfileError> {
                 .collect();
             files.sort();
             for f in files {
-                let text = std::fs::read_to_string(&f).map_err(|e| ProfileError::Invalid {
+                let text = crate::geom::input::read_text(&f, crate::geom::input::TEXT_LIMIT).map_err(|e| ProfileError::Invalid {
                     source_name: f.display().to_string(),
                     message: e.to_string(),
                 })?;
