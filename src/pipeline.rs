@@ -90,6 +90,20 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
                 e.into()
             }
         })?;
+        plausible_surface(&surface).map_err(|e| {
+            if s.line > 0 {
+                Error::At {
+                    file: spec.path.clone(),
+                    line: s.line,
+                    source: Box::new(e),
+                }
+            } else {
+                Error::In {
+                    file: spec.path.clone(),
+                    source: Box::new(e),
+                }
+            }
+        })?;
         if !quiet {
             for w in &surface.warnings {
                 eprintln!("flatcut: warning: {w}");
@@ -116,6 +130,48 @@ pub fn pieces(spec: &Spec, quiet: bool) -> Result<(Vec<Flat>, Vec<Piece>), Error
     let opts = spec.pattern_options();
     let pieces = crate::pattern::build(&flats, &opts)?;
     Ok((flats, pieces))
+}
+
+/// A surface whose coordinates are beyond [`crate::geom::input::MAX_COORD`] is refused before
+/// any stage allocates by them (a pole grid, a picture, a nesting scan).
+fn plausible_surface(surface: &crate::surface::Surface) -> Result<(), Error> {
+    let max = crate::geom::input::MAX_COORD;
+    let far = surface
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0, f64::max);
+    if far > max || far.is_nan() {
+        return Err(Error::Usage(format!(
+            "surface `{}`: a coordinate is {far:.3e} mm from the origin, beyond the {max:.0} mm (1 km) flatcut works in; check the units or the dimensions",
+            surface.name
+        )));
+    }
+    Ok(())
+}
+
+/// The sheet's sizes within [`crate::geom::input::MAX_COORD`] (a roll's length may be open).
+fn plausible_sheet(spec: &Spec) -> Result<(), Error> {
+    let max = crate::geom::input::MAX_COORD;
+    let s = &spec.sheet;
+    let sizes = [
+        ("width", Some(s.width)),
+        ("height", s.height),
+        ("margin", Some(s.margin)),
+        ("spacing", Some(s.spacing)),
+    ];
+    for (key, v) in sizes {
+        if let Some(v) = v.filter(|v| !(v.abs() <= max)) {
+            return Err(Error::In {
+                file: spec.path.clone(),
+                source: Box::new(Error::Usage(format!(
+                    "sheet.{key} = {v:.3e} mm is beyond the {max:.0} mm (1 km) flatcut works in"
+                ))),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Find a device profile and make its tool table say how folds are made: the tools that
@@ -177,6 +233,7 @@ pub fn plan(
     choices: &Toolpath,
     quiet: bool,
 ) -> Result<(Vec<Flat>, Layout, Job), Error> {
+    plausible_sheet(spec)?;
     let (flats, pieces) = pieces(spec, quiet)?;
     let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,

@@ -22,8 +22,8 @@ pub struct LinkArgs {
     /// Serial port of the machine (e.g. /dev/ttyUSB0); see `flatcut ports`.
     #[arg(long)]
     pub port: Option<String>,
-    /// Baud rate (overrides the device profile).
-    #[arg(long)]
+    /// Baud rate (overrides the device profile), 50 to 4000000.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(50..=4_000_000))]
     pub baud: Option<u32>,
     /// Send to a simulated cutter that behaves like the device instead of a real port.
     #[arg(long)]
@@ -36,6 +36,10 @@ pub struct LinkArgs {
     #[arg(long, default_value_t = 60.0)]
     pub timeout: f64,
 }
+
+/// Longest a simulated machine may work off its buffer after the last byte while it makes
+/// progress (a job of a day at the simulated speed).
+const SIM_FINISH_CAP: Duration = Duration::from_secs(24 * 3600);
 
 /// The process-wide Ctrl-C flag; the handler is installed on first use.
 pub fn cancel_flag() -> Arc<AtomicBool> {
@@ -112,7 +116,23 @@ pub fn deliver(
     };
     let mut said = Vec::new();
     let several = programs.len() > 1;
-    for (k, (name, bytes)) in programs.iter().enumerate() {
+    // Every program is checked before the first byte of the first one goes out.
+    let mut checked = Vec::with_capacity(programs.len());
+    for (name, bytes) in programs {
+        if profile.language != crate::profile::Language::Hpgl {
+            checked.push(bytes.clone());
+            continue;
+        }
+        let c = crate::device::check::check_hpgl(bytes, profile)
+            .map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+        if !quiet {
+            for w in &c.warnings {
+                eprintln!("flatcut: warning: {name}: {w}");
+            }
+        }
+        checked.push(c.bytes);
+    }
+    for (k, ((name, _), bytes)) in programs.iter().zip(&checked).enumerate() {
         if simulated(profile, link) {
             let mut cfg = SimConfig::new(profile.clone());
             // The simulated line runs at the rate the host uses.
@@ -121,8 +141,9 @@ pub fn deliver(
             }
             cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
             // The simulated machine works off what it has buffered, as a real one would (after
-            // Ctrl-C that includes the tool-up command, queued behind the buffer).
-            let (sent, report) = stream::stream_job(cfg, bytes, &opts, Duration::from_secs(600))?;
+            // Ctrl-C that includes the tool-up command, queued behind the buffer), for as long
+            // as it makes progress: `--timeout` without progress, or Ctrl-C, ends the wait.
+            let (sent, report) = stream::stream_job(cfg, bytes, &opts, SIM_FINISH_CAP)?;
             let stem = if several {
                 format!("sim-{}", k + 1)
             } else {

@@ -2,6 +2,9 @@
 //! `/dev/zero`, a FIFO that would block, or a directory), no larger than a limit, and text
 //! must be UTF-8 — an error names the line and column of the first invalid byte.
 //!
+//! [`MAX_COORD`] is the plausible magnitude of a coordinate, for the checks of surfaces,
+//! sheets and programs.
+//!
 //! Choices: the errors are `std::io::Error`s with a message of their own, so every reader
 //! keeps its own error variant (which names the file); the type is checked on the path before
 //! it is opened (opening a FIFO blocks) and again on the open handle; the read takes at most
@@ -9,6 +12,10 @@
 
 use std::io::{Error, ErrorKind, Read};
 use std::path::Path;
+
+/// Largest coordinate (mm, either sign) of a surface, sheet or program flatcut works with:
+/// 1 km. Checked before any stage allocates by a coordinate (grids, pictures, rulers).
+pub const MAX_COORD: f64 = 1e6;
 
 /// Largest text input (spec, profile, CSV loop, ESICUP instance): 16 MiB.
 pub const TEXT_LIMIT: u64 = 16 << 20;

@@ -133,8 +133,12 @@ fn check(p: &Profile) -> Result<(), Problem> {
         ));
     }
     let s = &p.serial;
-    if s.baud == 0 {
-        return Err(problem("serial", "baud", "must be more than 0"));
+    if !(50..=4_000_000).contains(&s.baud) {
+        return Err(problem(
+            "serial",
+            "baud",
+            format!("must be a baud rate from 50 to 4000000, got {}", s.baud),
+        ));
     }
     if !(5..=8).contains(&s.data_bits) {
         return Err(problem(

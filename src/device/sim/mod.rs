@@ -176,7 +176,20 @@ pub struct SimHandle {
     expect: Arc<AtomicUsize>,
     /// Overruns plus flow-control violations so far, as the device counts them.
     violations: Arc<AtomicUsize>,
+    /// Ticks of the device's loop in which it received, executed or moved.
+    progress: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
+}
+
+/// How [`SimHandle::finish_watching`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Finish {
+    /// The device worked off everything it held.
+    Done,
+    /// It made no progress (took no byte, executed nothing, did not move) for the idle time.
+    Idle,
+    /// The cancel flag (Ctrl-C) was raised.
+    Cancelled,
 }
 
 impl SimHandle {
@@ -195,6 +208,47 @@ impl SimHandle {
         }
         self.ctl.store(STOP, Ordering::SeqCst);
         t.join().map_err(|_| SimError::Thread)
+    }
+
+    /// [`SimHandle::finish`] as a host waits on a machine: as long as the device makes
+    /// progress (a busy machine is not a stopped one), until it made none for `idle`, or until
+    /// `cancel` is raised (Ctrl-C); then stop it.
+    /// `within` caps the whole wait (then it ends as [`Finish::Idle`]).
+    pub fn finish_watching(
+        mut self,
+        bytes_sent: usize,
+        idle: Duration,
+        within: Duration,
+        cancel: &AtomicBool,
+    ) -> Result<(SimReport, Finish), SimError> {
+        let deadline = Instant::now().checked_add(within);
+        self.expect.store(bytes_sent, Ordering::SeqCst);
+        self.ctl.store(FINISH, Ordering::SeqCst);
+        let t = self.thread.take().ok_or(SimError::Thread)?;
+        let mut seen = self.progress.load(Ordering::SeqCst);
+        let mut last = Instant::now();
+        let end = loop {
+            if t.is_finished() {
+                break Finish::Done;
+            }
+            if cancel.load(Ordering::SeqCst) {
+                break Finish::Cancelled;
+            }
+            let now = self.progress.load(Ordering::SeqCst);
+            if now != seen {
+                seen = now;
+                last = Instant::now();
+            } else if last.elapsed() > idle {
+                break Finish::Idle;
+            }
+            if deadline.is_some_and(|d| Instant::now() > d) {
+                break Finish::Idle;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        self.ctl.store(STOP, Ordering::SeqCst);
+        let rep = t.join().map_err(|_| SimError::Thread)?;
+        Ok((rep, end))
     }
 
     /// Wait until the device has counted a buffer overrun or a flow-control violation, or
@@ -243,10 +297,12 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let ctl = Arc::new(AtomicU8::new(RUN));
     let expect = Arc::new(AtomicUsize::new(0));
     let violations = Arc::new(AtomicUsize::new(0));
+    let progress = Arc::new(AtomicUsize::new(0));
     let (c2, k2, e2, v2) = (cts.clone(), ctl.clone(), expect.clone(), violations.clone());
+    let p2 = progress.clone();
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2)).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2, p2)).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
@@ -254,6 +310,7 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
         ctl,
         expect,
         violations,
+        progress,
         thread: Some(thread),
     })
 }
@@ -316,6 +373,7 @@ struct Device {
     ctl: Arc<AtomicU8>,
     expect: Arc<AtomicUsize>,
     violations: Arc<AtomicUsize>,
+    progress: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -348,7 +406,7 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
-        (expect, violations): (Arc<AtomicUsize>, Arc<AtomicUsize>),
+        (expect, violations, progress): (Arc<AtomicUsize>, Arc<AtomicUsize>, Arc<AtomicUsize>),
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -380,6 +438,7 @@ impl Device {
             ctl,
             expect,
             violations,
+            progress,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -515,6 +574,9 @@ impl Device {
             self.violations
                 .store(self.rep.violations(), Ordering::SeqCst);
             let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
+            if n > 0 || (!self.stalled && (!self.motion.is_empty() || self.has_complete_input())) {
+                self.progress.fetch_add(1, Ordering::Relaxed);
+            }
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
         self.close()
