@@ -19,7 +19,7 @@
 
 use crate::flatten::Flat;
 use crate::nest::Layout;
-pub use crate::output::files::{create_dir, write_atomic};
+pub use crate::output::files::{check_file_name, create_dir, write_atomic, RunFiles};
 use crate::output::report::{self, RunInfo};
 use crate::pattern::Piece;
 use crate::profile::Profile;
@@ -327,7 +327,7 @@ pub fn cut(
         .output
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
-    create_dir(&dir)?;
+    let mut run = RunFiles::begin(&dir)?;
     let mut files = Vec::new();
     let mut programs = Vec::new();
     let ext = profile.language.extension();
@@ -335,15 +335,16 @@ pub fn cut(
     for (i, sheet) in machine.sheets.iter().enumerate() {
         let name = sheet_file(&spec.name, i, n, ext);
         let bytes = crate::output::program(sheet, profile).map_err(|e| e.on_sheet(i + 1))?;
-        write_atomic(&dir.join(&name), &bytes)?;
+        run.write(&name, &bytes)?;
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    files.extend(write_pictures(&dir, &spec.name, &job)?);
-    files.extend(write_dxf(&dir, &spec.name, &layout)?);
-    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    files.extend(write_pictures(&mut run, &spec.name, &job)?);
+    files.extend(write_dxf(&mut run, &spec.name, &layout)?);
+    files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    write_report(&dir, spec, &profile.name, &files, &flats, &layout)?;
+    write_report(&mut run, spec, &profile.name, &files, &flats, &layout)?;
+    run.commit()?;
     Ok(CutRun {
         flats,
         layout,
@@ -394,11 +395,12 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .output
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
-    create_dir(&dir)?;
-    let mut files = write_pictures(&dir, &spec.name, &job)?;
-    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    let mut run = RunFiles::begin(&dir)?;
+    let mut files = write_pictures(&mut run, &spec.name, &job)?;
+    files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
-    write_report(&dir, spec, "", &files, &flats, &layout)?;
+    write_report(&mut run, spec, "", &files, &flats, &layout)?;
+    run.commit()?;
     Ok(FlattenRun {
         flats,
         layout,
@@ -436,12 +438,13 @@ pub fn nest_instance(
     };
     let sol = esicup::solve(&inst, &cfg)?;
     let dir = output.unwrap_or_else(|| default_dir(&inst.name));
-    create_dir(&dir)?;
+    let mut run = RunFiles::begin(&dir)?;
     let text = serde_json::to_string_pretty(&esicup::solution_json(&inst, &sol))
         .unwrap_or_default()
         + "\n";
-    write_atomic(&dir.join("solution.json"), text.as_bytes())?;
-    write_atomic(&dir.join("layout.svg"), esicup::svg(&inst, &sol).as_bytes())?;
+    run.write("solution.json", text.as_bytes())?;
+    run.write("layout.svg", esicup::svg(&inst, &sol).as_bytes())?;
+    run.commit()?;
     Ok(NestRun {
         instance: inst,
         solution: sol,
@@ -499,7 +502,7 @@ fn write_extras(flats: &[Flat], extras: &Extras) -> Result<(), Error> {
 
 /// report.json: the run, its pieces, seams, sheets and per-surface figures.
 fn write_report(
-    dir: &Path,
+    run: &mut RunFiles,
     spec: &Spec,
     device: &str,
     files: &[String],
@@ -516,7 +519,7 @@ fn write_report(
     };
     let rep = report::build(&info, flats, layout);
     let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
-    Ok(write_atomic(&dir.join("report.json"), text.as_bytes())?)
+    Ok(run.write("report.json", text.as_bytes())?)
 }
 
 /// Write the surfaces' meshes into one OBJ file (`--surface-obj`), atomically.
@@ -578,7 +581,11 @@ pub fn write_uv_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
 
 /// `--alternatives N`: write `<surface>-alt-<k>.obj`, the surface's mesh first and then the
 /// alternatives its source found; returns the file names.
-fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Vec<String>, Error> {
+fn write_alternatives(
+    run: &mut RunFiles,
+    flats: &[Flat],
+    n: Option<usize>,
+) -> Result<Vec<String>, Error> {
     let mut files = Vec::new();
     let Some(n) = n else { return Ok(files) };
     for f in flats {
@@ -596,7 +603,7 @@ fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Ve
                 f.surface.name
             );
             let text = crate::output::obj::write(mesh, None, &comment).unwrap_or_default();
-            write_atomic(&dir.join(&name), text.as_bytes())?;
+            run.write(&name, text.as_bytes())?;
             files.push(name);
         }
     }
@@ -604,31 +611,28 @@ fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Ve
 }
 
 /// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
-fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, Error> {
+fn write_pictures(run: &mut RunFiles, name: &str, job: &Job) -> Result<Vec<String>, Error> {
     let mut files = Vec::new();
     let svg = format!("{name}.svg");
-    write_atomic(&dir.join(&svg), crate::output::svg::render(job).as_bytes())?;
+    run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
         let bytes =
             crate::output::png::render(sheet, i + 1, crate::output::png::DEFAULT_PX_PER_MM)?;
-        write_atomic(&dir.join(&png), &bytes)?;
+        run.write(&png, &bytes)?;
         files.push(png);
     }
     Ok(files)
 }
 
 /// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.
-fn write_dxf(dir: &Path, name: &str, layout: &Layout) -> Result<Vec<String>, Error> {
+fn write_dxf(run: &mut RunFiles, name: &str, layout: &Layout) -> Result<Vec<String>, Error> {
     let n = layout.sheets.len();
     let mut files = Vec::new();
     for i in 0..n {
         let file = sheet_file(name, i, n, "dxf");
-        write_atomic(
-            &dir.join(&file),
-            crate::output::dxf::render(layout, i).as_bytes(),
-        )?;
+        run.write(&file, crate::output::dxf::render(layout, i).as_bytes())?;
         files.push(file);
     }
     Ok(files)

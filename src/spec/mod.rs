@@ -165,7 +165,7 @@ pub use crate::surface::{
 pub use context::SpecError;
 
 use crate::pattern::PatternOptions;
-use context::{Ctx, Opt, MM_NON_NEGATIVE, MM_POSITIVE, NON_EMPTY};
+use context::{Ctx, Opt, MM_NON_NEGATIVE, MM_POSITIVE};
 use names::one_of;
 use spanned::{fmt_num, List, RawMaterial, RawPattern, RawSheet, RawSpec, RawSurface, Tab};
 use std::path::{Path, PathBuf};
@@ -343,7 +343,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
 impl Ctx<'_> {
     fn build(&self, raw: RawSpec) -> Result<Spec, SpecError> {
         let name = self
-            .string(&raw.name, "name", NON_EMPTY)?
+            .file_name(&raw.name, "name")?
             .unwrap_or_else(|| stem_or(self.path, "pattern"));
         let device = self.string(&raw.device, "device", "a non-empty device profile name")?;
 

@@ -908,8 +908,8 @@ pub(crate) fn write_outputs(
     let png = crate::output::png::render(&sheet, 0, px)?;
     let png_path = dir.join(format!("{stem}.png"));
     let json_path = dir.join(format!("{stem}.json"));
-    crate::output::files::write_atomic(&png_path, &png)?;
+    crate::output::files::write_in_run(dir, &format!("{stem}.png"), &png)?;
     let text = serde_json::to_string_pretty(rep).unwrap_or_default() + "\n";
-    crate::output::files::write_atomic(&json_path, text.as_bytes())?;
+    crate::output::files::write_in_run(dir, &format!("{stem}.json"), text.as_bytes())?;
     Ok((png_path, json_path))
 }
