@@ -104,7 +104,11 @@ mod tests {
         assert!(c.bytes.ends_with(b"PD400,400;PU;"));
         assert_eq!(c.warnings.len(), 2, "{:?}", c.warnings);
         let c = check_hpgl(b"IN;SP1;PD400,400;PU", &profile()).unwrap();
-        assert!(c.bytes.ends_with(b";PU;"), "{:?}", String::from_utf8_lossy(&c.bytes));
+        assert!(
+            c.bytes.ends_with(b";PU;"),
+            "{:?}",
+            String::from_utf8_lossy(&c.bytes)
+        );
         let ok = b"IN;SP1;PU0,0;PD400,400;PU;SP0;";
         let c = check_hpgl(ok, &profile()).unwrap();
         assert_eq!(c.bytes, ok.to_vec());

@@ -133,9 +133,7 @@ impl Link {
         if let Some(c) = &self.virtual_cts {
             return Ok(c.load(Ordering::SeqCst));
         }
-        self.port
-            .read_clear_to_send()
-            .map_err(std::io::Error::from)
+        self.port.read_clear_to_send().map_err(std::io::Error::from)
     }
 
     /// Write some of `bytes`; `Ok(0)` when the port would not take any within `POLL`.

@@ -401,14 +401,7 @@ fn buffered(
         }
         let cts = match link.clear_to_send() {
             Ok(c) => c,
-            Err(e) => {
-                return Err(fail(
-                    link,
-                    Failure::Cts(e.to_string()),
-                    sent,
-                    stopped,
-                ))
-            }
+            Err(e) => return Err(fail(link, Failure::Cts(e.to_string()), sent, stopped)),
         };
         if stopped || !cts {
             if last_progress.elapsed() > opts.timeout {

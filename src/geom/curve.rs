@@ -494,10 +494,11 @@ fn rect(c: DVec3, w: f64, h: f64, r: f64, tol: f64) -> Result<Vec<DVec3>, CurveE
 
 /// Points of a CSV file (see the module doc for the format).
 pub fn read_csv(path: &Path) -> Result<Vec<DVec3>, CurveError> {
-    let text = super::input::read_text(path, super::input::TEXT_LIMIT).map_err(|e| CurveError::Io {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let text =
+        super::input::read_text(path, super::input::TEXT_LIMIT).map_err(|e| CurveError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     let mut out = Vec::new();
     let mut first = true;
     for (k, line) in text.lines().enumerate() {

@@ -88,7 +88,10 @@ pub fn line_col(bytes: &[u8], at: usize) -> (usize, usize) {
     let at = at.min(bytes.len());
     let before = &bytes[..at];
     let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
-    let start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
     let col = 1 + String::from_utf8_lossy(&before[start..]).chars().count();
     (line, col)
 }
@@ -100,7 +103,10 @@ pub fn utf8(bytes: Vec<u8>) -> Result<String, Error> {
         let (line, col) = line_col(e.as_bytes(), at);
         Error::new(
             ErrorKind::InvalidData,
-            format!("invalid UTF-8 at line {line}, column {col} (byte {})", at + 1),
+            format!(
+                "invalid UTF-8 at line {line}, column {col} (byte {})",
+                at + 1
+            ),
         )
     })
 }
@@ -125,10 +131,7 @@ mod tests {
     #[test]
     fn invalid_utf8_names_line_and_column() {
         let e = utf8(b"ab\ncd\xffe".to_vec()).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "invalid UTF-8 at line 2, column 3 (byte 6)"
-        );
+        assert_eq!(e.to_string(), "invalid UTF-8 at line 2, column 3 (byte 6)");
     }
 
     #[test]

@@ -176,9 +176,8 @@ impl RunFiles {
     /// Stage file `name` (a plain file name, [`check_file_name`]) with its bytes.
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), OutputError> {
         let path = self.dir.join(name);
-        check_file_name(name).map_err(|m| {
-            io_err(&path)(std::io::Error::new(std::io::ErrorKind::InvalidInput, m))
-        })?;
+        check_file_name(name)
+            .map_err(|m| io_err(&path)(std::io::Error::new(std::io::ErrorKind::InvalidInput, m)))?;
         if let Some(k) = self.staged.iter().position(|(n, _)| n == name) {
             let (_, old) = self.staged.remove(k);
             let _ = std::fs::remove_file(old);
@@ -224,9 +223,7 @@ impl RunFiles {
         for gone in old.difference(&new) {
             let path = self.dir.join(gone);
             match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(io_err(&path)(e))
-                }
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_err(&path)(e)),
                 _ => {}
             }
         }
@@ -265,7 +262,16 @@ mod tests {
 
     #[test]
     fn names_must_be_plain_file_names() {
-        for bad in ["../../escaped", "/etc/passwd", "a/b", "..", ".hidden", "", "a\\b", "x\0"] {
+        for bad in [
+            "../../escaped",
+            "/etc/passwd",
+            "a/b",
+            "..",
+            ".hidden",
+            "",
+            "a\\b",
+            "x\0",
+        ] {
             assert!(check_file_name(bad).is_err(), "{bad:?}");
         }
         for good in ["cube", "lamp shade", "job-1.plt", "taco_2"] {

@@ -196,8 +196,7 @@ fn key_at(text: &str, at: usize) -> Option<String> {
     let key = key.trim().trim_matches('"');
     let bare = |s: &str| {
         !s.is_empty()
-            && s
-                .chars()
+            && s.chars()
                 .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
     };
     if !bare(key) {

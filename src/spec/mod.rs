@@ -325,10 +325,13 @@ pub fn load(path: &Path) -> Result<Spec, SpecError> {
     if is_obj {
         return Ok(Spec::from_mesh(path));
     }
-    let text = crate::geom::input::read_text(path, crate::geom::input::TEXT_LIMIT).map_err(|source| SpecError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::geom::input::read_text(path, crate::geom::input::TEXT_LIMIT).map_err(|source| {
+            SpecError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     parse(&text, path)
 }
 
