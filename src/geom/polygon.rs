@@ -321,14 +321,21 @@ pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
     };
     let mut heap = BinaryHeap::new();
     let h = 0.5 * cell;
-    // Counted, not stepped: `x += cell` stalls where `cell` is below the spacing of floats.
-    let count = |extent: f64| (extent / cell).ceil().clamp(0.0, POLE_GRID) as usize;
-    let (nx, ny) = (count(size.x), count(size.y));
-    for i in 0..nx {
-        for j in 0..ny {
-            let c = lo + DVec2::new(i as f64, j as f64) * cell;
-            heap.push(make(c + DVec2::splat(h), h));
+    // At most `POLE_GRID` + 1 steps a side: `x += cell` stalls where `cell` is below the
+    // spacing of floats at `x`.
+    let cap = POLE_GRID as usize + 1;
+    let mut x = lo.x;
+    let mut i = 0;
+    while x < hi.x && i < cap {
+        let mut y = lo.y;
+        let mut j = 0;
+        while y < hi.y && j < cap {
+            heap.push(make(DVec2::new(x + h, y + h), h));
+            y += cell;
+            j += 1;
         }
+        x += cell;
+        i += 1;
     }
     // Start from the centroid of the outer ring, as polylabel does.
     let outer = &rings[0];
