@@ -162,7 +162,7 @@ fn plausible_sheet(spec: &Spec) -> Result<(), Error> {
         ("spacing", Some(s.spacing)),
     ];
     for (key, v) in sizes {
-        if let Some(v) = v.filter(|v| !(v.abs() <= max)) {
+        if let Some(v) = v.filter(|v| v.is_nan() || v.abs() > max) {
             return Err(Error::In {
                 file: spec.path.clone(),
                 source: Box::new(Error::Usage(format!(
