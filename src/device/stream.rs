@@ -335,6 +335,16 @@ fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
     }
 }
 
+/// Where a buffered job stopped: a buffered device answers nothing, so what it has surely
+/// executed is what was written less what its buffer and the line (two chunks) can still hold.
+fn unanswered_position(bar: &Bar, sent: usize, total: usize, buffer: usize) -> Position {
+    let mut at = position(bar, sent, total);
+    let executed = sent.saturating_sub(buffer + 2 * CHUNK);
+    at.confirmed = Some(executed);
+    at.stroke = bar.stroke_at(executed);
+    at
+}
+
 /// Stream an HP-GL program under the profile's flow control (XON/XOFF, RTS/CTS, or none:
 /// paced by the program's own execution time), at the line rate.
 fn buffered(
@@ -366,12 +376,7 @@ fn buffered(
     let mut last_bar = Instant::now();
 
     let fail = |link: &mut Link, kind: Failure, sent: usize, stopped: bool| -> StreamError {
-        let mut at = position(bar, sent, total);
-        // A buffered device answers nothing: what it has surely executed is what was written
-        // less what its buffer and the line (two chunks) can still hold.
-        let executed = sent.saturating_sub(profile.buffer + 2 * CHUNK);
-        at.confirmed = Some(executed);
-        at.stroke = bar.stroke_at(executed);
+        let at = unanswered_position(bar, sent, total, profile.buffer);
         let tool = if matches!(kind, Failure::HungUp(_)) {
             ToolState::Unknown
         } else {
@@ -1031,12 +1036,16 @@ pub fn stream_job(
     let mut sent = send(&mut port, &profile, program, opts);
     let written = port.written;
     drop(port);
-    let wait = if opts.cancel.load(Ordering::SeqCst) {
-        finish_within.min(opts.timeout)
+    // Cancelled while sending: the tool-up is queued behind the buffer; let the device work
+    // it off (at most 30 s), as a real one would.
+    let stopped_early = opts.cancel.load(Ordering::SeqCst);
+    let unset = AtomicBool::new(false);
+    let (wait, cancel) = if stopped_early {
+        (finish_within.min(Duration::from_secs(30)), &unset)
     } else {
-        finish_within
+        (finish_within, &*opts.cancel)
     };
-    let (report, end) = handle.finish_watching(written, opts.timeout, wait, &opts.cancel)?;
+    let (report, end) = handle.finish_watching(written, opts.timeout, wait, cancel)?;
     if profile.language == Language::Hpgl {
         let executed = report
             .bytes_received
@@ -1092,7 +1101,9 @@ fn set_confirmed(e: &mut StreamError, executed: usize, stroke: usize, state: Too
             at.confirmed = Some(executed);
             at.stroke = stroke;
             // The simulator knows what became of the tool.
-            *tool = state;
+            if state != ToolState::Lifted || *tool != ToolState::LiftQueued {
+                *tool = state;
+            }
         }
         _ => {}
     }
