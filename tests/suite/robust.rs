@@ -401,10 +401,10 @@ fn sim_opts(timeout: f64, cancel: Arc<AtomicBool>) -> StreamOptions {
     }
 }
 
-/// A long slow job: 200 pen-down moves of 100 mm.
+/// A long slow job that fits in the device's buffer: 40 pen-down moves of 100 mm at 1 cm/s.
 fn slow_job() -> Vec<u8> {
     let mut s = String::from("IN;SP1;VS1;PU0,0;");
-    for k in 0..200 {
+    for k in 0..40 {
         s.push_str(if k % 2 == 0 { "PD4000,0;" } else { "PD0,0;" });
     }
     s.push_str("PU;SP0;");
