@@ -61,6 +61,7 @@
 //!   sim.rs                     `flatcut sim --device D -o DIR`
 //! device/
 //!   mod.rs                     Device stage
+//!   check.rs                   Checking an HP-GL program before its first byte goes out
 //!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host (`super::stream`) and the simulate…
 //!   serial.rs                  The serial transport
 //!   stream.rs                  Streaming a program into a device without ever overrunning it
@@ -89,6 +90,7 @@
 //!   font.rs                    Single-stroke vector font for piece labels and edge id numbers
 //!   heap.rs                    A binary-heap entry that pops the smallest key first, ties broken on the smaller id
 //!   hull.rs                    3D convex hulls with facet adjacency and orientation, and the local-convexity test of an edge (…
+//!   input.rs                   Reading a user's input file with bounds (a regular file under a size limit, UTF-8)
 //!   mesh.rs                    Polygon meshes and their edge adjacency, Newell normals (`newell`) and signed dihedral angles (…
 //!   obj.rs                     Wavefront OBJ text of a mesh, optionally with texture coordinates
 //!   polygon.rs                 2D polygons
@@ -166,6 +168,7 @@
 //!     darts.rs                 §6.1 darts
 //!     figures.rs               §4 metrics of a finished triangulation, for the report
 //!     loops.rs                 §6 several loops and §6.1 rulings
+//!     planar.rs                A planar loop needs no search: its developable is the flat polygon it bounds
 //!     search.rs                The search of every region (§5), with the §7 radial offset and what happens when it finds nothi…
 //!   dcharts/
 //!     mod.rs                   D-Charts

@@ -20,7 +20,7 @@
 
 use crate::flatten::Flat;
 use crate::nest::Layout;
-pub use crate::output::files::{create_dir, write_atomic};
+pub use crate::output::files::{check_file_name, create_dir, write_atomic, RunFiles};
 use crate::output::report::{self, RunInfo};
 use crate::pattern::Piece;
 use crate::profile::Profile;
@@ -130,7 +130,22 @@ fn flatten_surfaces(
     quiet: bool,
 ) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
     let mut flats = Vec::new();
-    for surface in surfaces {
+    for (surface, s) in surfaces.into_iter().zip(&spec.surfaces) {
+        // Whatever its size came from, a surface lies within the range flatcut works in.
+        plausible_surface(&surface).map_err(|e| {
+            if s.line > 0 {
+                Error::At {
+                    file: spec.path.clone(),
+                    line: s.line,
+                    source: Box::new(e),
+                }
+            } else {
+                Error::In {
+                    file: spec.path.clone(),
+                    source: Box::new(e),
+                }
+            }
+        })?;
         if !quiet {
             for w in &surface.warnings {
                 eprintln!("flatcut: warning: {w}");
@@ -169,6 +184,48 @@ fn flatten_surfaces(
         }
     };
     Ok((flats, pieces))
+}
+
+/// A surface whose coordinates are beyond [`crate::geom::input::MAX_COORD`] is refused before
+/// any stage allocates by them (a pole grid, a picture, a nesting scan).
+fn plausible_surface(surface: &crate::surface::Surface) -> Result<(), Error> {
+    let max = crate::geom::input::MAX_COORD;
+    let far = surface
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0, f64::max);
+    if far > max || far.is_nan() {
+        return Err(Error::Usage(format!(
+            "surface `{}`: a coordinate is {far:.3e} mm from the origin, beyond the {max:.0} mm (1 km) flatcut works in; check the units or the dimensions",
+            surface.name
+        )));
+    }
+    Ok(())
+}
+
+/// The sheet's sizes within [`crate::geom::input::MAX_COORD`] (a roll's length may be open).
+fn plausible_sheet(spec: &Spec) -> Result<(), Error> {
+    let max = crate::geom::input::MAX_COORD;
+    let s = &spec.sheet;
+    let sizes = [
+        ("width", Some(s.width)),
+        ("height", s.height),
+        ("margin", Some(s.margin)),
+        ("spacing", Some(s.spacing)),
+    ];
+    for (key, v) in sizes {
+        if let Some(v) = v.filter(|v| v.is_nan() || v.abs() > max) {
+            return Err(Error::In {
+                file: spec.path.clone(),
+                source: Box::new(Error::Usage(format!(
+                    "sheet.{key} = {v:.3e} mm is beyond the {max:.0} mm (1 km) flatcut works in"
+                ))),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Find a device profile and make its tool table say how folds are made: the tools that
@@ -230,6 +287,7 @@ pub fn plan(
     choices: &Toolpath,
     quiet: bool,
 ) -> Result<(Vec<Flat>, Layout, Job), Error> {
+    plausible_sheet(spec)?;
     let (flats, pieces) = pieces(spec, quiet)?;
     let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
@@ -405,7 +463,7 @@ pub fn cut(
         .output
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
-    create_dir(&dir)?;
+    let mut run = RunFiles::begin(&dir)?;
     let mut files = Vec::new();
     let mut programs = Vec::new();
     let mut before = Vec::new();
@@ -426,26 +484,27 @@ pub fn cut(
         if tool_change && !pen.strokes.is_empty() {
             let pen_name = sheet_file(&format!("{}-pen", spec.name), i, n, ext);
             let bytes = crate::output::program(&pen, profile).map_err(|e| e.on_sheet(i + 1))?;
-            write_atomic(&dir.join(&pen_name), &bytes)?;
+            run.write(&pen_name, &bytes)?;
             files.push(pen_name.clone());
             programs.push((pen_name, bytes));
             before.push(Before::ToolChange { k: i + 1 });
         }
         let bytes = crate::output::program(&knife, profile).map_err(|e| e.on_sheet(i + 1))?;
-        write_atomic(&dir.join(&name), &bytes)?;
+        run.write(&name, &bytes)?;
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    files.extend(write_pictures(&dir, &spec.name, &job)?);
-    files.extend(write_dxf(&dir, &spec.name, &layout)?);
-    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    files.extend(write_pictures(&mut run, &spec.name, &job)?);
+    files.extend(write_dxf(&mut run, &spec.name, &layout)?);
+    files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
         dropped: dropped.clone(),
         warnings: cuttable(&layout, profile.knife_offset, spec, extras.quiet),
         ..run_info(spec, &profile.name, &files)
     };
-    write_report(&dir, &info, &flats, &layout)?;
+    write_report(&mut run, &info, &flats, &layout)?;
+    run.commit()?;
     Ok(CutRun {
         flats,
         layout,
@@ -498,15 +557,16 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .output
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
-    create_dir(&dir)?;
-    let mut files = write_pictures(&dir, &spec.name, &job)?;
-    files.extend(write_alternatives(&dir, &flats, extras.alternatives)?);
+    let mut run = RunFiles::begin(&dir)?;
+    let mut files = write_pictures(&mut run, &spec.name, &job)?;
+    files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
         warnings: cuttable(&layout, 0.0, spec, extras.quiet),
         ..run_info(spec, "", &files)
     };
-    write_report(&dir, &info, &flats, &layout)?;
+    write_report(&mut run, &info, &flats, &layout)?;
+    run.commit()?;
     Ok(FlattenRun {
         flats,
         layout,
@@ -544,12 +604,13 @@ pub fn nest_instance(
     };
     let sol = esicup::solve(&inst, &cfg)?;
     let dir = output.unwrap_or_else(|| default_dir(&inst.name));
-    create_dir(&dir)?;
+    let mut run = RunFiles::begin(&dir)?;
     let text = serde_json::to_string_pretty(&esicup::solution_json(&inst, &sol))
         .unwrap_or_default()
         + "\n";
-    write_atomic(&dir.join("solution.json"), text.as_bytes())?;
-    write_atomic(&dir.join("layout.svg"), esicup::svg(&inst, &sol).as_bytes())?;
+    run.write("solution.json", text.as_bytes())?;
+    run.write("layout.svg", esicup::svg(&inst, &sol).as_bytes())?;
+    run.commit()?;
     Ok(NestRun {
         instance: inst,
         solution: sol,
@@ -566,7 +627,7 @@ pub fn check_mesh(path: &Path) -> Result<crate::surface::obj::MeshStats, Error> 
 /// `flatcut send`: an existing program file, checked against the device's language (by its
 /// extension) and not empty.
 pub fn read_program(path: &Path, profile: &Profile) -> Result<Vec<u8>, Error> {
-    let bytes = std::fs::read(path)
+    let bytes = crate::geom::input::read_bytes(path, crate::geom::input::DATA_LIMIT)
         .map_err(|e| Error::Usage(format!("{}: cannot read: {e}", path.display())))?;
     let ext = path
         .extension()
@@ -636,10 +697,15 @@ fn run_info(spec: &Spec, device: &str, files: &[String]) -> RunInfo {
 }
 
 /// report.json: the run, its pieces, seams, sheets and per-surface figures.
-fn write_report(dir: &Path, info: &RunInfo, flats: &[Flat], layout: &Layout) -> Result<(), Error> {
+fn write_report(
+    run: &mut RunFiles,
+    info: &RunInfo,
+    flats: &[Flat],
+    layout: &Layout,
+) -> Result<(), Error> {
     let rep = report::build(info, flats, layout);
     let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
-    Ok(write_atomic(&dir.join("report.json"), text.as_bytes())?)
+    Ok(run.write("report.json", text.as_bytes())?)
 }
 
 /// Write the surfaces' meshes into one OBJ file (`--surface-obj`), atomically.
@@ -701,7 +767,11 @@ pub fn write_uv_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
 
 /// `--alternatives N`: write `<surface>-alt-<k>.obj`, the surface's mesh first and then the
 /// alternatives its source found; returns the file names.
-fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Vec<String>, Error> {
+fn write_alternatives(
+    run: &mut RunFiles,
+    flats: &[Flat],
+    n: Option<usize>,
+) -> Result<Vec<String>, Error> {
     let mut files = Vec::new();
     let Some(n) = n else { return Ok(files) };
     for f in flats {
@@ -719,7 +789,7 @@ fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Ve
                 f.surface.name
             );
             let text = crate::output::obj::write(mesh, None, &comment).unwrap_or_default();
-            write_atomic(&dir.join(&name), text.as_bytes())?;
+            run.write(&name, text.as_bytes())?;
             files.push(name);
         }
     }
@@ -727,31 +797,28 @@ fn write_alternatives(dir: &Path, flats: &[Flat], n: Option<usize>) -> Result<Ve
 }
 
 /// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
-fn write_pictures(dir: &Path, name: &str, job: &Job) -> Result<Vec<String>, Error> {
+fn write_pictures(run: &mut RunFiles, name: &str, job: &Job) -> Result<Vec<String>, Error> {
     let mut files = Vec::new();
     let svg = format!("{name}.svg");
-    write_atomic(&dir.join(&svg), crate::output::svg::render(job).as_bytes())?;
+    run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
         let bytes =
             crate::output::png::render(sheet, i + 1, crate::output::png::DEFAULT_PX_PER_MM)?;
-        write_atomic(&dir.join(&png), &bytes)?;
+        run.write(&png, &bytes)?;
         files.push(png);
     }
     Ok(files)
 }
 
 /// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.
-fn write_dxf(dir: &Path, name: &str, layout: &Layout) -> Result<Vec<String>, Error> {
+fn write_dxf(run: &mut RunFiles, name: &str, layout: &Layout) -> Result<Vec<String>, Error> {
     let n = layout.sheets.len();
     let mut files = Vec::new();
     for i in 0..n {
         let file = sheet_file(name, i, n, "dxf");
-        write_atomic(
-            &dir.join(&file),
-            crate::output::dxf::render(layout, i).as_bytes(),
-        )?;
+        run.write(&file, crate::output::dxf::render(layout, i).as_bytes())?;
         files.push(file);
     }
     Ok(files)

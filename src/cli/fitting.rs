@@ -227,8 +227,8 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
         .strip_spec(&opts)
         .map_err(|e| Error::Usage(e.to_string()))?;
     let name = a.name.clone().unwrap_or_else(|| f.kind().to_string());
-    if name.trim().is_empty() {
-        return Err(Error::Usage("--name: must not be empty".into()));
+    if let Err(m) = crate::pipeline::check_file_name(&name) {
+        return Err(Error::Usage(format!("--name: {m}")));
     }
     let path = PathBuf::from(format!("fitting {}", f.kind()));
     let kind = a.material.unwrap_or(MaterialKind::Metal);

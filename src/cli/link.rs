@@ -36,8 +36,8 @@ pub struct LinkArgs {
     /// Serial port of the machine (e.g. /dev/ttyUSB0); see `flatcut ports`.
     #[arg(long)]
     pub port: Option<String>,
-    /// Baud rate (overrides the device profile).
-    #[arg(long)]
+    /// Baud rate (overrides the device profile), 50 to 4000000.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(50..=4_000_000))]
     pub baud: Option<u32>,
     /// Send to a simulated cutter that behaves like the device instead of a real port.
     #[arg(long)]
@@ -55,6 +55,10 @@ pub struct LinkArgs {
     #[arg(long, value_name = "LIST")]
     pub sheets: Option<String>,
 }
+
+/// Longest a simulated machine may work off its buffer after the last byte while it makes
+/// progress (a job of a day at the simulated speed).
+const SIM_FINISH_CAP: Duration = Duration::from_secs(24 * 3600);
 
 /// The process-wide Ctrl-C flag; the handler is installed on first use.
 pub fn cancel_flag() -> Arc<AtomicBool> {
@@ -260,6 +264,8 @@ pub fn deliver(
         .filter(|(_, k)| chosen.contains(k))
         .map(|(i, k)| (*k, i))
         .collect();
+    // Every program is checked before the first byte of the first one goes out.
+    let programs = &checked(programs, profile, quiet)?;
     if simulated(profile, link) {
         return deliver_simulated(programs, &todo, n, profile, link, dir, &opts);
     }
@@ -294,6 +300,31 @@ pub fn deliver(
     Ok(said)
 }
 
+/// The programs as they are sent: HP-GL ones checked (`device::check`), with the warnings
+/// printed unless `quiet`; a program that cannot be sent is an error naming it.
+fn checked(
+    programs: &[(String, Vec<u8>)],
+    profile: &Profile,
+    quiet: bool,
+) -> Result<Vec<(String, Vec<u8>)>, Error> {
+    let mut out = Vec::with_capacity(programs.len());
+    for (name, bytes) in programs {
+        if profile.language != crate::profile::Language::Hpgl {
+            out.push((name.clone(), bytes.clone()));
+            continue;
+        }
+        let c = crate::device::check::check_hpgl(bytes, profile)
+            .map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+        if !quiet {
+            for w in &c.warnings {
+                eprintln!("flatcut: warning: {name}: {w}");
+            }
+        }
+        out.push((name.clone(), c.bytes));
+    }
+    Ok(out)
+}
+
 /// The simulated path of [`deliver`]: one simulated machine per sheet, the passes of a tool
 /// change streamed into the same one; no operator is waited for.
 fn deliver_simulated(
@@ -320,47 +351,35 @@ fn deliver_simulated(
             cfg.profile.serial.baud = b;
         }
         cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
-        let handle = sim::spawn(cfg.clone())?;
-        let mut written = 0;
-        let mut results = Vec::new();
-        for (j, &i) in group.iter().enumerate() {
-            if j > 0 {
-                said.push(format!(
-                    "sheet {k}: tool change (the simulated machine changes tools itself)"
-                ));
-            }
-            let mut port = crate::device::serial::open(&cfg.profile, &handle.path, None)?
-                .with_virtual_cts(handle.cts.clone());
-            let sent = stream::send(&mut port, &cfg.profile, &programs[i].1, opts);
-            written += port.written;
-            drop(port);
-            let failed = sent.is_err();
-            results.push((i, sent));
-            if failed {
-                break;
-            }
+        // The passes of a sheet go into one simulated machine, one after the other, as one
+        // stream (the simulated machine changes tools itself).
+        let bytes: Vec<u8> = group.iter().flat_map(|&i| programs[i].1.clone()).collect();
+        let names: Vec<&str> = group.iter().map(|&i| programs[i].0.as_str()).collect();
+        if group.len() > 1 {
+            said.push(format!(
+                "sheet {k}: tool change (the simulated machine changes tools itself)"
+            ));
         }
         // The simulated machine works off what it has buffered, as a real one would (after
-        // Ctrl-C that includes the tool-up command, queued behind the buffer).
-        let wait = if opts.cancel.load(Ordering::SeqCst) {
-            Duration::from_secs(30)
-        } else {
-            Duration::from_secs(600)
-        };
-        let report = handle.finish(written, wait)?;
+        // Ctrl-C that includes the tool-up command, queued behind the buffer), for as long
+        // as it makes progress: `--timeout` without progress, or Ctrl-C, ends the wait.
+        let (sent, report) = stream::stream_job(cfg, &bytes, opts, SIM_FINISH_CAP)?;
         let stem = if n > 1 {
             format!("sim-{k}")
         } else {
             "sim".into()
         };
         let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
-        for (i, sent) in results {
-            let rep = sent?;
-            said.push(format!(
-                "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud)",
-                programs[i].0, profile.name, rep.bytes, rep.strokes, rep.seconds, report.baud,
-            ));
-        }
+        let rep = sent?;
+        said.push(format!(
+            "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud)",
+            names.join(" + "),
+            profile.name,
+            rep.bytes,
+            rep.strokes,
+            rep.seconds,
+            report.baud,
+        ));
         if report.violations() > 0 {
             return Err(Error::Usage(format!(
                 "the simulated {} lost data: {} bytes overran its {}-byte buffer and {} were sent while it asked to stop (see {}); a real machine would have cut this job wrong",

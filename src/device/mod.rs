@@ -1,9 +1,11 @@
-//! Device stage: how a program reaches a machine ([`serial`] transport, [`stream`] protocols
+//! Device stage: how a program reaches a machine ([`check`] of a program before it is sent,
+//! [`serial`] transport, [`stream`] protocols
 //! with flow control and GRBL character counting, [`grbl`] protocol knowledge), and the
 //! simulated cutter on a pseudo-terminal ([`sim`]) that stands in for a machine. What flatcut
 //! knows about each machine (language, units, serial settings, tool table) is
 //! [`crate::profile`].
 
+pub mod check;
 pub mod grbl;
 pub mod serial;
 pub mod sim;

@@ -10,7 +10,11 @@
 //! - RTS/CTS: the port is opened with hardware flow control (the UART stops on CTS by
 //!   itself) and the CTS line is also read before every chunk. A pseudo-terminal has no modem
 //!   lines; for the simulated cutter the transport reads the simulator's CTS flag instead
-//!   ([`Link::with_virtual_cts`]).
+//!   ([`Link::with_virtual_cts`]). A CTS line that cannot be read is an error, never "clear".
+//!
+//! The port is taken exclusively while flatcut streams: `serialport` opens it with `TIOCEXCL`
+//! (further opens fail with `EBUSY`, except for root) and an exclusive `flock` (which other
+//! well-behaved programs honour); a port already held that way is reported as busy.
 
 use crate::profile::{FlowControl, Parity, Profile};
 use serialport::SerialPort;
@@ -75,9 +79,17 @@ pub fn open(profile: &Profile, port: &str, baud: Option<u32>) -> Result<Link, Se
         .stop_bits(stop_bits)
         .flow_control(flow)
         .timeout(POLL)
+        .exclusive(true)
         .open();
     let port_box = opened.map_err(|e| {
+        let busy = {
+            let d = e.description.to_ascii_lowercase();
+            d.contains("lock") || d.contains("busy")
+        };
         let hint = match e.kind() {
+            serialport::ErrorKind::NoDevice if busy => {
+                "; the port is busy: another program (or another flatcut) has it open; close that first, flatcut takes the port for itself while it streams"
+            }
             serialport::ErrorKind::NoDevice => {
                 "; is the cutter plugged in and switched on? `flatcut ports` lists the ports"
             }
@@ -112,16 +124,16 @@ impl Link {
         self
     }
 
-    /// Whether the device lets us send (always true unless the profile uses RTS/CTS).
-    pub(crate) fn clear_to_send(&mut self) -> bool {
+    /// Whether the device lets us send (always true unless the profile uses RTS/CTS). `Err`
+    /// when the port cannot report CTS: sending blind could overrun the device.
+    pub(crate) fn clear_to_send(&mut self) -> std::io::Result<bool> {
         if self.flow != FlowControl::RtsCts {
-            return true;
+            return Ok(true);
         }
         if let Some(c) = &self.virtual_cts {
-            return c.load(Ordering::SeqCst);
+            return Ok(c.load(Ordering::SeqCst));
         }
-        // A port that cannot report CTS relies on the UART's own hardware flow control.
-        self.port.read_clear_to_send().unwrap_or(true)
+        self.port.read_clear_to_send().map_err(std::io::Error::from)
     }
 
     /// Write some of `bytes`; `Ok(0)` when the port would not take any within `POLL`.

@@ -31,7 +31,7 @@
 
 use super::grbl::{self as proto, Response};
 use super::serial::Link;
-use super::sim::{SimConfig, SimError, SimReport, XOFF, XON};
+use super::sim::{Finish, SimConfig, SimError, SimReport, XOFF, XON};
 use crate::profile::{FlowControl, Language, Profile, Protocol};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -76,15 +76,26 @@ pub struct Position {
     /// GRBL: the last line answered `ok` (1-based in the program), and how many lines.
     pub line: Option<usize>,
     pub lines_total: usize,
+    /// HP-GL: bytes the device is known to have executed, when that differs from `bytes`
+    /// (what was written): the simulator's count, or for a real device without answers the
+    /// bytes written less what its buffer and the line can still hold.
+    pub confirmed: Option<usize>,
 }
 
 impl std::fmt::Display for Position {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "stroke {} of {}, byte {} of {}",
-            self.stroke, self.strokes_total, self.bytes, self.bytes_total
-        )?;
+        match self.confirmed {
+            Some(c) => write!(
+                f,
+                "{c} of {} bytes known executed by the device ({} written), stroke {} of {} begun",
+                self.bytes_total, self.bytes, self.stroke, self.strokes_total
+            )?,
+            None => write!(
+                f,
+                "stroke {} of {}, byte {} of {}",
+                self.stroke, self.strokes_total, self.bytes, self.bytes_total
+            )?,
+        }
         if let Some(l) = self.line {
             write!(f, ", last acknowledged line {l} of {}", self.lines_total)?;
         }
@@ -100,6 +111,8 @@ pub enum ToolState {
     LiftQueued,
     /// The line failed before the tool-up command could be sent.
     Unknown,
+    /// The line works but the device took no tool-up command (it stalled or holds XOFF).
+    NotTaken,
 }
 
 impl std::fmt::Display for ToolState {
@@ -113,6 +126,10 @@ impl std::fmt::Display for ToolState {
             ToolState::Unknown => write!(
                 f,
                 "the line is gone, so the tool could not be lifted: check the machine"
+            ),
+            ToolState::NotTaken => write!(
+                f,
+                "the device took no tool-up command (it stopped reading or keeps asking to wait): the tool may still be down, check the machine"
             ),
         }
     }
@@ -171,6 +188,13 @@ pub enum StreamError {
         at: Position,
         tool: ToolState,
     },
+    #[error("{port}: cannot read the CTS line ({message}); RTS/CTS flow control needs it to know the device can take more, so sending stopped ({at}; {tool})")]
+    Cts {
+        port: String,
+        message: String,
+        at: Position,
+        tool: ToolState,
+    },
 }
 
 impl StreamError {
@@ -180,7 +204,8 @@ impl StreamError {
             | StreamError::HungUp { at, .. }
             | StreamError::Grbl { at, .. }
             | StreamError::Alarm { at, .. }
-            | StreamError::Cancelled { at, .. } => Some(at),
+            | StreamError::Cancelled { at, .. }
+            | StreamError::Cts { at, .. } => Some(at),
             _ => None,
         }
     }
@@ -318,7 +343,18 @@ fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
         strokes_total: bar.starts.len(),
         line: None,
         lines_total: 0,
+        confirmed: None,
     }
+}
+
+/// Where a buffered job stopped: a buffered device answers nothing, so what it has surely
+/// executed is what was written less what its buffer and the line (two chunks) can still hold.
+fn unanswered_position(bar: &Bar, sent: usize, total: usize, buffer: usize) -> Position {
+    let mut at = position(bar, sent, total);
+    let executed = sent.saturating_sub(buffer + 2 * CHUNK);
+    at.confirmed = Some(executed);
+    at.stroke = bar.stroke_at(executed);
+    at
 }
 
 /// Stream an HP-GL program under the profile's flow control (XON/XOFF, RTS/CTS, or none:
@@ -352,7 +388,7 @@ fn buffered(
     let mut last_bar = Instant::now();
 
     let fail = |link: &mut Link, kind: Failure, sent: usize, stopped: bool| -> StreamError {
-        let at = position(bar, sent, total);
+        let at = unanswered_position(bar, sent, total, profile.buffer);
         let tool = if matches!(kind, Failure::HungUp(_)) {
             ToolState::Unknown
         } else {
@@ -381,7 +417,10 @@ fn buffered(
             ),
             Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
-        let cts = link.clear_to_send();
+        let cts = match link.clear_to_send() {
+            Ok(c) => c,
+            Err(e) => return Err(fail(link, Failure::Cts(e.to_string()), sent, stopped)),
+        };
         if stopped || !cts {
             if last_progress.elapsed() > opts.timeout {
                 let op = if stopped {
@@ -530,6 +569,8 @@ enum Failure {
     Timeout(&'static str),
     HungUp(&'static str),
     Cancelled,
+    /// CTS could not be read (the message).
+    Cts(String),
 }
 
 impl Failure {
@@ -544,6 +585,12 @@ impl Failure {
             },
             Failure::HungUp(op) => StreamError::HungUp { port, op, at, tool },
             Failure::Cancelled => StreamError::Cancelled { port, at, tool },
+            Failure::Cts(message) => StreamError::Cts {
+                port,
+                message,
+                at,
+                tool,
+            },
         }
     }
 }
@@ -583,7 +630,8 @@ fn lift_hpgl(
                 }
             }
         }
-        if (stopped && link.flow == FlowControl::XonXoff) || !link.clear_to_send() {
+        if (stopped && link.flow == FlowControl::XonXoff) || !link.clear_to_send().unwrap_or(false)
+        {
             std::thread::sleep(Duration::from_millis(2));
             continue;
         }
@@ -595,7 +643,7 @@ fn lift_hpgl(
     if sent == cmd.len() && link.flush().is_ok() {
         ToolState::LiftQueued
     } else {
-        ToolState::Unknown
+        ToolState::NotTaken
     }
 }
 
@@ -1010,9 +1058,12 @@ impl<'a> Grbl<'a> {
 }
 /// Stream `program` through a pseudo-terminal into a new simulator set up by `cfg`, exactly
 /// as flatcut's transport streams to a real port (CTS read from the simulator's flag), then let
-/// the simulated machine work off what it holds, as a real one would: at most `finish_within`,
-/// and at most 30 s once the stream was cancelled (Ctrl-C). Returns the stream's outcome and
-/// the simulator's report; the report exists even when the stream failed.
+/// the simulated machine work off what it holds, as a real one would: while it makes progress,
+/// until it made none for `opts.timeout` (a stall: the stream then fails with a timeout), until
+/// Ctrl-C (`opts.cancel`, the stream then fails as cancelled), and at most `finish_within`.
+/// Returns the stream's outcome and the simulator's report; the report exists even when the
+/// stream failed. A failed HP-GL stream's position gives the bytes the simulated device
+/// executed (`Position::confirmed`).
 pub fn stream_job(
     cfg: SimConfig,
     program: &[u8],
@@ -1023,14 +1074,78 @@ pub fn stream_job(
     let handle = super::sim::spawn(cfg)?;
     let mut port =
         super::serial::open(&profile, &handle.path, None)?.with_virtual_cts(handle.cts.clone());
-    let sent = send(&mut port, &profile, program, opts);
+    let mut sent = send(&mut port, &profile, program, opts);
     let written = port.written;
     drop(port);
-    let wait = if opts.cancel.load(Ordering::SeqCst) {
-        finish_within.min(Duration::from_secs(30))
+    // Cancelled while sending: the tool-up is queued behind the buffer; let the device work
+    // it off (at most 30 s), as a real one would.
+    let stopped_early = opts.cancel.load(Ordering::SeqCst);
+    let unset = AtomicBool::new(false);
+    let (wait, cancel) = if stopped_early {
+        (finish_within.min(Duration::from_secs(30)), &unset)
     } else {
-        finish_within
+        (finish_within, &*opts.cancel)
     };
-    let report = handle.finish(written, wait)?;
+    let (report, end) = handle.finish_watching(written, opts.timeout, wait, cancel)?;
+    if profile.language == Language::Hpgl {
+        let executed = report
+            .bytes_received
+            .saturating_sub(report.unexecuted_bytes)
+            .min(program.len());
+        let starts = stroke_starts(program, profile.language);
+        let at = Position {
+            bytes: written.min(program.len()),
+            bytes_total: program.len(),
+            stroke: starts.partition_point(|&s| s < executed),
+            strokes_total: starts.len(),
+            confirmed: Some(executed),
+            ..Position::default()
+        };
+        let tool = if report.tool_down_at_end.is_some() {
+            ToolState::NotTaken
+        } else {
+            ToolState::Lifted
+        };
+        let port = handle_port_name(&report);
+        sent = match (sent, end) {
+            (Ok(_), Finish::Cancelled) => Err(StreamError::Cancelled { port, at, tool }),
+            (Ok(_), Finish::Idle) if executed < program.len() => Err(StreamError::Timeout {
+                port,
+                op: "waiting for the device to work off its buffer (it stopped making progress)",
+                secs: opts.timeout.as_secs_f64(),
+                at,
+                tool,
+            }),
+            (Err(mut e), _) => {
+                set_confirmed(&mut e, executed, at.stroke, tool);
+                Err(e)
+            }
+            (ok, _) => ok,
+        };
+    }
     Ok((sent, report))
+}
+
+/// The name the simulated device goes by in messages.
+fn handle_port_name(report: &SimReport) -> String {
+    format!("the simulated {}", report.device)
+}
+
+/// Put the device's own count of executed bytes (and what it did with the tool) into a failed
+/// stream's position.
+fn set_confirmed(e: &mut StreamError, executed: usize, stroke: usize, state: ToolState) {
+    match e {
+        StreamError::Timeout { at, tool, .. }
+        | StreamError::HungUp { at, tool, .. }
+        | StreamError::Cancelled { at, tool, .. }
+        | StreamError::Cts { at, tool, .. } => {
+            at.confirmed = Some(executed);
+            at.stroke = stroke;
+            // The simulator knows what became of the tool.
+            if state != ToolState::Lifted || *tool != ToolState::LiftQueued {
+                *tool = state;
+            }
+        }
+        _ => {}
+    }
 }

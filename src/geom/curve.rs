@@ -494,10 +494,11 @@ fn rect(c: DVec3, w: f64, h: f64, r: f64, tol: f64) -> Result<Vec<DVec3>, CurveE
 
 /// Points of a CSV file (see the module doc for the format).
 pub fn read_csv(path: &Path) -> Result<Vec<DVec3>, CurveError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CurveError::Io {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let text =
+        super::input::read_text(path, super::input::TEXT_LIMIT).map_err(|e| CurveError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     let mut out = Vec::new();
     let mut first = true;
     for (k, line) in text.lines().enumerate() {
@@ -520,7 +521,18 @@ pub fn read_csv(path: &Path) -> Result<Vec<DVec3>, CurveError> {
                 first = false;
                 continue; // a header
             }
-            Err(_) => return Err(err(format!("expected numbers `x,y[,z]`, got {t:?}"))),
+            Err(_) => {
+                // Name the field, never echo it: the file may not be a CSV at all.
+                let bad = fields
+                    .iter()
+                    .position(|s| s.parse::<f64>().is_err())
+                    .unwrap_or(0);
+                return Err(err(format!(
+                    "expected numbers `x,y[,z]`; field {} of {} is not a number",
+                    bad + 1,
+                    fields.len()
+                )));
+            }
             Ok(v) if v.len() == 2 || v.len() == 3 => {
                 if v.iter().any(|x| !x.is_finite()) {
                     return Err(err("a coordinate is not a finite number".into()));

@@ -12,6 +12,8 @@
 //! - [`unionfind`], [`heap`]: disjoint sets and a smallest-first heap entry.
 //! - [`rng`]: the crate's one seeded random number generator.
 //! - [`font`]: the single-stroke font for labels a pen or knife can draw.
+//! - [`input`]: reading a user's input file: a regular file under a size limit, UTF-8 with a
+//!   position.
 
 pub mod boolean;
 pub mod curve;
@@ -19,6 +21,7 @@ pub mod cut;
 pub mod font;
 pub mod heap;
 pub mod hull;
+pub mod input;
 pub mod mesh;
 pub mod obj;
 pub mod polygon;

@@ -281,7 +281,10 @@ pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
     use std::collections::BinaryHeap;
     let (lo, hi) = bounds(rings.first()?.iter().copied())?;
     let size = hi - lo;
-    let cell = size.min_element();
+    // polylabel's first grid has cells the size of the shorter side; at most `POLE_GRID`
+    // along the longer side, so a needle-thin ring costs no more than a square one.
+    const POLE_GRID: f64 = 4096.0;
+    let cell = size.min_element().max(size.max_element() / POLE_GRID);
     if cell.is_nan() || cell <= 0.0 || !cell.is_finite() {
         return None;
     }
@@ -318,14 +321,21 @@ pub fn pole(rings: &[Vec<DVec2>], precision: f64) -> Option<(DVec2, f64)> {
     };
     let mut heap = BinaryHeap::new();
     let h = 0.5 * cell;
+    // At most `POLE_GRID` + 1 steps a side: `x += cell` stalls where `cell` is below the
+    // spacing of floats at `x`.
+    let cap = POLE_GRID as usize + 1;
     let mut x = lo.x;
-    while x < hi.x {
+    let mut i = 0;
+    while x < hi.x && i < cap {
         let mut y = lo.y;
-        while y < hi.y {
+        let mut j = 0;
+        while y < hi.y && j < cap {
             heap.push(make(DVec2::new(x + h, y + h), h));
             y += cell;
+            j += 1;
         }
         x += cell;
+        i += 1;
     }
     // Start from the centroid of the outer ring, as polylabel does.
     let outer = &rings[0];

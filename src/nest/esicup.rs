@@ -78,10 +78,13 @@ impl Instance {
 
 /// Read and check an instance file.
 pub fn load(path: &Path) -> Result<Instance, EsicupError> {
-    let text = std::fs::read_to_string(path).map_err(|source| EsicupError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::geom::input::read_text(path, crate::geom::input::TEXT_LIMIT).map_err(|source| {
+            EsicupError::Read {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     parse(&text, path)
 }
 

@@ -147,11 +147,15 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     // Only when there is something, so that the report of a job that lost nothing stays as
     // it was.
     let mut warnings = info.warnings.clone();
-    warnings.extend(info.dropped.iter().map(|d| crate::toolpath::cuttable::Warning {
-        piece: d.name.clone(),
-        kind: "left-out",
-        message: format!("left out: {} ({})", d.describe(), d.reason),
-    }));
+    warnings.extend(
+        info.dropped
+            .iter()
+            .map(|d| crate::toolpath::cuttable::Warning {
+                piece: d.name.clone(),
+                kind: "left-out",
+                message: format!("left out: {} ({})", d.describe(), d.reason),
+            }),
+    );
     if !info.dropped.is_empty() {
         rep["dropped"] = json!(info.dropped);
     }

@@ -266,10 +266,11 @@ pub fn all() -> Result<Vec<Profile>, ProfileError> {
                 .collect();
             files.sort();
             for f in files {
-                let text = std::fs::read_to_string(&f).map_err(|e| ProfileError::Invalid {
-                    source_name: f.display().to_string(),
-                    message: e.to_string(),
-                })?;
+                let text = crate::geom::input::read_text(&f, crate::geom::input::TEXT_LIMIT)
+                    .map_err(|e| ProfileError::Invalid {
+                        source_name: f.display().to_string(),
+                        message: e.to_string(),
+                    })?;
                 let p = parse(&text, &f.display().to_string())?;
                 map.insert(p.name.clone(), p);
             }

@@ -15,11 +15,14 @@ pub fn parse(text: &str, source_name: &str) -> Result<Profile, ProfileError> {
         message,
     };
     let mut p: Profile = toml::from_str(text).map_err(|e| {
-        let line = e
-            .span()
-            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let at = e.span().map(|s| s.start.min(text.len()));
+        let line = at.map(|s| text[..s].matches('\n').count() + 1);
+        let key = at
+            .and_then(|s| key_at(text, s))
+            .map(|k| format!("`{k}` "))
+            .unwrap_or_default();
         invalid(format!(
-            "{}{}",
+            "{}{key}{}",
             line.map(|l| format!("line {l}: ")).unwrap_or_default(),
             e.message()
         ))
@@ -142,8 +145,12 @@ fn check(p: &Profile) -> Result<(), Problem> {
         ));
     }
     let s = &p.serial;
-    if s.baud == 0 {
-        return Err(problem("serial", "baud", "must be more than 0"));
+    if !(50..=4_000_000).contains(&s.baud) {
+        return Err(problem(
+            "serial",
+            "baud",
+            format!("must be a baud rate from 50 to 4000000, got {}", s.baud),
+        ));
     }
     if !(5..=8).contains(&s.data_bits) {
         return Err(problem(
@@ -190,6 +197,35 @@ fn check(p: &Profile) -> Result<(), Problem> {
         ));
     }
     Ok(())
+}
+
+/// The key (`table.key`) set on the line holding byte `at`, when that line reads `key = …`
+/// under a `[table]` header (or at the top level).
+fn key_at(text: &str, at: usize) -> Option<String> {
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next().unwrap_or("");
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim().trim_matches('"');
+    let bare = |s: &str| {
+        !s.is_empty()
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+    };
+    if !bare(key) {
+        return None;
+    }
+    let table = text[..start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find_map(|l| l.strip_prefix('[').and_then(|r| r.split(']').next()))
+        .map(|t| t.trim_start_matches('[').trim().to_string())
+        .unwrap_or_default();
+    Some(if table.is_empty() {
+        key.to_string()
+    } else {
+        format!("{table}.{key}")
+    })
 }
 
 /// Line (1-based) where `key` is set under `[table]` (`""`: top level), or where `[table]`

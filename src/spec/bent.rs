@@ -26,7 +26,7 @@
 //! `pieces`), where errors about the geometry point; the sheet is named `sheet[K]` after its
 //! entry when it has no `name`.
 
-use super::context::{Ctx, MM_POSITIVE, NON_EMPTY};
+use super::context::{Ctx, MM_POSITIVE};
 use super::names::{one_of, pick};
 use super::spanned::{span, RawSurface};
 use super::SpecError;
@@ -328,7 +328,7 @@ impl Ctx<'_> {
             None => self.bent_top_piece(s, key, header_line, dir)?,
         };
         let name = self
-            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .file_name(&s.name, &format!("{key}.name"))?
             .unwrap_or_else(|| format!("sheet{}", key.trim_start_matches("surface")));
         Ok(SurfaceSpec {
             kind: SurfaceKind::BentSheet,

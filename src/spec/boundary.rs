@@ -10,7 +10,7 @@
 //! B-spline through the points and cannot be combined with darts or rulings, which name
 //! points; loop, point and dart numbers are counted from 1 in the file and 0-based inside.
 
-use super::context::{Ctx, MM_POSITIVE, NON_EMPTY};
+use super::context::{Ctx, MM_POSITIVE};
 use super::spanned::{span, RawSurface};
 use super::SpecError;
 use crate::surface::boundary::{self, BoundaryError, Dart, Input, Options};
@@ -84,7 +84,7 @@ impl Ctx<'_> {
             return Err(self.invalid(line, &k, e.to_string()));
         }
         let name = self
-            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .file_name(&s.name, &format!("{key}.name"))?
             .unwrap_or_else(|| format!("boundary{}", key.trim_start_matches("surface")));
         Ok(SurfaceSpec {
             kind: SurfaceKind::Boundary,

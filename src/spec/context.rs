@@ -144,6 +144,18 @@ impl Ctx<'_> {
         }
     }
 
+    /// A name that becomes part of file names: a plain file name
+    /// ([`crate::output::files::check_file_name`]), so a run writes inside its folder.
+    pub(super) fn file_name(&self, v: &Opt, key: &str) -> Result<Option<String>, SpecError> {
+        let s = self.string(v, key, NON_EMPTY)?;
+        if let (Some(s), Some(v)) = (&s, v) {
+            if let Err(m) = crate::output::files::check_file_name(s) {
+                return Err(self.invalid(self.line(v.span()), key, m));
+            }
+        }
+        Ok(s)
+    }
+
     pub(super) fn boolean(&self, v: &Opt, key: &str) -> Result<Option<bool>, SpecError> {
         let Some(v) = v else { return Ok(None) };
         match v.get_ref() {

@@ -19,7 +19,7 @@
 //! Choices: a mesh's name defaults to its file's stem; `approximate` is checked key by key
 //! (`iterations` 1 to 100, `fixed` entries "boundary" or a vertex number from 1).
 
-use super::context::{Ctx, NON_EMPTY};
+use super::context::Ctx;
 use super::spanned::RawSurface;
 use super::{stem_or, SpecError};
 use crate::surface::{
@@ -69,7 +69,7 @@ impl Ctx<'_> {
             .choice(&s.units, &format!("{key}.units"), &Units::NAMES)?
             .unwrap_or_default();
         let name = self
-            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .file_name(&s.name, &format!("{key}.name"))?
             .unwrap_or_else(|| stem_or(&path, key));
         Ok(SurfaceSpec {
             kind,

@@ -169,7 +169,7 @@ pub use crate::surface::{
 pub use context::SpecError;
 
 use crate::pattern::PatternOptions;
-use context::{Ctx, Opt, MM_NON_NEGATIVE, MM_POSITIVE, NON_EMPTY};
+use context::{Ctx, Opt, MM_NON_NEGATIVE, MM_POSITIVE};
 use names::one_of;
 use spanned::{fmt_num, List, RawMaterial, RawPattern, RawSheet, RawSpec, RawSurface, Tab};
 use std::path::{Path, PathBuf};
@@ -338,10 +338,13 @@ pub fn load(path: &Path) -> Result<Spec, SpecError> {
     if crate::surface::import::is_mesh_path(path) {
         return Ok(Spec::from_mesh(path));
     }
-    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::geom::input::read_text(path, crate::geom::input::TEXT_LIMIT).map_err(|source| {
+            SpecError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     parse(&text, path)
 }
 
@@ -356,7 +359,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
 impl Ctx<'_> {
     fn build(&self, raw: RawSpec) -> Result<Spec, SpecError> {
         let name = self
-            .string(&raw.name, "name", NON_EMPTY)?
+            .file_name(&raw.name, "name")?
             .unwrap_or_else(|| stem_or(self.path, "pattern"));
         let device = self.string(&raw.device, "device", "a non-empty device profile name")?;
 

@@ -9,7 +9,7 @@
 //! factor are kept for [`crate::surface::SurfaceSpec::for_material`], since the material (and
 //! the flags that may change it) is known only later.
 
-use super::context::{Ctx, MM_POSITIVE, NON_EMPTY};
+use super::context::{Ctx, MM_POSITIVE};
 use super::spanned::{span, RawSurface};
 use super::SpecError;
 use crate::surface::{SegmentSpec, SheetSide, StripSpec, SurfaceKind, SurfaceSpec, Units};
@@ -95,7 +95,7 @@ impl Ctx<'_> {
             return Err(self.invalid(q_line, &format!("{key}.q"), e.to_string()));
         }
         let name = self
-            .string(&s.name, &format!("{key}.name"), NON_EMPTY)?
+            .file_name(&s.name, &format!("{key}.name"))?
             .unwrap_or_else(|| format!("strip{}", key.trim_start_matches("surface")));
         Ok(SurfaceSpec {
             kind: SurfaceKind::Strip,

@@ -45,10 +45,13 @@ fn parse_err(path: &Path, line: Option<usize>, message: impl Into<String>) -> Su
 
 /// Parse an OBJ file.
 pub fn read(path: &Path) -> Result<RawMesh, SurfaceError> {
-    let bytes = std::fs::read(path).map_err(|source| SurfaceError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes =
+        crate::geom::input::read_bytes(path, crate::geom::input::DATA_LIMIT).map_err(|source| {
+            SurfaceError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     let text = String::from_utf8(bytes).map_err(|_| {
         parse_err(
             path,
@@ -133,6 +136,21 @@ fn prescan(text: &str, path: &Path) -> Result<Vec<usize>, SurfaceError> {
                             ))
                         }
                     }
+                }
+                // tobj takes `x y z`, `x y z w` (w not 0) or `x y z r g b`.
+                let extra_ok = coords[3..]
+                    .iter()
+                    .all(|c| c.parse::<f64>().is_ok_and(f64::is_finite))
+                    && (coords.len() != 4 || coords[3].parse::<f64>().is_ok_and(|w| w != 0.0));
+                if !matches!(coords.len(), 3 | 4 | 6) || !extra_ok {
+                    return Err(parse_err(
+                        path,
+                        Some(line_no),
+                        format!(
+                            "vertex has {} numbers; a vertex is `v x y z`, `v x y z w` (w not 0) or `v x y z r g b`",
+                            coords.len()
+                        ),
+                    ));
                 }
                 n_vertices += 1;
             }

@@ -195,40 +195,80 @@ impl Grid {
         k: usize,
         mut keep: impl FnMut(usize) -> bool,
     ) -> Vec<(f64, usize)> {
+        // Clamped so that ring arithmetic cannot overflow for a far pen; a cell index moved
+        // towards the grid only lowers the ring of every point, so the bound below stays true.
+        const FAR: i64 = 1 << 40;
         let c = self.key(p);
+        let c = (c.0.clamp(-FAR, FAR), c.1.clamp(-FAR, FAR));
         let max_r =
             (c.0.abs().max((c.0 - self.nx).abs())).max(c.1.abs().max((c.1 - self.ny).abs())) + 1;
         let mut best: Vec<(f64, usize)> = Vec::new();
-        for r in 0..=max_r {
+        let mut offer = |i: usize, best: &mut Vec<(f64, usize)>| {
+            if !keep(i) {
+                return;
+            }
+            let d = p.distance(points[i]);
+            if best.len() < k || (d, i) < best[k - 1] {
+                let at = best.partition_point(|&b| b < (d, i));
+                best.insert(at, (d, i));
+                best.truncate(k);
+            }
+        };
+        // Rings nearer than the grid's own cells are empty: start at the first that meets it.
+        let gap = |v: i64, hi: i64| (-v).max(v - hi).max(0);
+        let first = gap(c.0, self.nx).max(gap(c.1, self.ny));
+        // A bound that does not depend on the coordinates: once the rings have looked at as
+        // many cells as there are points, a plain scan of the points is cheaper.
+        let mut looked = 0usize;
+        for r in first..=max_r {
             if best.len() >= k {
                 // Every point in ring r is at least (r - 1) cells away.
                 if best[k - 1].0 < (r - 1) as f64 * self.cell {
                     break;
                 }
             }
-            for x in c.0 - r..=c.0 + r {
-                for y in c.1 - r..=c.1 + r {
-                    if (x - c.0).abs() != r && (y - c.1).abs() != r {
-                        continue;
-                    }
-                    let Some(list) = self.cells.get(&(x, y)) else {
-                        continue;
-                    };
+            let cells = self.ring(c, r);
+            looked += cells.len();
+            if looked > points.len() + 64 {
+                best.clear();
+                for i in 0..points.len() {
+                    offer(i, &mut best);
+                }
+                return best;
+            }
+            for key in cells {
+                if let Some(list) = self.cells.get(&key) {
                     for &i in list {
-                        if !keep(i) {
-                            continue;
-                        }
-                        let d = p.distance(points[i]);
-                        if best.len() < k || (d, i) < best[k - 1] {
-                            let at = best.partition_point(|&b| b < (d, i));
-                            best.insert(at, (d, i));
-                            best.truncate(k);
-                        }
+                        offer(i, &mut best);
                     }
                 }
             }
         }
         best
+    }
+
+    /// The cells of ring `r` around `c` (Chebyshev distance `r`) that lie on the grid.
+    fn ring(&self, c: (i64, i64), r: i64) -> Vec<(i64, i64)> {
+        let (x0, x1) = ((c.0 - r).max(0), (c.0 + r).min(self.nx));
+        let (y0, y1) = ((c.1 - r).max(0), (c.1 + r).min(self.ny));
+        let mut out = Vec::new();
+        if x0 > x1 || y0 > y1 {
+            return out;
+        }
+        for y in [c.1 - r, c.1 + r] {
+            if (0..=self.ny).contains(&y) {
+                out.extend((x0..=x1).map(|x| (x, y)));
+            }
+            if r == 0 {
+                return out;
+            }
+        }
+        for x in [c.0 - r, c.0 + r] {
+            if (0..=self.nx).contains(&x) {
+                out.extend(((c.1 - r + 1).max(0)..=(c.1 + r - 1).min(self.ny)).map(|y| (x, y)));
+            }
+        }
+        out
     }
 }
 

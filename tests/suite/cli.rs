@@ -54,12 +54,15 @@ fn every_pattern_cuts_with_hpgl_pens_dry_run() {
         }
         let plt = std::fs::read_to_string(out.join(format!("{name}.plt"))).unwrap();
         assert!(plt.starts_with("IN;") && plt.trim_end().ends_with("PU;SP0;"));
-        // No partial files left behind.
+        // No partial files left behind (the run's manifest is the one hidden file).
         let leftovers = std::fs::read_dir(&out)
             .unwrap()
             .filter(|e| {
                 e.as_ref()
-                    .map(|e| e.file_name().to_string_lossy().starts_with('.'))
+                    .map(|e| {
+                        let n = e.file_name().to_string_lossy().into_owned();
+                        n.starts_with('.') && n != flatcut::output::files::MANIFEST
+                    })
                     .unwrap_or(false)
             })
             .count();

@@ -8,7 +8,9 @@
 //! spaces, read by the crate's one HP-GL lexer (`output::hpgl::read`); `PU`/`PD` take
 //! coordinate pairs, absolute after `PA` (the default after `IN`), relative after `PR`.
 //! Roland's `!`-prefixed instructions (`!PZ`, `!ST`, …) are named with their three characters.
-//! A stray odd coordinate is ignored, as a plotter does.
+//! A stray odd coordinate is ignored, as a plotter does. A move to a point outside HP-GL's
+//! coordinate range (±2^30 plotter units, HP 7475A manual ch. 14, error 3 "parameter out of
+//! range") is ignored whole and counted as `XX (out of range)`.
 //!
 //! Motion time: pen-down moves at the `VS` speed (cm/s; the profile's tool speed when the
 //! program sets none), pen-up moves at [`TRAVEL_CM_S`]. This is what paces the simulated
@@ -19,6 +21,9 @@ use crate::output::hpgl::read::{instruction, numbers};
 use crate::profile::Profile;
 use glam::DVec2;
 use std::collections::BTreeMap;
+
+/// Largest plotter coordinate, either sign (HP-GL: −2^30 … 2^30 − 1).
+pub const RANGE: f64 = 1_073_741_823.0;
 
 /// Pen-up speed, cm/s.
 pub(crate) const TRAVEL_CM_S: f64 = 50.0;
@@ -165,6 +170,13 @@ impl Hpgl {
                 .or_default() += 1;
             return 0.0;
         };
+        if matches!(op.as_str(), "PU" | "PD" | "PA" | "PR") && !self.in_range(&op, &nums) {
+            *self
+                .ignored
+                .entry(format!("{op} (out of range)"))
+                .or_default() += 1;
+            return 0.0;
+        }
         self.instructions += 1;
         match op.as_str() {
             "IN" | "DF" => {
@@ -215,6 +227,29 @@ impl Hpgl {
                 0.0
             }
         }
+    }
+
+    /// Whether every point a move instruction goes to is within [`RANGE`].
+    fn in_range(&self, op: &str, nums: &[f64]) -> bool {
+        let relative = match op {
+            "PA" => false,
+            "PR" => true,
+            _ => self.relative,
+        };
+        let mut at = self.pos;
+        for xy in nums.chunks_exact(2) {
+            let v = DVec2::new(xy[0], xy[1]);
+            at = if relative { at + v } else { v };
+            if !(at.x.abs() <= RANGE && at.y.abs() <= RANGE) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Whether the pen is down (whatever tool it holds).
+    pub fn pen_down(&self) -> bool {
+        self.down
     }
 
     fn current_tool(&self) -> Option<&str> {

@@ -179,7 +179,20 @@ pub struct SimHandle {
     violations: Arc<AtomicUsize>,
     /// Bytes received so far.
     received: Arc<AtomicUsize>,
+    /// Ticks of the device's loop in which it received, executed or moved.
+    progress: Arc<AtomicUsize>,
     thread: Option<JoinHandle<SimReport>>,
+}
+
+/// How [`SimHandle::finish_watching`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Finish {
+    /// The device worked off everything it held.
+    Done,
+    /// It made no progress (took no byte, executed nothing, did not move) for the idle time.
+    Idle,
+    /// The cancel flag (Ctrl-C) was raised.
+    Cancelled,
 }
 
 impl SimHandle {
@@ -198,6 +211,47 @@ impl SimHandle {
         }
         self.ctl.store(STOP, Ordering::SeqCst);
         t.join().map_err(|_| SimError::Thread)
+    }
+
+    /// [`SimHandle::finish`] as a host waits on a machine: as long as the device makes
+    /// progress (a busy machine is not a stopped one), until it made none for `idle`, or until
+    /// `cancel` is raised (Ctrl-C); then stop it.
+    /// `within` caps the whole wait (then it ends as [`Finish::Idle`]).
+    pub fn finish_watching(
+        mut self,
+        bytes_sent: usize,
+        idle: Duration,
+        within: Duration,
+        cancel: &AtomicBool,
+    ) -> Result<(SimReport, Finish), SimError> {
+        let deadline = Instant::now().checked_add(within);
+        self.expect.store(bytes_sent, Ordering::SeqCst);
+        self.ctl.store(FINISH, Ordering::SeqCst);
+        let t = self.thread.take().ok_or(SimError::Thread)?;
+        let mut seen = self.progress.load(Ordering::SeqCst);
+        let mut last = Instant::now();
+        let end = loop {
+            if t.is_finished() {
+                break Finish::Done;
+            }
+            if cancel.load(Ordering::SeqCst) {
+                break Finish::Cancelled;
+            }
+            let now = self.progress.load(Ordering::SeqCst);
+            if now != seen {
+                seen = now;
+                last = Instant::now();
+            } else if last.elapsed() > idle {
+                break Finish::Idle;
+            }
+            if deadline.is_some_and(|d| Instant::now() > d) {
+                break Finish::Idle;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        self.ctl.store(STOP, Ordering::SeqCst);
+        let rep = t.join().map_err(|_| SimError::Thread)?;
+        Ok((rep, end))
     }
 
     /// Wait until the device has counted a buffer overrun or a flow-control violation, or
@@ -253,11 +307,12 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let expect = Arc::new(AtomicUsize::new(0));
     let violations = Arc::new(AtomicUsize::new(0));
     let received = Arc::new(AtomicUsize::new(0));
+    let progress = Arc::new(AtomicUsize::new(0));
     let (c2, k2, e2, v2) = (cts.clone(), ctl.clone(), expect.clone(), violations.clone());
-    let r2 = received.clone();
+    let (r2, p2) = (received.clone(), progress.clone());
     let thread = std::thread::Builder::new()
         .name("flatcut-sim".into())
-        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2, r2)).run())
+        .spawn(move || Device::new(cfg, master, slave, c2, k2, (e2, v2, r2, p2)).run())
         .map_err(|e| SimError::Pty(e.to_string()))?;
     Ok(SimHandle {
         path,
@@ -266,6 +321,7 @@ pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
         expect,
         violations,
         received,
+        progress,
         thread: Some(thread),
     })
 }
@@ -330,6 +386,7 @@ struct Device {
     expect: Arc<AtomicUsize>,
     violations: Arc<AtomicUsize>,
     received: Arc<AtomicUsize>,
+    progress: Arc<AtomicUsize>,
     interp: Interp,
     rx: VecDeque<u8>,
     cap: usize,
@@ -362,7 +419,12 @@ impl Device {
         slave: serialport::TTYPort,
         cts: Arc<AtomicBool>,
         ctl: Arc<AtomicU8>,
-        (expect, violations, received): (Arc<AtomicUsize>, Arc<AtomicUsize>, Arc<AtomicUsize>),
+        (expect, violations, received, progress): (
+            Arc<AtomicUsize>,
+            Arc<AtomicUsize>,
+            Arc<AtomicUsize>,
+            Arc<AtomicUsize>,
+        ),
     ) -> Device {
         let p = &cfg.profile;
         let grbl = p.language == Language::Gcode;
@@ -395,6 +457,7 @@ impl Device {
             expect,
             violations,
             received,
+            progress,
             interp,
             rx: VecDeque::with_capacity(cap),
             cap,
@@ -532,6 +595,9 @@ impl Device {
             self.received
                 .store(self.rep.bytes_received, Ordering::SeqCst);
             let busy = n > 0 || !self.tx.is_empty() || (!self.stalled && self.has_complete_input());
+            if n > 0 || (!self.stalled && (!self.motion.is_empty() || self.has_complete_input())) {
+                self.progress.fetch_add(1, Ordering::Relaxed);
+            }
             std::thread::sleep(Duration::from_micros(if busy { 100 } else { 300 }));
         }
         self.close()
@@ -884,8 +950,8 @@ pub(crate) fn write_outputs(
     let png = crate::output::png::render(&sheet, 0, px)?;
     let png_path = dir.join(format!("{stem}.png"));
     let json_path = dir.join(format!("{stem}.json"));
-    crate::output::files::write_atomic(&png_path, &png)?;
+    crate::output::files::write_in_run(dir, &format!("{stem}.png"), &png)?;
     let text = serde_json::to_string_pretty(rep).unwrap_or_default() + "\n";
-    crate::output::files::write_atomic(&json_path, text.as_bytes())?;
+    crate::output::files::write_in_run(dir, &format!("{stem}.json"), text.as_bytes())?;
     Ok((png_path, json_path))
 }

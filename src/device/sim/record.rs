@@ -40,6 +40,8 @@ impl SimPath {
 
 /// Heading change of the blade tip (degrees) after which the recorder keeps a point.
 pub(crate) const HEADING_TOL_DEG: f64 = 0.5;
+/// Drag-knife simulation steps in one move at most (1e6 steps of r / 50: 5 m at r = 0.25 mm).
+const MAX_DRAG_STEPS: f64 = 1e6;
 
 /// A trailing blade (see the module documentation).
 #[derive(Debug, Clone, Default)]
@@ -177,7 +179,9 @@ impl Recorder {
         let Some(d) = self.drag.as_ref() else { return };
         let r = d.r;
         let len = from.distance(to);
-        let steps = ((len / (r / 50.0)).ceil() as usize).max(1);
+        // Steps of r / 50, at most `MAX_DRAG_STEPS` per move (a move longer than that many
+        // steps is straight long before its end, where the step size no longer matters).
+        let steps = ((len / (r / 50.0)).ceil().min(MAX_DRAG_STEPS) as usize).max(1);
         let cos_tol = HEADING_TOL_DEG.to_radians().cos();
         for k in 1..=steps {
             let h = from + (to - from) * (k as f64 / steps as f64);

@@ -11,7 +11,10 @@
 //! items fill the first bin they fit in, opening a new one when none has room.
 //!
 //! Choices: the candidates come from bounding boxes (not no-fit polygons), which puts
-//! rectangles exactly edge to edge; the slide keeps only positions tested free.
+//! rectangles exactly edge to edge; the slide keeps only positions tested free. The scan of one
+//! shape is bounded by a count of box tests (`SCAN_BUDGET`), not by the coordinates: past it,
+//! the shape goes right of everything placed (always free), so thousands of tiny pieces cost
+//! O(n) each instead of O(n²) candidates.
 
 use super::state::{Ctx, State};
 use crate::nest::collision::{boxes_near, collide, Placed, Shape};
@@ -54,6 +57,10 @@ fn slide(
     pos + dir * lo
 }
 
+/// Box tests one shape's bottom-left scan may make before it takes the free place right of
+/// everything placed.
+const SCAN_BUDGET: usize = 50_000;
+
 /// Bottom-left position of one shape among `others` in a container of `height` and at most
 /// `max_len` long; only positions whose right end is left of `bound` count.
 fn bottom_left(
@@ -63,6 +70,7 @@ fn bottom_left(
     height: f64,
     max_len: f64,
     bound: f64,
+    exhausted: &mut bool,
 ) -> Option<DVec2> {
     let s = ctx.prob.spacing;
     let (w, h) = (shape.size.x, shape.size.y);
@@ -83,16 +91,25 @@ fn bottom_left(
         .collect();
     ys.sort_by(f64::total_cmp);
     ys.dedup();
-    for x in xs {
+    let mut work = 0usize;
+    'columns: for x in xs {
         if x + w >= bound {
             break;
         }
+        if work > SCAN_BUDGET {
+            break 'columns;
+        }
+        work += others.len();
         // Items that can meet the shape anywhere in this column.
         let col: Vec<&Placed> = others
             .iter()
             .filter(|o| o.pos.x < x + w + s && o.hi().x + s > x)
             .collect();
         for &y in &ys {
+            work += 1 + col.len();
+            if work > SCAN_BUDGET {
+                break 'columns;
+            }
             let pos = DVec2::new(x, y);
             let near: Vec<&Placed> = col
                 .iter()
@@ -111,17 +128,30 @@ fn bottom_left(
             return Some(p);
         }
     }
-    None
+    if work <= SCAN_BUDGET {
+        return None;
+    }
+    // Out of budget: right of everything placed (and the spacing) is free.
+    *exhausted = true;
+    let x = others.iter().map(|o| o.hi().x + s).fold(0.0, f64::max);
+    (x + w <= max_len + 1e-9 && x + w < bound).then_some(DVec2::new(x, 0.0))
 }
 
 /// Best bottom-left placement over the item's construction shapes.
-fn place_item(ctx: &mut Ctx, item: usize, others: &[Placed], max_len: f64) -> Option<Placed> {
+/// `exhausted` is set when a scan ran out of its budget.
+fn place_item(
+    ctx: &mut Ctx,
+    item: usize,
+    others: &[Placed],
+    max_len: f64,
+    exhausted: &mut bool,
+) -> Option<Placed> {
     let height = ctx.prob.container.height();
     let shapes = ctx.prob.items[item].shapes.clone();
     let mut best: Option<Placed> = None;
     for sh in &shapes {
         let bound = best.as_ref().map_or(f64::INFINITY, |b| b.hi().x + 1e-9);
-        if let Some(p) = bottom_left(ctx, sh, others, height, max_len, bound) {
+        if let Some(p) = bottom_left(ctx, sh, others, height, max_len, bound, exhausted) {
             let cand = Placed {
                 shape: sh.clone(),
                 pos: p,
@@ -145,7 +175,7 @@ fn place_item(ctx: &mut Ctx, item: usize, others: &[Placed], max_len: f64) -> Op
 pub(crate) fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
     let mut st = State::default();
     for &i in order {
-        let p = place_item(ctx, i, &st.placed, f64::INFINITY)?;
+        let p = place_item(ctx, i, &st.placed, f64::INFINITY, &mut false)?;
         st.items.push(i);
         st.placed.push(p);
     }
@@ -156,10 +186,23 @@ pub(crate) fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
 pub(crate) fn fill_bins(ctx: &mut Ctx, order: &[usize], max_len: f64) -> Option<Vec<State>> {
     debug_assert!(matches!(ctx.prob.container, Container::Bins { .. }));
     let mut bins: Vec<State> = Vec::new();
+    // Area used in each bin: an item larger than what is left cannot fit, so its scan is
+    // skipped. A bin where a scan ran out of budget and found no room is closed.
+    let room = max_len * ctx.prob.container.height();
+    let mut used: Vec<f64> = Vec::new();
+    let mut closed: Vec<bool> = Vec::new();
     for &i in order {
         let mut done = false;
-        for b in bins.iter_mut() {
-            if let Some(p) = place_item(ctx, i, &b.placed, max_len) {
+        let area = ctx.prob.items[i].area.max(0.0);
+        for (k, b) in bins.iter_mut().enumerate() {
+            if closed[k] || used[k] + area > room * (1.0 + 1e-9) {
+                continue;
+            }
+            let mut exhausted = false;
+            let placed = place_item(ctx, i, &b.placed, max_len, &mut exhausted);
+            closed[k] = placed.is_none() && exhausted;
+            if let Some(p) = placed {
+                used[k] += area;
                 b.items.push(i);
                 b.placed.push(p);
                 done = true;
@@ -167,7 +210,9 @@ pub(crate) fn fill_bins(ctx: &mut Ctx, order: &[usize], max_len: f64) -> Option<
             }
         }
         if !done {
-            let p = place_item(ctx, i, &[], max_len)?;
+            let p = place_item(ctx, i, &[], max_len, &mut false)?;
+            used.push(area);
+            closed.push(false);
             bins.push(State {
                 items: vec![i],
                 placed: vec![p],

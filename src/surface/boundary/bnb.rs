@@ -13,6 +13,10 @@
 //! A hull without any valid chart makes each of its triangles a chart (the pathological case).
 //!
 //! [`Search::dive`] completes a cover depth first when the iterations run out.
+//!
+//! Memory: at most `QUEUE_MAX` covers wait in the queue; past that the one with the worst
+//! potential is dropped (the paper's iteration bound alone leaves the queue unbounded, since
+//! one iteration may queue a cover per chart of every subloop).
 
 use super::darts::sites_valid;
 use super::figures::{angle, unit_normal};
@@ -21,6 +25,9 @@ use super::{Options, Quality};
 use glam::DVec3;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::rc::Rc;
+
+/// Covers queued at most (see the module doc).
+const QUEUE_MAX: usize = 1 << 16;
 
 pub(super) struct Run {
     pub(super) best: Option<(Vec<[usize; 3]>, Quality)>,
@@ -271,6 +278,9 @@ impl<'a> Search<'a> {
                         },
                         (n, nq),
                     );
+                    if queue.len() > QUEUE_MAX {
+                        queue.pop_last();
+                    }
                 }
             }
         }

@@ -18,6 +18,7 @@
 //! - `charts`: §3 charts, envelopes and subloops of a subloop's hull (cached).
 //! - `bounds`: §5.1.1 cover quality, the lower bound that prunes the search.
 //! - `figures`: §4 metrics of a finished triangulation and the output mesh.
+//! - `planar`: a planar loop, which needs no search (the flat polygon it bounds).
 //!
 //! # Choices where the paper is silent
 //!
@@ -42,6 +43,7 @@ mod checks;
 mod darts;
 mod figures;
 mod loops;
+mod planar;
 mod search;
 
 use crate::geom::mesh::Mesh;
@@ -208,6 +210,10 @@ pub fn check(input: &Input) -> Result<(), BoundaryError> {
 pub fn triangulate(input: &Input, opts: &Options) -> Result<Output, BoundaryError> {
     let t0 = Instant::now();
     let prep = prepare(input, opts, false)?;
+    if let Some(mut out) = planar::planar(input, &prep) {
+        out.figures.seconds = t0.elapsed().as_secs_f64();
+        return Ok(out);
+    }
     let relaxed = |o: &Output| o.warnings.iter().any(|w| w.starts_with(RELAXED));
     let (out, ok) = search(prep, opts, t0);
     if ok && (input.darts.is_empty() || !relaxed(&out)) {
