@@ -224,7 +224,9 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     let mean = lengths.iter().sum::<f64>() / ne.max(1) as f64;
+    // Coincidence of a cut edge's copies; overlap is exact (rounding only).
     let eps = opts.tolerance.min(0.01 * mean);
+    let overlap_eps = super::overlap::exact_eps(mean);
 
     // Grid cell: a little over the typical face size.
     let mut sizes: Vec<f64> = pos
@@ -249,7 +251,7 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         stamp: vec![0; nf],
         round: 0,
         moved: Vec::new(),
-        eps,
+        eps: overlap_eps,
         pos,
         tris,
     };

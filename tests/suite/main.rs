@@ -15,6 +15,7 @@ mod fandisk;
 mod house;
 mod knife;
 mod nest;
+mod overlap;
 mod param;
 mod pattern;
 mod simplify;
