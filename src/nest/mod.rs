@@ -265,6 +265,25 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
     }
 }
 
+/// What is cut of a piece, as the nest places it: the outline, grown to hold any stroke
+/// outside it ([`reach::nested_rings`]); an error when it has no usable outline.
+fn nested(piece: &Piece) -> Result<Vec<Vec<DVec2>>, NestError> {
+    let bad = || NestError::BadOutline {
+        piece: piece.name.clone(),
+    };
+    if piece.outline.first().is_none_or(|r| r.len() < 3) {
+        return Err(bad());
+    }
+    let rings = reach::nested_rings(piece);
+    if rings.is_empty()
+        || polygon::signed_area(&rings[0]).abs() <= 0.0
+        || rings.iter().flatten().any(|p| !p.is_finite())
+    {
+        return Err(bad());
+    }
+    Ok(rings)
+}
+
 /// Place every piece.
 pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError> {
     let m = opts.margin;
@@ -283,21 +302,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
     let to_internal = |deg: f64| if roll { deg - 90.0 } else { deg };
     let mut items = Vec::with_capacity(pieces.len());
     for piece in &pieces {
-        if piece.outline.first().is_none_or(|r| r.len() < 3) {
-            return Err(NestError::BadOutline {
-                piece: piece.name.clone(),
-            });
-        }
-        // What is cut: the outline, grown to hold any stroke outside it.
-        let rings = reach::nested_rings(piece);
-        if rings.is_empty()
-            || polygon::signed_area(&rings[0]).abs() <= 0.0
-            || rings.iter().flatten().any(|p| !p.is_finite())
-        {
-            return Err(NestError::BadOutline {
-                piece: piece.name.clone(),
-            });
-        }
+        let rings = nested(piece)?;
         let orients = match piece_orients(piece, opts) {
             Orients::Set(v) => Orients::Set(
                 v.into_iter()

@@ -21,7 +21,8 @@
 //!
 //! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
 //! material's tolerance"), a chart
-//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap) has
+//! - whose layout overlaps itself (two faces whose interiors intersect, by any depth above
+//!   rounding: [`crate::flatten::overlap`]; a global overlap) has
 //!   the overlapping region cut off (`cut_off`, after Lévy et al. 2002, the thesis' ref. 22:
 //!   the overlapping faces are sorted to the nearer of the two first found overlapping, the
 //!   side with less overlapping area is cut off, again while the rest still overlaps) when
@@ -38,7 +39,10 @@
 //!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
 //!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
 //!
-//! and is split along the bisector of its two most distant faces
+//! (a chart that overlaps itself and that none of these separates is halved, down to single
+//! faces; and once every chart is laid, any piece that still overlaps itself is split apart and
+//! laid again, so that no output piece overlaps itself), and is split along the bisector of
+//! its two most distant faces
 //! (`bisect` of [`crate::geom::cut`]) when
 //! - it has a flipped triangle,
 //! - the parameteriser refuses it (no cut makes it a disk),
