@@ -143,8 +143,8 @@ impl Triangles {
             let c = entries[s].0;
             for p in s..e {
                 let i = entries[p].1 as usize;
-                for q in p + 1..e {
-                    let j = entries[q].1 as usize;
+                for &(_, j) in &entries[p + 1..e] {
+                    let j = j as usize;
                     let (a, b) = (self.owner[i], self.owner[j]);
                     if a == b {
                         continue;

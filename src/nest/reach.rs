@@ -45,7 +45,7 @@ impl Rows {
     /// Even-odd containment (as [`polygon::contains`]).
     fn contains(&self, p: DVec2) -> bool {
         let k = (p.y - self.lo) / self.h;
-        if !(k >= 0.0) || k as usize >= self.rows.len() + 1 {
+        if k.is_nan() || k < 0.0 || k as usize > self.rows.len() {
             return false;
         }
         let row = &self.rows[(k as usize).min(self.rows.len() - 1)];
@@ -134,7 +134,7 @@ pub fn nested_rings(piece: &Piece) -> Vec<Vec<DVec2>> {
     // Nothing held them: the outline's convex hull with every point, grown.
     let pts: Vec<DVec2> = piece.points().filter(|p| p.is_finite()).collect();
     let hull = polygon::convex_hull(&pts);
-    boolean::offset(&[hull.clone()], 1e-6)
+    boolean::offset(std::slice::from_ref(&hull), 1e-6)
         .into_iter()
         .next()
         .unwrap_or_else(|| vec![hull])

@@ -139,6 +139,7 @@ fn mushroom_faces_unscaled_left_the_sheet() {
 /// boundary triangulated (136 r² triangles), smoothed by `smooth` rounds of Laplacian
 /// averaging, about `size` across.
 pub fn genus3(r: usize, smooth: usize, size: f64) -> String {
+    type P = (i64, i64, i64);
     let (nx, ny, nz) = (7 * r, 3 * r, r);
     let solid = |x: i64, y: i64, z: i64| {
         if x < 0 || y < 0 || z < 0 || x >= nx as i64 || y >= ny as i64 || z >= nz as i64 {
@@ -163,7 +164,7 @@ pub fn genus3(r: usize, smooth: usize, size: f64) -> String {
                     continue;
                 }
                 // Each open side: a quad, counter-clockwise seen from outside.
-                let sides: [((i64, i64, i64), [(i64, i64, i64); 4]); 6] = [
+                let sides: [(P, [P; 4]); 6] = [
                     ((1, 0, 0), [(1, 0, 0), (1, 1, 0), (1, 1, 1), (1, 0, 1)]),
                     ((-1, 0, 0), [(0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0)]),
                     ((0, 1, 0), [(0, 1, 0), (0, 1, 1), (1, 1, 1), (1, 1, 0)]),
