@@ -451,7 +451,7 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
         let s = &layout.sheets[at.sheet];
         for q in p.points().map(|q| at.apply(q)) {
             // What was nested holds every point (`reach`): only rounding is let through.
-            let tol = 1e-6;
+            let tol = reach::SLACK_MM;
             if q.x < m - tol || q.y < m - tol || q.x > s.width - m + tol || q.y > s.height - m + tol
             {
                 return Err(format!(

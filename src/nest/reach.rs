@@ -6,13 +6,18 @@
 //! keeps hold for every stroke, and [`super::verify`] checks exactly what was nested.
 //!
 //! Choices: a point counts as outside when the even-odd test says so and it is farther than
-//! 1e-9 mm from the outline; the offset is mitred ([`crate::geom::boolean::offset`]), and
+//! [`SLACK_MM`] from the outline (the outline went through polygon booleans, which snap to a
+//! grid of about 1e-6 mm, so a stroke ending on it may stand a rounding step outside); the offset is mitred ([`crate::geom::boolean::offset`]), and
 //! grown again (doubled, a few times) in the rare case a bevelled sharp corner leaves a point
 //! out; pieces with nothing outside are nested as they are, unchanged.
 
 use crate::geom::{boolean, polygon};
 use crate::pattern::Piece;
 use glam::DVec2;
+
+/// How far (mm) a point may lie outside what was nested and still count as on it: rounding of
+/// the outline's booleans, far below a plotter unit (0.025 mm).
+pub const SLACK_MM: f64 = 1e-4;
 
 /// Rows of an outline's edges, for even-odd tests of many points against it.
 struct Rows {
@@ -79,7 +84,7 @@ fn outside(piece: &Piece, rings: &[Vec<DVec2>]) -> Vec<DVec2> {
     };
     piece
         .points()
-        .filter(|p| p.is_finite() && !rows.contains(*p) && distance(rings, *p) > 1e-9)
+        .filter(|p| p.is_finite() && !rows.contains(*p) && distance(rings, *p) > SLACK_MM)
         .collect()
 }
 
@@ -123,7 +128,7 @@ pub fn nested_rings(piece: &Piece) -> Vec<Vec<DVec2>> {
             if let Some(rows) = Rows::new(&shape) {
                 if piece
                     .points()
-                    .all(|p| !p.is_finite() || rows.contains(p) || distance(&shape, p) <= 1e-9)
+                    .all(|p| !p.is_finite() || rows.contains(p) || distance(&shape, p) <= SLACK_MM)
                 {
                     return shape;
                 }
