@@ -17,6 +17,7 @@ mod gpgl;
 mod house;
 mod knife;
 mod nest;
+mod overlap;
 mod param;
 mod pattern;
 mod robust;
