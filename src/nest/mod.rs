@@ -24,7 +24,10 @@
 //! Orientations per piece come from [`NestOptions::rotations`] (a set, a step or free; per-piece
 //! overrides in [`NestOptions::piece_rotations`]), doubled by mirror images when
 //! [`NestOptions::mirror`]; a piece with a grain line may only turn so that the grain runs along
-//! the sheet's y axis (the roll's length), either way, whatever the rotation setting.
+//! the sheet's y axis (the roll's length), either way, whatever the rotation setting. On a roll,
+//! a few freely turning pieces ([`problem::FEW_ITEMS`]) also try the turns that make them
+//! shortest along it ([`problem::Item::add_shortest_shapes`]), so that a lone piece takes the
+//! least roll.
 //!
 //! Frames: on sheets the optimiser's container is the sheet inside the margins; on a roll the
 //! optimiser's strip (length along its x) is the roll turned by 90°, so the length used runs
@@ -309,9 +312,10 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         };
         items.push(Item::new(rings, orients));
     }
-    if items.len() <= problem::FEW_ITEMS {
+    // A few pieces on a roll also try the turns that use the least roll.
+    if roll && items.len() <= problem::FEW_ITEMS {
         for it in &mut items {
-            it.add_shortest_shapes(if roll { uw } else { uh });
+            it.add_shortest_shapes(uw);
         }
     }
     let container = if roll {

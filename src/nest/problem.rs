@@ -14,9 +14,9 @@ use std::sync::Arc;
 
 pub use super::collision::Orient;
 
-/// Problems with at most this many items try, for each freely turning item, the turns that
-/// make it shortest ([`Item::add_shortest_shapes`]) besides the four of its smallest
-/// enclosing rectangle.
+/// Strip problems (a roll) with at most this many items try, for each freely turning item,
+/// the turns that make it shortest ([`Item::add_shortest_shapes`]) besides the four of its
+/// smallest enclosing rectangle (`nest::nest`).
 pub const FEW_ITEMS: usize = 8;
 /// How many shortest turns such an item gets.
 pub const SHORTEST_TURNS: usize = 2;
