@@ -143,6 +143,13 @@ impl Item {
         }
     }
 
+    /// Whether one of the construction shapes fits in `length` × `height`.
+    pub(crate) fn fits(&self, length: f64, height: f64) -> bool {
+        self.shapes
+            .iter()
+            .any(|s| s.size.x <= length + 1e-9 && s.size.y <= height + 1e-9)
+    }
+
     /// Smallest length (x extent) over the construction shapes that fit the height.
     pub(crate) fn min_length(&self, height: f64) -> Option<f64> {
         self.shapes
