@@ -156,11 +156,17 @@
 //!   mod.rs                     Surface stage
 //!   dcs.rs                     The DCS approximation (Julius 2006, thesis chapter 6, eq. 6.1–6.3)
 //!   fittings.rs                Sheet-metal fittings a shop makes every day (issue 4, item 3), each built as a developable stri…
+//!   import.rs                  Mesh files of every format flatcut reads, chosen by extension and, for a file with another…
 //!   material.rs                The material a pattern is cut from
 //!   obj.rs                     Polyhedral meshes from Wavefront OBJ files, read through `tobj`, keeping polygon faces (a plana…
+//!   off.rs                     OFF files (Object File Format, Geomview; the format of the CGAL and Princeton shape benchm…
+//!   ply.rs                     PLY files (Greg Turk's polygon file format, Stanford 1994), ASCII and binary (little and b…
 //!   segment.rs                 How a mesh surface is cut into pieces
+//!   size.rs                    The size of a model
 //!   solids.rs                  Small polyhedra for the example patterns in `patterns/` and for tests
 //!   source.rs                  The description of one surface to build, the input of `crate::surface::build`
+//!   stl.rs                     STL files (binary and ASCII), the triangle soups of 3D printing, welded into an indexed me…
+//!   weld.rs                    What the mesh readers of STL, PLY and OFF share (see `import.rs`)
 //!   boundary/
 //!     mod.rs                   Developable surfaces from a closed 3D boundary (Rose, Sheffer, Wither, Cani, Thibert 2007, seed…
 //!     bnb.rs                   §5 branch-and-bound on one simple loop (local vertex indices 0..m, in loop order), Fig. 9
@@ -199,6 +205,7 @@
 //! toolpath/
 //!   mod.rs                     Toolpath stage
 //!   collect.rs                 The strokes of one sheet, unordered
+//!   cuttable.rs                Features a device cannot make, found before anything is cut (issue 21)
 //!   knife.rs                   What a machine's tools need beyond the ordered design
 //!   order.rs                   Travel optimisation inside one group of strokes
 //!   passes.rs                  Machines with one tool (issue 23)

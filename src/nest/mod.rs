@@ -24,7 +24,10 @@
 //! Orientations per piece come from [`NestOptions::rotations`] (a set, a step or free; per-piece
 //! overrides in [`NestOptions::piece_rotations`]), doubled by mirror images when
 //! [`NestOptions::mirror`]; a piece with a grain line may only turn so that the grain runs along
-//! the sheet's y axis (the roll's length), either way, whatever the rotation setting.
+//! the sheet's y axis (the roll's length), either way, whatever the rotation setting. On a roll,
+//! a few freely turning pieces ([`problem::FEW_ITEMS`]) also try the turns that make them
+//! shortest along it ([`problem::Item::add_shortest_shapes`]), so that a lone piece takes the
+//! least roll; on sheets, a piece that none of its usual turns fits tries them too.
 //!
 //! Frames: on sheets the optimiser's container is the sheet inside the margins; on a roll the
 //! optimiser's strip (length along its x) is the roll turned by 90°, so the length used runs
@@ -284,6 +287,18 @@ fn nested(piece: &Piece) -> Result<Vec<Vec<DVec2>>, NestError> {
     Ok(rings)
 }
 
+/// A few pieces on a roll, and a piece that fits a sheet in none of its usual turns, also try
+/// the turns that make them shortest ([`Item::add_shortest_shapes`]); `uw` × `uh` is the room
+/// inside the margins.
+fn add_shortest_turns(items: &mut [Item], roll: bool, uw: f64, uh: f64) {
+    let few = items.len() <= problem::FEW_ITEMS;
+    for it in items.iter_mut() {
+        if (roll && few) || (!roll && !it.fits(uw, uh)) {
+            it.add_shortest_shapes(if roll { uw } else { uh });
+        }
+    }
+}
+
 /// Place every piece.
 pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError> {
     let m = opts.margin;
@@ -316,11 +331,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
         };
         items.push(Item::new(rings, orients));
     }
-    if items.len() <= problem::FEW_ITEMS {
-        for it in &mut items {
-            it.add_shortest_shapes(if roll { uw } else { uh });
-        }
-    }
+    add_shortest_turns(&mut items, roll, uw, uh);
     let container = if roll {
         Container::Strip { height: uw }
     } else {

@@ -14,9 +14,9 @@ use std::sync::Arc;
 
 pub use super::collision::Orient;
 
-/// Problems with at most this many items try, for each freely turning item, the turns that
-/// make it shortest ([`Item::add_shortest_shapes`]) besides the four of its smallest
-/// enclosing rectangle.
+/// Strip problems (a roll) with at most this many items try, for each freely turning item,
+/// the turns that make it shortest ([`Item::add_shortest_shapes`]) besides the four of its
+/// smallest enclosing rectangle (`nest::nest`).
 pub const FEW_ITEMS: usize = 8;
 /// How many shortest turns such an item gets.
 pub const SHORTEST_TURNS: usize = 2;
@@ -141,6 +141,13 @@ impl Item {
                 .push(Arc::new(Shape::new(&self.rings, &self.poles, o)));
             added += 1;
         }
+    }
+
+    /// Whether one of the construction shapes fits in `length` × `height`.
+    pub(crate) fn fits(&self, length: f64, height: f64) -> bool {
+        self.shapes
+            .iter()
+            .any(|s| s.size.x <= length + 1e-9 && s.size.y <= height + 1e-9)
     }
 
     /// Smallest length (x extent) over the construction shapes that fit the height.

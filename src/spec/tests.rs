@@ -666,3 +666,21 @@ rulings = [[[1, 1], [2, 1]]]
     assert_eq!(b.input.rulings, vec![[(0, 0), (1, 0)]]);
     assert!(b.input.loops[0].len() > 8);
 }
+
+#[test]
+fn size_top_level_and_per_surface() {
+    let s = p(&format!("size = 200\n{MINIMAL}size = 150\n")).unwrap();
+    assert_eq!(s.size, Some(200.0));
+    assert_eq!(s.surfaces[0].size, Some(150.0));
+    assert!(!s.sheet_given);
+    assert!(
+        p(&format!("{MINIMAL}[sheet]\nwidth = 300\n"))
+            .unwrap()
+            .sheet_given
+    );
+    let (line, key, msg) = invalid(&format!("size = -1\n{MINIMAL}"));
+    assert_eq!((line, key.as_str()), (1, "size"));
+    assert!(msg.contains("-1"), "{msg}");
+    let (line, key, _) = invalid(&format!("{MINIMAL}size = 0\n"));
+    assert_eq!((line, key.as_str()), (4, "surface[1].size"));
+}

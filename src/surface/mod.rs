@@ -3,7 +3,11 @@
 //! [`Surface`]: a polygon mesh in millimetres whose faces are flat panels, with its name and
 //! the file it came from.
 //!
-//! - [`obj`]: a polyhedral mesh read from a Wavefront OBJ file, checked and repaired.
+//! - [`obj`]: a polyhedral mesh read from a Wavefront OBJ file, checked and repaired; beside
+//!   it [`stl`], [`ply`] and [`off`] read the other mesh formats into the same raw mesh
+//!   (`weld.rs` welds their points), and [`import`] picks the reader by extension or content.
+//! - [`size`]: a model's extent, scaling a surface to a size, and the refusal of implausible
+//!   sizes (issue 21).
 //! - [`solids`]: small polyhedra for the example patterns and tests (cube, tetrahedron,
 //!   lampshade, house).
 //! - [`strip`]/: Wang & Tang, *Developable Triangulations of a Strip*: the developable
@@ -34,6 +38,7 @@ pub mod solids;
 pub mod source;
 pub mod stl;
 pub mod strip;
+mod weld;
 
 use crate::geom::mesh::Mesh;
 pub use material::{Material, MaterialKind};

@@ -9,8 +9,8 @@
 //! indices (colours) are ignored; `4OFF`/`nOFF` (other dimensions) and binary OFF are refused
 //! with a message. Errors name the line.
 
-use super::import::{coord, err, indexed};
 use super::obj::RawMesh;
+use super::weld::{coord, err, indexed};
 use super::SurfaceError;
 use glam::DVec3;
 use std::path::Path;
@@ -122,7 +122,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<RawMesh, SurfaceError> {
         let n = w[0]
             .parse::<usize>()
             .ok()
-            .filter(|&n| n + 1 <= w.len())
+            .filter(|&n| n < w.len())
             .ok_or_else(|| {
                 err(
                     path,

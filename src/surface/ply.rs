@@ -12,8 +12,8 @@
 //! line (ASCII, and the header) or the vertex or face, counted from 1 (binary); counts are
 //! bounded (100 million) so that a broken header cannot ask for unbounded memory.
 
-use super::import::{err, indexed, non_finite};
 use super::obj::RawMesh;
+use super::weld::{err, indexed, non_finite};
 use super::SurfaceError;
 use glam::DVec3;
 use std::path::Path;

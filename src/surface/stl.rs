@@ -1,5 +1,5 @@
 //! STL files (binary and ASCII), the triangle soups of 3D printing, welded into an indexed
-//! mesh: corners with identical coordinates become one vertex (see [`super::import`]). The
+//! mesh: corners with identical coordinates become one vertex (see `weld.rs`). The
 //! format is 3D Systems' *StereoLithography Interface Specification* (1989): binary, an 80-byte
 //! header, a little-endian `u32` triangle count, then 50 bytes per triangle (normal, three
 //! corners as `f32`, a `u16` attribute); ASCII, `solid name`, then per triangle `facet normal
@@ -11,8 +11,8 @@
 //! the binary file's size must match its triangle count exactly. Errors name the line (ASCII)
 //! or the triangle, counted from 1 (binary).
 
-use super::import::{coord, err, Welder};
 use super::obj::RawMesh;
+use super::weld::{coord, err, Welder};
 use super::SurfaceError;
 use glam::DVec3;
 use std::path::Path;

@@ -605,6 +605,9 @@ fn cli_flatten_writes_uv_obj_and_stretch() {
     let o = flatcut(&[
         "flatten",
         &shared_data("meshes/cylinder.obj").to_string_lossy(),
+        // 3 units across: read in cm, 30 mm (in mm it is refused as too small, issue 21).
+        "--units",
+        "cm",
         "--segment",
         "dcharts",
         "--uv-obj",
