@@ -1,10 +1,11 @@
-//! Device stage: how a program reaches a machine ([`serial`] transport, [`stream`] protocols
+//! Device stage: how a program reaches a machine ([`serial`] transport, [`stream`] protocols (GRBL streaming in `grbl_stream`)
 //! with flow control and GRBL character counting, [`grbl`] protocol knowledge), and the
 //! simulated cutter on a pseudo-terminal ([`sim`]) that stands in for a machine. What flatcut
 //! knows about each machine (language, units, serial settings, tool table) is
 //! [`crate::profile`].
 
 pub mod grbl;
+mod grbl_stream;
 pub mod serial;
 pub mod sim;
 pub mod stream;
