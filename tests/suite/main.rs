@@ -12,6 +12,7 @@ mod cli;
 mod dcharts;
 mod device;
 mod fandisk;
+mod grbl_firmware;
 mod house;
 mod knife;
 mod nest;

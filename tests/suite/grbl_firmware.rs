@@ -1,0 +1,338 @@
+//! The real GRBL firmware as the peer: GRBL 1.1h and 0.9j built from `../shared/peers/grbl-sim`
+//! (the firmware's own C source on a simulated AVR, its serial port on stdin/stdout), run with
+//! its stdin and stdout on the master side of a pseudo-terminal, and flatcut's real sender on
+//! the slave side. The firmware is built once per test run into the target directory; without
+//! gcc the tests skip (and fail when `CI` is set).
+//!
+//! The simulator's patches log every byte GRBL's receive buffer drops ("RX OVERFLOW", stderr)
+//! and every planned block (`-b`, in steps), so a test can see both that character counting
+//! held and that the machine planned exactly the program's moves. Each test runs a few seconds
+//! of machine time at `-t` speed-up.
+
+use crate::common::*;
+use flatcut::device::serial;
+use flatcut::device::stream::{self, StreamError, StreamOptions};
+use flatcut::profile::{self, Profile};
+use serialport::SerialPort;
+use std::io::{Read, Write};
+use std::os::fd::{FromRawFd, IntoRawFd, OwnedFd};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Mutex, OnceLock};
+use std::time::{Duration, Instant};
+
+/// GRBL's default steps per mm (`$100`–`$102`), which the tests keep.
+const STEPS_PER_MM: f64 = 250.0;
+
+/// Settings a job wants on top of GRBL's defaults (which cap feeds low).
+const FAST: &[&str] = &[
+    "$110=10000",
+    "$111=10000",
+    "$112=5000",
+    "$120=2000",
+    "$121=2000",
+    "$122=2000",
+];
+
+static BUILT: OnceLock<Mutex<Vec<(String, Option<PathBuf>)>>> = OnceLock::new();
+/// One firmware at a time: each keeps a core busy, and two would slow each other's machine
+/// time (grbl-sim runs at about a third of real time on a loaded two-core machine).
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Build (once per run) GRBL `ver` inside grbl-sim; `None` (skip) without the peers or gcc.
+pub fn firmware(ver: &str) -> Option<PathBuf> {
+    let peers = manifest("../shared/peers/grbl-sim/build.sh");
+    if !peers.is_file() || Command::new("gcc").arg("--version").output().is_err() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI: the GRBL firmware tests need ../shared/peers/grbl-sim and gcc"
+        );
+        eprintln!("skipped: no ../shared/peers/grbl-sim or no gcc");
+        return None;
+    }
+    let m = BUILT.get_or_init(|| Mutex::new(Vec::new()));
+    let mut built = m.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, p)) = built.iter().find(|(v, _)| v == ver) {
+        return p.clone();
+    }
+    // Each run builds into its own folder (the target directory may be shared by several
+    // checkouts running tests at once), then keeps it under the version's name.
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("peers");
+    let dest = root.join(format!("grbl-sim-{ver}-{}", std::process::id()));
+    let o = Command::new("bash")
+        .arg(&peers)
+        .arg(&dest)
+        .arg(ver)
+        .output()
+        .expect("run build.sh");
+    assert!(
+        o.status.success(),
+        "building GRBL {ver}: {}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let exe = dest.join("grbl_sim.exe");
+    assert!(exe.is_file());
+    built.push((ver.to_string(), Some(exe.clone())));
+    Some(exe)
+}
+
+/// A running firmware on a pty pair.
+pub struct Firmware {
+    child: Child,
+    _turn: std::sync::MutexGuard<'static, ()>,
+    /// The slave side's path (what flatcut opens).
+    pub path: String,
+    /// The slave side kept open between connections (and used for raw setup lines).
+    slave: serialport::TTYPort,
+    pub dir: PathBuf,
+    partial: Vec<u8>,
+}
+
+impl Firmware {
+    /// Start GRBL `ver` `speed` times faster than real time, in a fresh folder (its EEPROM).
+    pub fn start(ver: &str, name: &str, speed: f64) -> Option<Firmware> {
+        let exe = firmware(ver)?;
+        let turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = scratch(&format!("grbl-fw-{name}"));
+        let (master, slave) = serialport::TTYPort::pair().expect("pty pair");
+        let path = slave.name().expect("pty name");
+        // SAFETY: `into_raw_fd` hands over the only owner of the master descriptor.
+        let fd = unsafe { OwnedFd::from_raw_fd(master.into_raw_fd()) };
+        let out = fd.try_clone().expect("dup");
+        let child = Command::new(exe)
+            .args(["-n", "-t", &speed.to_string(), "-b"])
+            .arg(dir.join("block.out"))
+            .current_dir(&dir)
+            .stdin(Stdio::from(fd))
+            .stdout(Stdio::from(out))
+            .stderr(std::fs::File::create(dir.join("stderr.log")).expect("stderr log"))
+            .spawn()
+            .expect("start grbl_sim");
+        let mut fw = Firmware {
+            child,
+            _turn: turn,
+            path,
+            slave,
+            dir,
+            partial: Vec::new(),
+        };
+        fw.slave.set_timeout(Duration::from_millis(20)).ok();
+        // The welcome (GRBL waits a simulated second before it reads).
+        let banner = if ver.starts_with("0.9") {
+            "Grbl 0.9"
+        } else {
+            "Grbl 1.1"
+        };
+        let got = fw.read_until(|l| l.starts_with(banner), Duration::from_secs(10));
+        assert!(
+            got.iter().any(|l| l.starts_with(banner)),
+            "no welcome: {got:?}"
+        );
+        Some(fw)
+    }
+
+    /// Lines the firmware sends until `done` is true of one (or `timeout`).
+    pub fn read_until(&mut self, done: impl Fn(&str) -> bool, timeout: Duration) -> Vec<String> {
+        let deadline = Instant::now() + timeout;
+        let mut lines = Vec::new();
+        let mut buf = [0u8; 256];
+        while Instant::now() < deadline {
+            while let Some(i) = self.partial.iter().position(|&b| b == b'\n') {
+                let raw: Vec<u8> = self.partial.drain(..=i).collect();
+                let l = String::from_utf8_lossy(&raw).trim().to_string();
+                if l.is_empty() {
+                    continue;
+                }
+                let stop = done(&l);
+                lines.push(l);
+                if stop {
+                    return lines;
+                }
+            }
+            if let Ok(n) = self.slave.read(&mut buf) {
+                self.partial.extend_from_slice(&buf[..n]);
+            }
+        }
+        lines
+    }
+
+    /// Send one line and collect its answer: the lines up to and including `ok` or `error…`.
+    pub fn ask(&mut self, line: &str) -> Vec<String> {
+        self.slave.write_all(line.as_bytes()).unwrap();
+        self.slave.write_all(b"\n").unwrap();
+        self.read_until(
+            |l| l == "ok" || l.starts_with("error") || l.starts_with("ALARM"),
+            Duration::from_secs(10),
+        )
+    }
+
+    /// Send `$` settings one at a time, each answered `ok`.
+    pub fn settings(&mut self, lines: &[&str]) {
+        for l in lines {
+            let a = self.ask(l);
+            assert_eq!(a.last().map(String::as_str), Some("ok"), "{l}: {a:?}");
+        }
+    }
+
+    /// Every block GRBL planned: its end position in mm.
+    pub fn blocks(&self) -> Vec<[f64; 3]> {
+        let text = std::fs::read_to_string(self.dir.join("block.out")).unwrap_or_default();
+        text.lines()
+            .filter_map(|l| {
+                let v: Vec<f64> = l.split(',').filter_map(|w| w.trim().parse().ok()).collect();
+                (v.len() >= 3).then(|| {
+                    [
+                        v[0] / STEPS_PER_MM,
+                        v[1] / STEPS_PER_MM,
+                        v[2] / STEPS_PER_MM,
+                    ]
+                })
+            })
+            .collect()
+    }
+
+    /// Bytes GRBL's receive buffer dropped.
+    pub fn overflows(&self) -> usize {
+        std::fs::read_to_string(self.dir.join("stderr.log"))
+            .unwrap_or_default()
+            .matches("RX OVERFLOW")
+            .count()
+    }
+}
+
+impl Drop for Firmware {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn opts(timeout_s: f64) -> StreamOptions {
+    StreamOptions {
+        timeout: Duration::from_secs_f64(timeout_s),
+        wake_timeout: Duration::from_secs(5),
+        progress: false,
+        ..StreamOptions::default()
+    }
+}
+
+/// Stream `program` to the firmware with flatcut's sender.
+fn send(
+    fw: &Firmware,
+    p: &Profile,
+    program: &[u8],
+    o: &StreamOptions,
+) -> Result<stream::StreamReport, StreamError> {
+    let mut link = serial::open(p, &fw.path, None).expect("open the pty");
+    stream::send(&mut link, p, program, o)
+}
+
+/// The end positions of the program's moves, as GRBL plans them: absolute mm, a move to
+/// where the machine already is planning nothing.
+fn program_moves(program: &str, z0: f64) -> Vec<[f64; 3]> {
+    let mut pos = [0.0, 0.0, z0];
+    let mut out = Vec::new();
+    for l in program.lines() {
+        let l = l.trim();
+        if !(l.starts_with("G0") || l.starts_with("G1")) {
+            continue;
+        }
+        let mut next = pos;
+        for w in l.split_whitespace() {
+            let (k, v) = w.split_at(1);
+            let Ok(v) = v.parse::<f64>() else { continue };
+            match k {
+                "X" => next[0] = v,
+                "Y" => next[1] = v,
+                "Z" => next[2] = v,
+                _ => {}
+            }
+        }
+        let steps = |a: f64| (a * STEPS_PER_MM).round();
+        if (0..3).any(|i| steps(next[i]) != steps(pos[i])) {
+            out.push(next);
+        }
+        pos = next;
+    }
+    out
+}
+
+/// The profile with every tool at least 6,000 mm/min: machine time is dear (grbl-sim runs
+/// slower than real time), and the protocol does not care about the feed.
+fn quick(name: &str) -> Profile {
+    let mut p = profile::find(name).unwrap();
+    for t in p.tools.values_mut() {
+        t.speed = t.speed.map(|s| s.max(6000.0));
+    }
+    p
+}
+
+/// A few strokes, about 30 mm of cutting and drawing.
+fn short_job() -> flatcut::toolpath::SheetJob {
+    use flatcut::toolpath::{SheetJob, Stroke, StrokeRole};
+    let stroke = |role, pts: &[(f64, f64)]| Stroke {
+        role,
+        points: pts.iter().map(|&(x, y)| glam::DVec2::new(x, y)).collect(),
+        closed: pts.first() == pts.last(),
+        piece: None,
+        outer: false,
+    };
+    SheetJob {
+        width: 100.0,
+        height: 100.0,
+        strokes: vec![
+            stroke(
+                StrokeRole::Cut,
+                &[(5.0, 5.0), (10.0, 5.0), (10.0, 8.0), (5.0, 8.0), (5.0, 5.0)],
+            ),
+            stroke(StrokeRole::FoldValley, &[(5.0, 6.5), (10.0, 6.5)]),
+            stroke(StrokeRole::Mark, &[(5.5, 5.5), (6.0, 6.25), (6.5, 5.5)]),
+            stroke(
+                StrokeRole::Cut,
+                &[(12.0, 5.0), (14.5, 6.0), (12.0, 7.0), (12.0, 5.0)],
+            ),
+        ],
+    }
+}
+
+#[test]
+fn each_grbl_profile_runs_a_short_job_on_grbl_1_1h() {
+    for name in ["grbl-laser", "grbl-dragknife", "grbl-pen"] {
+        let Some(mut fw) = Firmware::start("1.1h", name, 4.0) else {
+            return;
+        };
+        fw.settings(FAST);
+        if name == "grbl-laser" {
+            fw.settings(&["$32=1"]);
+        }
+        let p = quick(name);
+        let program = flatcut::output::program(&short_job(), &p).unwrap();
+        let r = send(&fw, &p, &program, &opts(20.0));
+        let text = String::from_utf8(program.clone()).unwrap();
+        let r = r.unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(r.lines, text.lines().count(), "{name}");
+        // Let the planner log the last blocks.
+        std::thread::sleep(Duration::from_millis(300));
+        assert_eq!(
+            fw.overflows(),
+            0,
+            "{name}: GRBL's receive buffer overflowed"
+        );
+        let want = program_moves(&text, 0.0);
+        let got = fw.blocks();
+        assert_eq!(
+            got.len(),
+            want.len(),
+            "{name}: blocks {got:?}\nmoves {want:?}"
+        );
+        for (g, w) in got.iter().zip(&want) {
+            for i in 0..3 {
+                assert!(
+                    (g[i] - w[i]).abs() <= 1.0 / STEPS_PER_MM,
+                    "{name}: {g:?} vs {w:?}"
+                );
+            }
+        }
+    }
+}
