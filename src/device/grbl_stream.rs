@@ -7,6 +7,19 @@
 //! (Ctrl-X) and its welcome awaited. `error:N` or `ALARM:N` stops the job with the line, GRBL's
 //! meaning and the tool lifted (feed hold, wait for the hold, soft reset, then the cut tool's
 //! "up" command).
+//!
+//! Progress that is not an `ok`: GRBL holds the `ok` of a line that waits for the planner to
+//! empty (`M3`/`M4`/`M5`, `S` changes, `G4`, `M2`, and any line once the planner is full), so a
+//! long move can hold the next answer for minutes. While a job runs the status is asked with
+//! `?` (a real-time byte, never counted in the buffer) five times a second, and a machine
+//! whose position moves or whose state is `Run` or `Hold` (a pause waiting to resume) counts
+//! as busy: the timeout is about a machine that makes no progress at all.
+//!
+//! At connect the welcome says which GRBL it is (`Grbl 0.9…`: text errors and the 0.9 status,
+//! read alike). On GRBL 1.1 a laser profile (tools with `power`) needs laser mode, `$32=1`, and
+//! a servo pen needs it off (else `S` changes would not wait for the pen): `$$` is asked and a
+//! wrong `$32` refused with the setting to send. Every line is checked against GRBL's 79
+//! significant characters before the first byte.
 
 // A stream error carries the job position for the user; it happens at most once per job.
 #![allow(clippy::result_large_err)]
@@ -39,9 +52,12 @@ pub(super) struct Grbl<'a> {
     acked_bytes: usize,
     partial: Vec<u8>,
     rep: StreamReport,
+    /// Last sign of progress: an answer, a moving position, a busy state.
     last_answer: Instant,
     last_poll: Instant,
     state: String,
+    mpos: Option<[f64; 3]>,
+    version: proto::Version,
 }
 
 enum Event {
@@ -89,6 +105,8 @@ impl<'a> Grbl<'a> {
             last_answer: Instant::now(),
             last_poll: Instant::now(),
             state: String::new(),
+            mpos: None,
+            version: proto::Version::V1_1,
         }
     }
 
@@ -109,7 +127,7 @@ impl<'a> Grbl<'a> {
                 return Ok(Event::Nothing);
             }
             let r = proto::parse_response(&text);
-            if let Response::Other(_) = &r {
+            if let Response::Other(_) | Response::ErrorText(_) | Response::AlarmText(_) = &r {
                 self.rep.garbage_bytes += line.len();
             }
             return Ok(Event::Answer(r));
@@ -162,8 +180,9 @@ impl<'a> Grbl<'a> {
         let mut awake = false;
         while Instant::now() < deadline {
             match self.poll()? {
-                Event::Answer(Response::Welcome) => {
+                Event::Answer(Response::Welcome(v)) => {
                     awake = true;
+                    self.version = v;
                     // Let the messages that follow the welcome arrive.
                     std::thread::sleep(Duration::from_millis(20));
                 }
@@ -219,6 +238,12 @@ impl<'a> Grbl<'a> {
         if matches!(r, Response::Ok | Response::Error(_) | Response::Alarm(_)) {
             self.last_answer = Instant::now();
         }
+        let r = match r {
+            // A 0.9 message flatcut does not know: an error all the same, without a number.
+            Response::ErrorText(_) => Response::Error(0),
+            Response::AlarmText(_) => Response::Alarm(0),
+            r => r,
+        };
         match r {
             Response::Ok => {
                 if let Some((i, len)) = self.pending.pop_front() {
@@ -256,10 +281,17 @@ impl<'a> Grbl<'a> {
                 })
             }
             Response::Status(s) => {
-                self.state = s;
+                // A moving or busy machine is making progress even when no `ok` comes.
+                if s.busy() || (s.mpos.is_some() && self.mpos.is_some() && s.mpos != self.mpos) {
+                    self.last_answer = Instant::now();
+                }
+                self.state = s.state;
+                if s.mpos.is_some() {
+                    self.mpos = s.mpos;
+                }
                 Ok(())
             }
-            Response::Welcome => {
+            Response::Welcome(_) => {
                 // The controller reset under us: everything in flight is lost.
                 Err(StreamError::HungUp {
                     port: self.port.clone(),
@@ -268,7 +300,7 @@ impl<'a> Grbl<'a> {
                     tool: ToolState::Unknown,
                 })
             }
-            Response::Other(_) => Ok(()),
+            Response::Other(_) | Response::ErrorText(_) | Response::AlarmText(_) => Ok(()),
         }
     }
 
@@ -294,7 +326,11 @@ impl<'a> Grbl<'a> {
                 last_q = Instant::now();
             }
             match self.poll() {
-                Ok(Event::Answer(Response::Status(s))) if s == "Hold:0" || s == "Idle" => break,
+                Ok(Event::Answer(Response::Status(s)))
+                    if s.state == "Hold:0" || s.state == "Hold" || s.state == "Idle" =>
+                {
+                    break
+                }
                 Ok(_) => {}
                 Err(_) => return ToolState::Unknown,
             }
@@ -307,7 +343,7 @@ impl<'a> Grbl<'a> {
         let mut alarm = false;
         while Instant::now() < deadline {
             match self.poll() {
-                Ok(Event::Answer(Response::Welcome)) => awake = true,
+                Ok(Event::Answer(Response::Welcome(_))) => awake = true,
                 Ok(Event::Answer(Response::Alarm(_))) => alarm = true,
                 Ok(Event::Nothing) if awake => break,
                 Ok(_) => {}
@@ -361,8 +397,82 @@ impl<'a> Grbl<'a> {
         }
     }
 
+    /// Refuse a line longer than GRBL keeps, before the first byte.
+    fn check_lines(&self) -> Result<(), StreamError> {
+        for (_, text, line) in &self.lines {
+            let len = proto::significant_len(text);
+            if len > proto::LINE_MAX {
+                return Err(StreamError::LineTooLong {
+                    port: self.port.clone(),
+                    line: *line,
+                    len,
+                    max: proto::LINE_MAX,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// GRBL 1.1's laser mode (`$32`) against what the profile's tools need: on for a laser
+    /// (`power`), off for a servo pen; other profiles do not ask.
+    fn check_laser_mode(&mut self) -> Result<(), StreamError> {
+        let tools = self.profile.tools.values();
+        let laser = tools
+            .clone()
+            .any(|t| t.power.is_some() && t.z_down.is_none());
+        let servo = tools
+            .clone()
+            .any(|t| t.servo_down.is_some() && t.z_down.is_none());
+        if self.version != proto::Version::V1_1 || !(laser || servo) {
+            return Ok(());
+        }
+        self.write_all(b"$$\n", "asking GRBL for its settings ($$)")?;
+        let deadline = Instant::now() + self.opts.wake_timeout;
+        let mut mode = None;
+        loop {
+            match self.poll()? {
+                Event::Answer(Response::Ok) => break,
+                Event::Answer(Response::Other(l)) => {
+                    if let Some(v) = l.strip_prefix("$32=") {
+                        mode = v.trim().parse::<f64>().ok();
+                    }
+                }
+                Event::Answer(Response::Error(_)) => break,
+                _ if Instant::now() > deadline => {
+                    return Err(StreamError::NoWelcome {
+                        port: self.port.clone(),
+                        secs: self.opts.wake_timeout.as_secs_f64(),
+                    })
+                }
+                _ => {}
+            }
+        }
+        self.rep.garbage_bytes = 0;
+        let on = mode.is_some_and(|m| m != 0.0);
+        let message = if laser && !on {
+            format!(
+                "GRBL's laser mode is off ($32={}): profile `{}` drives a laser with M4 and                  needs it on, else every S change stops the machine and G0 moves do not turn                  the beam off; send `$32=1` once from a terminal",
+                mode.map_or("?".into(), crate::output::fmt_mm),
+                self.profile.name
+            )
+        } else if servo && !laser && on {
+            format!(
+                "GRBL's laser mode is on ($32=1): profile `{}` lifts its pen with M3 S, which                  laser mode does not wait for; send `$32=0` once from a terminal",
+                self.profile.name
+            )
+        } else {
+            return Ok(());
+        };
+        Err(StreamError::Settings {
+            port: self.port.clone(),
+            message,
+        })
+    }
+
     pub(super) fn run(mut self) -> Result<StreamReport, StreamError> {
+        self.check_lines()?;
         self.wake()?;
+        self.check_laser_mode()?;
         let limit = match self.profile.protocol {
             Protocol::GrblSendResponse => 1,
             _ => self.profile.buffer.clamp(1, 1 << 20),
@@ -377,14 +487,6 @@ impl<'a> Grbl<'a> {
             // Send what fits.
             if next < self.lines.len() {
                 let text = self.lines[next].1.clone();
-                if text.len() > proto::LINE_MAX {
-                    return Err(StreamError::LineTooLong {
-                        port: self.port.clone(),
-                        line: self.lines[next].2,
-                        len: text.len(),
-                        max: proto::LINE_MAX,
-                    });
-                }
                 let len = text.len() + 1;
                 let system = text.trim_start().starts_with('$');
                 let fits = if send_response || system {
@@ -412,12 +514,12 @@ impl<'a> Grbl<'a> {
                 Event::Nothing => {
                     if self.last_answer.elapsed() > self.opts.timeout {
                         return Err(self.stop(Failure::Timeout(
-                            "waiting for GRBL to answer `ok` (the controller went silent)",
+                            "waiting for GRBL to answer `ok` (the machine neither answered nor moved)",
                         )));
                     }
                 }
             }
-            if self.bar.bar.is_some() && self.last_poll.elapsed() > Duration::from_millis(200) {
+            if self.last_poll.elapsed() > Duration::from_millis(200) {
                 self.last_poll = Instant::now();
                 self.write_all(&[proto::STATUS_QUERY], "asking GRBL for its status")?;
                 let state = format!(" {}", self.state);

@@ -158,13 +158,16 @@ pub enum StreamError {
     },
     #[error("{port}: GRBL did not answer the reset within {secs:.0} s: is it a GRBL controller at this baud rate?")]
     NoWelcome { port: String, secs: f64 },
-    #[error("{port}: line {line} is {len} characters, more than GRBL's {max}")]
+    #[error("{port}: line {line} has {len} significant characters (spaces and comments not counted), more than the {max} GRBL keeps; nothing was sent")]
     LineTooLong {
         port: String,
         line: usize,
         len: usize,
         max: usize,
     },
+    /// A controller setting does not suit the profile (nothing was sent).
+    #[error("{port}: {message}")]
+    Settings { port: String, message: String },
     #[error("{port}: stopped by Ctrl-C ({at}; {tool})")]
     Cancelled {
         port: String,
