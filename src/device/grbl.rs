@@ -24,6 +24,31 @@ pub(crate) const SOFT_RESET: u8 = 0x18;
 
 /// The welcome line GRBL prints after a reset.
 pub(crate) const WELCOME: &str = "Grbl 1.1h ['$' for help]";
+/// GRBL 0.9j's.
+pub(crate) const WELCOME_0_9: &str = "Grbl 0.9j ['$' for help]";
+
+/// GRBL 0.9j's text for an error code (`report.c`), the other way round from the reading.
+pub(crate) fn error_text_0_9(code: u32) -> String {
+    let t = match code {
+        1 => "Expected command letter",
+        2 => "Bad number format",
+        3 => "Invalid statement",
+        4 => "Value < 0",
+        5 => "Setting disabled",
+        6 => "Value < 3 usec",
+        7 => "EEPROM read fail. Using defaults",
+        8 => "Not idle",
+        9 => "Alarm lock",
+        10 => "Homing not enabled",
+        11 => "Line overflow",
+        12 => "Step rate > 30kHz",
+        20 => "Unsupported command",
+        21 => "Modal group violation",
+        22 => "Undefined feed rate",
+        _ => return format!("Invalid gcode ID:{code}"),
+    };
+    t.to_string()
+}
 
 /// GRBL 1.1's meaning of `error:N`.
 pub(crate) fn error_meaning(code: u32) -> &'static str {

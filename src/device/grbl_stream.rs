@@ -3,7 +3,8 @@
 //!
 //! Lines are sent while the bytes of the lines not yet answered (`ok` or `error:N`) fit in the
 //! device's 128-byte receive buffer; `$` commands are sent alone, after every earlier line is
-//! answered, because GRBL executes them only when idle. Before a job the controller is reset
+//! answered and the status says `Idle`, because GRBL executes them only when idle (an `ok`
+//! means planned, not done). Before a job the controller is reset
 //! (Ctrl-X) and its welcome awaited. `error:N` or `ALARM:N` stops the job with the line, GRBL's
 //! meaning and the tool lifted (feed hold, wait for the hold, soft reset, then the cut tool's
 //! "up" command).
@@ -498,7 +499,18 @@ impl<'a> Grbl<'a> {
                             .front()
                             .is_some_and(|&(i, _)| self.lines[i].1.trim_start().starts_with('$'))
                 };
-                if fits {
+                if fits && system && !matches!(self.state.as_str(), "Idle" | "Alarm" | "Check") {
+                    // GRBL refuses most `$` commands while it moves (`error:8`), and an `ok`
+                    // only says a line was planned: wait until the status says Idle.
+                    if self.last_poll.elapsed() > Duration::from_millis(50) {
+                        self.last_poll = Instant::now();
+                        self.state.clear();
+                        self.write_all(&[proto::STATUS_QUERY], "asking GRBL for its status")?;
+                    }
+                } else if fits {
+                    if system {
+                        self.state.clear();
+                    }
                     let mut bytes = text.into_bytes();
                     bytes.push(b'\n');
                     self.write_all(&bytes, "sending G-code")?;

@@ -6,6 +6,7 @@
 
 pub mod grbl;
 mod grbl_stream;
+pub(crate) mod motion;
 pub mod serial;
 pub mod sim;
 pub mod stream;

@@ -336,3 +336,217 @@ fn each_grbl_profile_runs_a_short_job_on_grbl_1_1h() {
         }
     }
 }
+
+/// The lines the simulator and the firmware must answer alike: the list (arcs, planes,
+/// G53, G92, G10 L20, G28, T words, `G1 F0`, `$100=-1`, `$999=1`, `N99999999`, long lines, `G1
+/// X1.2.3`, `G0 G1 X1`, `$Z`, `$$`…) and the modes a job uses. `LONG80`/`LONG79` stand for a
+/// line of 80 / 79 significant characters. `G4 P0` before the `$` commands lets the machine
+/// come to rest, as GRBL answers most of them `error:8` while it moves.
+const TABLE: &[&str] = &[
+    "$110=10000",
+    "$111=10000",
+    "$112=5000",
+    "$120=2000",
+    "$121=2000",
+    "$122=2000",
+    "G21",
+    "G90",
+    "G94",
+    "G17",
+    "G0 X1 Y1",
+    "G1 X2 F600",
+    "G1 X3",
+    "G1 F0 X3",
+    "G1 X1.2.3",
+    "G0 G1 X1",
+    "G0 X1 X2",
+    "G5 X1",
+    "G4",
+    "G4 P-1",
+    "G4 P0.05",
+    "G18",
+    "G19",
+    "G17",
+    "G2 X3 Y3 I1 J0 F600",
+    "G3 X1 Y1 R2",
+    "G2 X1 Y1",
+    "G53 G0 X0 Y0",
+    "G53 X1",
+    "G92 X0 Y0",
+    "G92.1",
+    "G10 L20 P1 X0 Y0",
+    "G10 L2 P1 X0 Y0",
+    "G10 L20 X0",
+    "G28",
+    "G28.1",
+    "G30",
+    "G54",
+    "G55",
+    "G54",
+    "G59.1",
+    "T1",
+    "T300",
+    "M6",
+    "M3 S500",
+    "M4 S200",
+    "M5",
+    "S300",
+    "M8",
+    "M9",
+    "M7",
+    "M1",
+    "M2",
+    "M30",
+    "N10 G0 X1",
+    "N99999999 G0 X1",
+    "g0 x2 y2",
+    "G0 X1 ; a comment",
+    "(a comment) G0 Y1",
+    "%",
+    "LONG80",
+    "LONG79",
+    "G1 X1.0000000 Y1.0000000 Z0.0000000 F600.000000 (spaces and comments do not count) ; ok",
+    "G0 X1 Y1 Z0 G0 X1 Y1",
+    "G1 X2 Y1 F-5",
+    "G20",
+    "G0 X0.1",
+    "G21",
+    "G91",
+    "G0 X1",
+    "G90",
+    "G93 G1 X1",
+    "G94",
+    "G61",
+    "G80",
+    "G40",
+    "G43.1 Z1",
+    "G49",
+    "G4 P0",
+    "$",
+    "$$",
+    "$#",
+    "$G",
+    "$N",
+    "$X",
+    "$H",
+    "$Z",
+    "$100=-1",
+    "$999=1",
+    "$110=abc",
+    "$110=5000",
+    "$32=1",
+    "$32=0",
+    "G4 P0",
+];
+
+/// Open a raw line to a pty path.
+fn raw_port(path: &str) -> serialport::TTYPort {
+    let mut p = serialport::new(path, 115_200)
+        .timeout(Duration::from_millis(20))
+        .open_native()
+        .expect("open pty");
+    p.set_timeout(Duration::from_millis(20)).ok();
+    p
+}
+
+/// Send `line`, collect its answer lines up to `ok`/`error…`.
+fn ask(port: &mut serialport::TTYPort, partial: &mut Vec<u8>, line: &str) -> Vec<String> {
+    port.write_all(line.as_bytes()).unwrap();
+    port.write_all(b"\n").unwrap();
+    read_answer(port, partial, |l| l == "ok" || l.starts_with("error"))
+}
+
+fn read_answer(
+    port: &mut serialport::TTYPort,
+    partial: &mut Vec<u8>,
+    done: impl Fn(&str) -> bool,
+) -> Vec<String> {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut out = Vec::new();
+    let mut buf = [0u8; 256];
+    while Instant::now() < deadline {
+        while let Some(i) = partial.iter().position(|&b| b == b'\n') {
+            let raw: Vec<u8> = partial.drain(..=i).collect();
+            let l = String::from_utf8_lossy(&raw).trim().to_string();
+            if l.is_empty() {
+                continue;
+            }
+            let end = done(&l);
+            out.push(l);
+            if end {
+                return out;
+            }
+        }
+        if let Ok(n) = port.read(&mut buf) {
+            partial.extend_from_slice(&buf[..n]);
+        }
+    }
+    out.push("(no answer)".into());
+    out
+}
+
+fn table_line(l: &str) -> String {
+    match l {
+        "LONG80" => format!("G1X1.{}", "0".repeat(75)),
+        "LONG79" => format!("G0X1.{}", "0".repeat(74)),
+        l => l.to_string(),
+    }
+}
+
+/// `$$` answers compared by their setting numbers (the values are the profile's).
+fn comparable(line: &str, answer: &[String]) -> Vec<String> {
+    if line == "$$" {
+        return answer
+            .iter()
+            .map(|a| a.split('=').next().unwrap_or(a).to_string())
+            .collect();
+    }
+    answer.to_vec()
+}
+
+#[test]
+fn the_simulator_answers_like_grbl_1_1h() {
+    let Some(mut fw) = Firmware::start("1.1h", "compare", 4.0) else {
+        return;
+    };
+    let p = profile::find("grbl-dragknife").unwrap();
+    let h = flatcut::device::sim::spawn(flatcut::device::sim::SimConfig::new(p)).unwrap();
+    let mut sim = raw_port(&h.path);
+    let mut partial = Vec::new();
+    let mut differ = Vec::new();
+    for l in TABLE.iter().map(|l| table_line(l)) {
+        let want = fw.ask(&l);
+        let got = ask(&mut sim, &mut partial, &l);
+        if comparable(&l, &want) != comparable(&l, &got) {
+            differ.push(format!("{l}: GRBL {want:?}, simulator {got:?}"));
+        }
+    }
+    // M0 pauses: Hold:0 and no `ok` until cycle start (`~`), then `ok`.
+    fw.slave.write_all(b"M0\n").unwrap();
+    sim.write_all(b"M0\n").unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    fw.slave.write_all(b"?").unwrap();
+    let want = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
+    sim.write_all(b"?").unwrap();
+    let got = read_answer(&mut sim, &mut partial, |l| l.starts_with('<'));
+    let state = |a: &[String]| {
+        a.last()
+            .map(|l| l[1..].split('|').next().unwrap_or("").to_string())
+    };
+    assert_eq!(want.len(), 1, "no ok before cycle start: {want:?}");
+    assert_eq!(state(&want), Some("Hold:0".into()), "{want:?}");
+    assert_eq!(got.len(), 1, "{got:?}");
+    assert_eq!(state(&got), state(&want), "{got:?}");
+    fw.slave.write_all(b"~").unwrap();
+    sim.write_all(b"~").unwrap();
+    assert_eq!(fw.read_until(|l| l == "ok", Duration::from_secs(5)), ["ok"]);
+    assert_eq!(read_answer(&mut sim, &mut partial, |l| l == "ok"), ["ok"]);
+    assert!(TABLE.len() >= 62);
+    assert!(
+        differ.is_empty(),
+        "{} of {} lines differ:\n{}",
+        differ.len(),
+        TABLE.len(),
+        differ.join("\n")
+    );
+}
