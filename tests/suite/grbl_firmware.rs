@@ -217,6 +217,21 @@ fn opts(timeout_s: f64) -> StreamOptions {
     }
 }
 
+/// Open the pty as flatcut does. grbl-sim switches its terminal's line mode back and forth
+/// on every poll of stdin (`enable_kbhit`), so the port's check that its settings applied can
+/// fail now and then: try a few times.
+fn open_link(p: &Profile, path: &str) -> serial::Link {
+    let mut last = None;
+    for _ in 0..20 {
+        match serial::open(p, path, None) {
+            Ok(l) => return l,
+            Err(e) => last = Some(e),
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("open {path}: {last:?}")
+}
+
 /// Stream `program` to the firmware with flatcut's sender.
 fn send(
     fw: &Firmware,
@@ -224,7 +239,7 @@ fn send(
     program: &[u8],
     o: &StreamOptions,
 ) -> Result<stream::StreamReport, StreamError> {
-    let mut link = serial::open(p, &fw.path, None).expect("open the pty");
+    let mut link = open_link(p, &fw.path);
     stream::send(&mut link, p, program, o)
 }
 
@@ -549,4 +564,192 @@ fn the_simulator_answers_like_grbl_1_1h() {
         TABLE.len(),
         differ.join("\n")
     );
+}
+
+#[test]
+fn a_laser_job_with_held_oks_outlasts_a_short_timeout() {
+    let Some(mut fw) = Firmware::start("1.1h", "held-ok", 4.0) else {
+        return;
+    };
+    fw.settings(FAST);
+    fw.settings(&["$32=1"]);
+    let p = quick("grbl-laser");
+    // M5 waits for the 20 mm move (1 s of machine time, more on a loaded host): its `ok` is
+    // held far beyond the 0.5 s timeout, but the moving position is progress.
+    let job = "G21\nG90\nG94\nM4 S1000\nG1 X20 F1200\nM5\nM2\n";
+    let t = Instant::now();
+    let r = send(&fw, &p, job.as_bytes(), &opts(0.5));
+    let r = r.unwrap_or_else(|e| panic!("{e}"));
+    assert!(t.elapsed() > Duration::from_secs(1), "{:?}", t.elapsed());
+    assert_eq!(r.lines, 7);
+    assert!(StreamOptions::default().timeout >= Duration::from_secs(60));
+    assert_eq!(fw.overflows(), 0);
+    let b = fw.blocks();
+    assert!((b.last().unwrap()[0] - 20.0).abs() < 0.01, "{b:?}");
+}
+
+#[test]
+fn a_firmware_error_stops_the_job_with_the_tool_lifted() {
+    let Some(mut fw) = Firmware::start("1.1h", "error", 4.0) else {
+        return;
+    };
+    fw.settings(FAST);
+    let p = quick("grbl-dragknife");
+    // The knife is down (Z-1) when GRBL refuses line 7.
+    let job = "G21\nG90\nG94\nG0 Z2\nG0 X2 Y2\nG1 Z-1 F6000\nG5 X3\nG1 X4\nG0 Z2\nM2\n";
+    let e = send(&fw, &p, job.as_bytes(), &opts(5.0)).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(
+            e,
+            StreamError::Grbl {
+                code: 20,
+                line: 7,
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("G5 X3") && msg.contains("tool lifted"),
+        "{msg}"
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    fw.slave.write_all(b"?").unwrap();
+    let st = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
+    let z: f64 = st
+        .last()
+        .and_then(|l| l.split("MPos:").nth(1))
+        .and_then(|m| m.split([',', '|']).nth(2))
+        .and_then(|z| z.parse().ok())
+        .unwrap_or(f64::NAN);
+    assert_eq!(z, 2.0, "{st:?}");
+}
+
+#[test]
+fn a_reset_during_motion_stops_the_job_and_the_next_one_runs() {
+    let Some(fw) = Firmware::start("1.1h", "reset", 4.0) else {
+        return;
+    };
+    let mut fw = fw;
+    fw.settings(FAST);
+    let p = quick("grbl-dragknife");
+    let job = "G21\nG90\nG94\nG0 Z2\nG0 X0 Y0\nG1 Z-1 F6000\nG1 X40 F1200\nG1 Y5\nG0 Z2\nM2\n";
+    let (path, p2) = (fw.path.clone(), p.clone());
+    let t = std::thread::spawn(move || {
+        let mut link = open_link(&p2, &path);
+        stream::send(&mut link, &p2, job.as_bytes(), &opts(5.0))
+    });
+    // Someone presses reset while the knife cuts the 40 mm line (2 s of machine time).
+    std::thread::sleep(Duration::from_millis(1500));
+    fw.slave.write_all(&[0x18]).unwrap();
+    let e = t.join().unwrap().unwrap_err();
+    assert!(
+        matches!(
+            e,
+            StreamError::Alarm { code: 3, .. } | StreamError::HungUp { .. }
+        ),
+        "{e}"
+    );
+    // The next job unlocks the alarm and runs.
+    let r = send(&fw, &p, b"G21\nG90\nG0 Z2\nG0 X1 Y1\nM2\n", &opts(5.0));
+    r.unwrap_or_else(|e| panic!("after the reset: {e}"));
+    assert_eq!(fw.overflows(), 0);
+}
+
+#[test]
+fn character_counting_fills_but_never_overflows_the_128_byte_buffer() {
+    let Some(mut fw) = Firmware::start("1.1h", "counting", 4.0) else {
+        return;
+    };
+    fw.settings(FAST);
+    let p = quick("grbl-dragknife");
+    // 150 tiny moves: the planner fills and lines wait in GRBL's receive buffer.
+    let mut job = String::from("G21\nG90\nG94\nG1 F6000\n");
+    for k in 1..=150 {
+        job.push_str(&format!(
+            "G1 X{:.3} Y{:.3}\n",
+            k as f64 * 0.05,
+            (k % 2) as f64 * 0.05
+        ));
+    }
+    job.push_str("M2\n");
+    send(&fw, &p, job.as_bytes(), &opts(5.0)).unwrap_or_else(|e| panic!("{e}"));
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(fw.overflows(), 0);
+    assert_eq!(fw.blocks().len(), 150);
+    // The check can fail: a host that does not count overflows the firmware's buffer.
+    let mut naive = String::new();
+    for k in 1..=40 {
+        naive.push_str(&format!("G1 X{:.3} Y1\n", k as f64 * 0.1));
+    }
+    fw.slave.write_all(naive.as_bytes()).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while fw.overflows() == 0 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(fw.overflows() > 0, "no RX overflow logged for a naive host");
+}
+
+#[test]
+fn grbl_0_9j_runs_a_job_and_its_text_errors_stop_the_next() {
+    let Some(mut fw) = Firmware::start("0.9j", "v0_9", 4.0) else {
+        return;
+    };
+    fw.settings(FAST);
+    let p = quick("grbl-pen");
+    let program = flatcut::output::program(&short_job(), &p).unwrap();
+    let text = String::from_utf8(program.clone()).unwrap();
+    let r = send(&fw, &p, &program, &opts(10.0)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(r.lines, text.lines().count());
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(fw.overflows(), 0);
+    let (got, want) = (fw.blocks(), program_moves(&text, 0.0));
+    assert_eq!(got.len(), want.len(), "{got:?}\n{want:?}");
+    // GRBL 0.9 says `error: Unsupported command`: an error all the same.
+    let e = send(&fw, &p, b"G21\nG0 X1\nG5 X1\nG0 X2\n", &opts(5.0)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            StreamError::Grbl {
+                code: 20,
+                line: 3,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // Its status `<Idle,MPos:…>` is read: a held `ok` does not time out on 0.9 either.
+    let r = send(&fw, &p, b"G21\nG1 X20 F1200\nG4 P0\nG0 X0\n", &opts(0.5));
+    r.unwrap_or_else(|e| panic!("0.9 status: {e}"));
+}
+
+#[test]
+fn the_house_on_grbl_laser_turns_the_beam_on_once() {
+    let out = scratch("house-laser");
+    let o = flatcut(&[
+        "cut",
+        "patterns/house.toml",
+        "--device",
+        "grbl-laser",
+        "--dry-run",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let gcode = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .find(|e| e.path().extension().is_some_and(|x| x == "gcode"))
+        .expect("a .gcode file");
+    let text = std::fs::read_to_string(gcode.path()).unwrap();
+    let count = |w: &str| {
+        text.lines()
+            .filter(|l| l.split_whitespace().next() == Some(w))
+            .count()
+    };
+    assert_eq!(count("M4"), 1, "M4");
+    assert_eq!(count("M5"), 1, "M5");
+    assert!(text.lines().all(|l| l.len() <= 79));
 }
