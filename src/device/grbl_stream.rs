@@ -21,6 +21,10 @@
 //! a servo pen needs it off (else `S` changes would not wait for the pen): `$$` is asked and a
 //! wrong `$32` refused with the setting to send. Every line is checked against GRBL's 79
 //! significant characters before the first byte.
+//!
+//! ETA: the progress bar counts machine seconds, not bytes: each line's motion time as the
+//! simulated GRBL plans it (the profile's `[grbl]` rates and accelerations, junction speeds,
+//! dwells), so the bar moves as the machine does.
 
 // A stream error carries the job position for the user; it happens at most once per job.
 #![allow(clippy::result_large_err)]
@@ -59,6 +63,8 @@ pub(super) struct Grbl<'a> {
     state: String,
     mpos: Option<[f64; 3]>,
     version: proto::Version,
+    /// Machine milliseconds from the start to the end of each line of `lines`.
+    timeline: Vec<u64>,
 }
 
 enum Event {
@@ -108,7 +114,50 @@ impl<'a> Grbl<'a> {
             state: String::new(),
             mpos: None,
             version: proto::Version::V1_1,
+            timeline: Vec::new(),
         }
+        .with_timeline()
+    }
+
+    /// When a bar is shown: the machine time of every line, and the bar in those units.
+    fn with_timeline(mut self) -> Self {
+        let Some(b) = &self.bar.bar else {
+            return self;
+        };
+        let mut g = super::sim::grbl::Grbl::new(self.profile);
+        let mut t = 0.0f64;
+        for (_, text, _) in &self.lines {
+            if let Ok(e) = g.execute(text, false) {
+                t += e.seconds + e.correction + e.dwell.unwrap_or(0.0);
+            }
+            self.timeline.push((t.max(0.0) * 1000.0) as u64);
+        }
+        b.set_length(self.timeline.last().copied().unwrap_or(0).max(1));
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} [{bar:32}] {msg} machine ETA {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        self
+    }
+
+    fn show_progress(&self) {
+        let Some(b) = &self.bar.bar else { return };
+        let done = self.pending.front().map_or(self.lines.len(), |&(i, _)| i);
+        let ms = done
+            .checked_sub(1)
+            .and_then(|i| self.timeline.get(i))
+            .copied()
+            .unwrap_or(0);
+        b.set_position(ms);
+        let stroke = self.position().stroke;
+        b.set_message(format!(
+            "line {}/{} stroke {stroke}/{} {}",
+            self.acked,
+            self.file_lines,
+            self.bar.starts.len(),
+            self.state
+        ));
     }
 
     fn position(&self) -> Position {
@@ -534,8 +583,7 @@ impl<'a> Grbl<'a> {
             if self.last_poll.elapsed() > Duration::from_millis(200) {
                 self.last_poll = Instant::now();
                 self.write_all(&[proto::STATUS_QUERY], "asking GRBL for its status")?;
-                let state = format!(" {}", self.state);
-                self.bar.set(self.acked_bytes, &state);
+                self.show_progress();
             }
         }
         let _ = self.link.flush();

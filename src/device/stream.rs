@@ -23,7 +23,8 @@
 //! stroke (counted from the program's pen-up moves) and the byte or line.
 //!
 //! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
-//! GRBL status is polled with `?` at most five times a second while the bar is shown.
+//! GRBL's bar counts machine time and its status is polled with `?` five times a second while a
+//! job runs (`grbl_stream`).
 
 // A stream error carries the job position for the user; it happens at most once per job, so
 // its size on the error path does not matter.

@@ -9,6 +9,9 @@
 //! held and that the machine planned exactly the program's moves. Each test runs a few seconds
 //! of machine time at `-t` speed-up.
 
+// A stream error carries the job position; tests return it as the library does.
+#![allow(clippy::result_large_err)]
+
 use crate::common::*;
 use flatcut::device::serial;
 use flatcut::device::stream::{self, StreamError, StreamOptions};
@@ -34,7 +37,9 @@ const FAST: &[&str] = &[
     "$122=2000",
 ];
 
-static BUILT: OnceLock<Mutex<Vec<(String, Option<PathBuf>)>>> = OnceLock::new();
+/// GRBL versions built in this run, and where.
+type Built = Vec<(String, Option<PathBuf>)>;
+static BUILT: OnceLock<Mutex<Built>> = OnceLock::new();
 /// One firmware at a time: each keeps a core busy, and two would slow each other's machine
 /// time (grbl-sim runs at about a third of real time on a loaded two-core machine).
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());

@@ -422,8 +422,8 @@ impl Grbl {
                 self.planner.stop();
             }
             Some(NonModal::SetOffset) => {
-                for i in 0..3 {
-                    if let Some(v) = axes[i] {
+                for (i, v) in axes.iter().enumerate() {
+                    if let Some(v) = v {
                         self.g92[i] = self.pos[i] - self.coords[self.coord][i] - v * scale;
                     }
                 }

@@ -304,6 +304,8 @@ impl Line {
     }
 }
 
+// One interpreter per simulator: the size of the enum does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Interp {
     Hpgl(hpgl::Hpgl),
     Grbl(grbl::Grbl),
