@@ -404,50 +404,7 @@ impl Grbl {
             work(1, self.pos.y),
             work(2, self.pos.z),
         );
-        match k.non_modal {
-            Some(NonModal::SetCoord) => {
-                let p = k.get(b'P').unwrap_or(0.0) as usize;
-                let cs = if p == 0 { self.coord } else { p - 1 };
-                let mut c = self.coords[cs];
-                for i in 0..3 {
-                    if let Some(v) = axes[i] {
-                        c[i] = if k.get(b'L') == Some(20.0) {
-                            self.pos[i] - self.g92[i] - v * scale
-                        } else {
-                            v * scale
-                        };
-                    }
-                }
-                self.coords[cs] = c;
-                self.planner.stop();
-            }
-            Some(NonModal::SetOffset) => {
-                for (i, v) in axes.iter().enumerate() {
-                    if let Some(v) = v {
-                        self.g92[i] = self.pos[i] - self.coords[self.coord][i] - v * scale;
-                    }
-                }
-            }
-            Some(NonModal::ResetOffset) => self.g92 = DVec3::ZERO,
-            Some(NonModal::SetHome0) => self.g28 = self.pos,
-            Some(NonModal::SetHome1) => self.g30 = self.pos,
-            Some(h @ (NonModal::GoHome0 | NonModal::GoHome1)) => {
-                let home = if h == NonModal::GoHome0 {
-                    self.g28
-                } else {
-                    self.g30
-                };
-                let mut mid = self.pos;
-                for i in 0..3 {
-                    if axes[i].is_some() {
-                        mid[i] = target[i];
-                    }
-                }
-                e.add(self.line_to(mid, None));
-                e.add(self.line_to(home, None));
-            }
-            _ => {}
-        }
+        self.non_modal(k, target, scale, &mut e);
         if k.axis_command == AxisCommand::Motion {
             let target = if k.non_modal == Some(NonModal::Absolute) {
                 DVec3::new(
@@ -496,6 +453,56 @@ impl Grbl {
         // Tool state may change without motion (M3/M5, Z-less): open or close paths.
         self.sync_tool();
         Ok(e)
+    }
+
+    /// `G10`, `G92`, `G92.1`, `G28.1`, `G30.1`, `G28`, `G30`: `target` is the block's axis
+    /// words as a machine position.
+    fn non_modal(&mut self, k: &Block, target: DVec3, scale: f64, e: &mut Effect) {
+        let axes = k.axes();
+        match k.non_modal {
+            Some(NonModal::SetCoord) => {
+                let p = k.get(b'P').unwrap_or(0.0) as usize;
+                let cs = if p == 0 { self.coord } else { p - 1 };
+                let mut c = self.coords[cs];
+                for i in 0..3 {
+                    if let Some(v) = axes[i] {
+                        c[i] = if k.get(b'L') == Some(20.0) {
+                            self.pos[i] - self.g92[i] - v * scale
+                        } else {
+                            v * scale
+                        };
+                    }
+                }
+                self.coords[cs] = c;
+                self.planner.stop();
+            }
+            Some(NonModal::SetOffset) => {
+                for (i, v) in axes.iter().enumerate() {
+                    if let Some(v) = v {
+                        self.g92[i] = self.pos[i] - self.coords[self.coord][i] - v * scale;
+                    }
+                }
+            }
+            Some(NonModal::ResetOffset) => self.g92 = DVec3::ZERO,
+            Some(NonModal::SetHome0) => self.g28 = self.pos,
+            Some(NonModal::SetHome1) => self.g30 = self.pos,
+            Some(h @ (NonModal::GoHome0 | NonModal::GoHome1)) => {
+                let home = if h == NonModal::GoHome0 {
+                    self.g28
+                } else {
+                    self.g30
+                };
+                let mut mid = self.pos;
+                for i in 0..3 {
+                    if axes[i].is_some() {
+                        mid[i] = target[i];
+                    }
+                }
+                e.add(self.line_to(mid, None));
+                e.add(self.line_to(home, None));
+            }
+            _ => {}
+        }
     }
 
     /// The work offset in effect (coordinate system, G92, tool length on Z).
