@@ -1,16 +1,20 @@
-//! What GRBL 1.1 says on the wire, shared by the streaming host ([`super::stream`]) and the
-//! simulated GRBL device ([`super::sim`]): the meaning of `error:N` and `ALARM:N`, the
-//! real-time command bytes, the receive-buffer size, and the parsing of a response line.
+//! What GRBL 1.1 and 0.9 say on the wire, shared by the streaming host ([`super::stream`]) and
+//! the simulated GRBL device ([`super::sim`]): the meaning of `error:N` and `ALARM:N`, the
+//! real-time command bytes, the receive-buffer size, the line-length rule, and the parsing of a
+//! response line.
 //!
 //! Source: the GRBL 1.1 wiki, "Interface" (messages, real-time commands, streaming protocols)
-//! and `grbl/doc/csv/error_codes_en_US.csv`, `alarm_codes_en_US.csv`. GRBL's serial receive
-//! buffer is 128 bytes (`RX_BUFFER_SIZE` in `serial.h`); a line may hold at most 80 characters
-//! (`LINE_BUFFER_SIZE`), more is `error:11`.
+//! and `grbl/doc/csv/error_codes_en_US.csv`, `alarm_codes_en_US.csv`; GRBL 0.9j's `report.c`
+//! for its text messages (`error: Unsupported command`, `ALARM: Abort during cycle`) and its
+//! status `<Idle,MPos:…,WPos:…>`. GRBL's serial receive buffer is 128 bytes (`RX_BUFFER_SIZE`
+//! in `serial.h`). Its line buffer (`LINE_BUFFER_SIZE` 80, `protocol.c`) keeps at most 79
+//! significant characters: spaces and control characters, `/`, `( … )` comments and what
+//! follows `;` are dropped as the line arrives and do not count; the 80th is `error:11`.
 
 /// GRBL's serial receive buffer, bytes.
 pub const RX_BUFFER: usize = 128;
-/// Longest line GRBL accepts, characters (without the newline).
-pub(crate) const LINE_MAX: usize = 80;
+/// GRBL's line-length rule, which the G-code writer keeps too.
+pub(crate) use crate::output::gcode::{significant_len, LINE_MAX};
 
 /// Real-time commands: picked out of the byte stream as they arrive, never buffered.
 pub(crate) const STATUS_QUERY: u8 = b'?';
@@ -20,6 +24,31 @@ pub(crate) const SOFT_RESET: u8 = 0x18;
 
 /// The welcome line GRBL prints after a reset.
 pub(crate) const WELCOME: &str = "Grbl 1.1h ['$' for help]";
+/// GRBL 0.9j's.
+pub(crate) const WELCOME_0_9: &str = "Grbl 0.9j ['$' for help]";
+
+/// GRBL 0.9j's text for an error code (`report.c`), the other way round from the reading.
+pub(crate) fn error_text_0_9(code: u32) -> String {
+    let t = match code {
+        1 => "Expected command letter",
+        2 => "Bad number format",
+        3 => "Invalid statement",
+        4 => "Value < 0",
+        5 => "Setting disabled",
+        6 => "Value < 3 usec",
+        7 => "EEPROM read fail. Using defaults",
+        8 => "Not idle",
+        9 => "Alarm lock",
+        10 => "Homing not enabled",
+        11 => "Line overflow",
+        12 => "Step rate > 30kHz",
+        20 => "Unsupported command",
+        21 => "Modal group violation",
+        22 => "Undefined feed rate",
+        _ => return format!("Invalid gcode ID:{code}"),
+    };
+    t.to_string()
+}
 
 /// GRBL 1.1's meaning of `error:N`.
 pub(crate) fn error_meaning(code: u32) -> &'static str {
@@ -80,44 +109,139 @@ pub(crate) fn alarm_meaning(code: u32) -> &'static str {
     }
 }
 
+/// The firmware generation, read off the welcome (`Grbl 1.1h […]`, `Grbl 0.9j […]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Version {
+    V1_1,
+    /// 0.9 and older: text errors and alarms, `<State,MPos:…>` status.
+    V0_9,
+}
+
+/// A status report: the state word and the machine position when given.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Status {
+    /// `Idle`, `Run`, `Hold:0`, `Hold`, `Alarm`, `Jog`, `Door:1`, `Queue` (0.9)…
+    pub state: String,
+    pub mpos: Option<[f64; 3]>,
+}
+
+impl Status {
+    /// Whether the state says the machine is busy with a job: running, or held (by the user or
+    /// an `M0`) and waiting to resume.
+    pub(crate) fn busy(&self) -> bool {
+        let s = self.state.as_str();
+        s == "Run" || s.starts_with("Hold") || s == "Jog" || s == "Queue" || s.starts_with("Door")
+    }
+}
+
 /// One line GRBL sends back.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Response {
     Ok,
     Error(u32),
+    /// GRBL 0.9's `error: <text>`.
+    ErrorText(String),
     Alarm(u32),
-    /// `<State|MPos:…|…>`: the machine state word (`Idle`, `Run`, `Hold:0`, `Alarm`, …).
-    Status(String),
+    /// GRBL 0.9's `ALARM: <text>`.
+    AlarmText(String),
+    /// `<State|MPos:…|…>` (1.1) or `<State,MPos:…,WPos:…>` (0.9).
+    Status(Status),
     /// The welcome message after a reset.
-    Welcome,
+    Welcome(Version),
     /// Anything else: `[MSG:…]`, `$` setting echoes, or garbage.
     Other(String),
 }
 
-/// Parse one response line (without its line ending).
+/// Parse one response line (without its line ending), of GRBL 1.1 or 0.9.
 pub(crate) fn parse_response(line: &str) -> Response {
     let line = line.trim();
     if line == "ok" {
         return Response::Ok;
     }
     if let Some(n) = line.strip_prefix("error:") {
-        if let Ok(n) = n.trim().parse() {
-            return Response::Error(n);
-        }
+        let n = n.trim();
+        return match n.parse() {
+            Ok(n) => Response::Error(n),
+            Err(_) if n.chars().next().is_some_and(|c| c.is_ascii_alphabetic()) => {
+                error_code_0_9(n).map_or(Response::ErrorText(n.to_string()), Response::Error)
+            }
+            Err(_) => Response::Other(line.to_string()),
+        };
     }
     if let Some(n) = line.strip_prefix("ALARM:") {
-        if let Ok(n) = n.trim().parse() {
-            return Response::Alarm(n);
-        }
+        let n = n.trim();
+        return match n.parse() {
+            Ok(n) => Response::Alarm(n),
+            Err(_) if n.chars().next().is_some_and(|c| c.is_ascii_alphabetic()) => {
+                alarm_code_0_9(n).map_or(Response::AlarmText(n.to_string()), Response::Alarm)
+            }
+            Err(_) => Response::Other(line.to_string()),
+        };
     }
     if let Some(body) = line.strip_prefix('<').and_then(|l| l.strip_suffix('>')) {
-        let state = body.split('|').next().unwrap_or("").to_string();
-        return Response::Status(state);
+        return Response::Status(parse_status(body));
     }
-    if line.starts_with("Grbl ") {
-        return Response::Welcome;
+    if let Some(v) = line.strip_prefix("Grbl ") {
+        return Response::Welcome(if v.starts_with("0.") {
+            Version::V0_9
+        } else {
+            Version::V1_1
+        });
     }
     Response::Other(line.to_string())
+}
+
+/// GRBL 0.9j's error text (`report.c`) as the status code it stands for, which 1.1 kept:
+/// 0.9's `STATUS_*` numbers are 1.1's `error:N`.
+fn error_code_0_9(text: &str) -> Option<u32> {
+    if let Some(n) = text.strip_prefix("Invalid gcode ID:") {
+        return n.trim().parse().ok();
+    }
+    Some(match text {
+        "Expected command letter" => 1,
+        "Bad number format" => 2,
+        "Invalid statement" => 3,
+        "Value < 0" => 4,
+        "Setting disabled" => 5,
+        "Value < 3 usec" => 6,
+        "EEPROM read fail. Using defaults" => 7,
+        "Not idle" => 8,
+        "Alarm lock" => 9,
+        "Homing not enabled" => 10,
+        "Line overflow" => 11,
+        "Step rate > 30kHz" => 12,
+        "Modal group violation" => 21,
+        "Unsupported command" => 20,
+        "Undefined feed rate" => 22,
+        _ => return None,
+    })
+}
+
+/// GRBL 0.9j's alarm text as 1.1's `ALARM:N`.
+fn alarm_code_0_9(text: &str) -> Option<u32> {
+    Some(match text {
+        "Hard limit" => 1,
+        "Soft limit" => 2,
+        "Abort during cycle" => 3,
+        "Probe fail" => 4,
+        "Homing fail" => 9,
+        _ => return None,
+    })
+}
+
+/// The inside of `<…>`: 1.1 separates fields with `|`, 0.9 with `,` (and its coordinates too).
+fn parse_status(body: &str) -> Status {
+    let state_end = body.find(['|', ',']).unwrap_or(body.len());
+    let state = body[..state_end].to_string();
+    let mpos = body.find("MPos:").and_then(|i| {
+        let v: Vec<f64> = body[i + 5..]
+            .split([',', '|'])
+            .take(3)
+            .map_while(|w| w.trim().parse().ok())
+            .collect();
+        (v.len() == 3).then(|| [v[0], v[1], v[2]])
+    });
+    Status { state, mpos }
 }
 
 #[cfg(test)]
@@ -131,10 +255,43 @@ mod tests {
         assert_eq!(parse_response("ALARM:3"), Response::Alarm(3));
         assert_eq!(
             parse_response("<Hold:0|MPos:1.000,2.000,0.000|FS:0,0>"),
-            Response::Status("Hold:0".into())
+            Response::Status(Status {
+                state: "Hold:0".into(),
+                mpos: Some([1.0, 2.0, 0.0])
+            })
         );
-        assert_eq!(parse_response(WELCOME), Response::Welcome);
-        assert_eq!(parse_response("error:x"), Response::Other("error:x".into()));
+        assert_eq!(
+            parse_response("<Idle,MPos:5.000,-2.500,1.000,WPos:5.000,-2.500,1.000>"),
+            Response::Status(Status {
+                state: "Idle".into(),
+                mpos: Some([5.0, -2.5, 1.0])
+            })
+        );
+        assert_eq!(parse_response(WELCOME), Response::Welcome(Version::V1_1));
+        assert_eq!(
+            parse_response("Grbl 0.9j ['$' for help]"),
+            Response::Welcome(Version::V0_9)
+        );
+        assert_eq!(
+            parse_response("error: Unsupported command"),
+            Response::Error(20)
+        );
+        assert_eq!(
+            parse_response("error: Invalid gcode ID:33"),
+            Response::Error(33)
+        );
+        assert_eq!(
+            parse_response("error: Something new"),
+            Response::ErrorText("Something new".into())
+        );
+        assert_eq!(
+            parse_response("ALARM: Abort during cycle"),
+            Response::Alarm(3)
+        );
+        assert_eq!(parse_response("error:x"), Response::ErrorText("x".into()));
+        assert_eq!(parse_response("error:#"), Response::Other("error:#".into()));
+        assert_eq!(significant_len("G1 X10 Y20 (a comment) ; rest"), 8);
+        assert_eq!(significant_len(&"G1 X1 ".repeat(20)), 80);
         assert!(error_meaning(22).contains("feed rate"));
         assert!(alarm_meaning(3).contains("reset while in motion"));
     }

@@ -23,16 +23,17 @@
 //! stroke (counted from the program's pen-up moves) and the byte or line.
 //!
 //! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
-//! GRBL status is polled with `?` at most five times a second while the bar is shown.
+//! GRBL's bar counts machine time and its status is polled with `?` five times a second while a
+//! job runs (`grbl_stream`).
 
 // A stream error carries the job position for the user; it happens at most once per job, so
 // its size on the error path does not matter.
 #![allow(clippy::result_large_err)]
 
-use super::grbl::{self as proto, Response};
+use super::grbl_stream::Grbl;
 use super::serial::Link;
 use super::sim::{Finish, SimConfig, SimError, SimReport, XOFF, XON};
-use crate::profile::{FlowControl, Language, Profile, Protocol};
+use crate::profile::{FlowControl, Language, Profile};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -175,13 +176,16 @@ pub enum StreamError {
     },
     #[error("{port}: GRBL did not answer the reset within {secs:.0} s: is it a GRBL controller at this baud rate?")]
     NoWelcome { port: String, secs: f64 },
-    #[error("{port}: line {line} is {len} characters, more than GRBL's {max}")]
+    #[error("{port}: line {line} has {len} significant characters (spaces and comments not counted), more than the {max} GRBL keeps; nothing was sent")]
     LineTooLong {
         port: String,
         line: usize,
         len: usize,
         max: usize,
     },
+    /// A controller setting does not suit the profile (nothing was sent).
+    #[error("{port}: {message}")]
+    Settings { port: String, message: String },
     #[error("{port}: stopped by Ctrl-C ({at}; {tool})")]
     Cancelled {
         port: String,
@@ -267,9 +271,9 @@ pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
     out
 }
 
-struct Bar {
-    bar: Option<indicatif::ProgressBar>,
-    starts: Vec<usize>,
+pub(crate) struct Bar {
+    pub(crate) bar: Option<indicatif::ProgressBar>,
+    pub(crate) starts: Vec<usize>,
 }
 
 impl Bar {
@@ -293,7 +297,7 @@ impl Bar {
         self.starts.partition_point(|&s| s < byte)
     }
 
-    fn set(&self, byte: usize, extra: &str) {
+    pub(crate) fn set(&self, byte: usize, extra: &str) {
         if let Some(b) = &self.bar {
             b.set_position(byte as u64);
             b.set_message(format!(
@@ -335,7 +339,7 @@ pub fn send(
     Ok(rep)
 }
 
-fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
+pub(crate) fn position(bar: &Bar, bytes: usize, total: usize) -> Position {
     Position {
         bytes,
         bytes_total: total,
@@ -565,7 +569,7 @@ fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
     out
 }
 
-enum Failure {
+pub(crate) enum Failure {
     Timeout(&'static str),
     HungUp(&'static str),
     Cancelled,
@@ -574,7 +578,13 @@ enum Failure {
 }
 
 impl Failure {
-    fn into_error(self, port: String, at: Position, tool: ToolState, t: Duration) -> StreamError {
+    pub(crate) fn into_error(
+        self,
+        port: String,
+        at: Position,
+        tool: ToolState,
+        t: Duration,
+    ) -> StreamError {
         match self {
             Failure::Timeout(op) => StreamError::Timeout {
                 port,
@@ -647,415 +657,6 @@ fn lift_hpgl(
     }
 }
 
-struct Grbl<'a> {
-    link: &'a mut Link,
-    profile: &'a Profile,
-    program: &'a [u8],
-    opts: &'a StreamOptions,
-    bar: &'a Bar,
-    port: String,
-    /// Lines to send: (byte offset after the line, text without its ending, 1-based line number
-    /// in the file). GRBL ends a line at `\n` or `\r`, so both split here.
-    lines: Vec<(usize, String, usize)>,
-    /// Lines in the file.
-    file_lines: usize,
-    /// Lines sent and not yet answered: (index into `lines`, bytes incl. newline).
-    pending: std::collections::VecDeque<(usize, usize)>,
-    in_flight: usize,
-    acked: usize,
-    acked_bytes: usize,
-    partial: Vec<u8>,
-    rep: StreamReport,
-    last_answer: Instant,
-    last_poll: Instant,
-    state: String,
-}
-
-enum Event {
-    Answer(Response),
-    Nothing,
-}
-
-impl<'a> Grbl<'a> {
-    fn new(
-        link: &'a mut Link,
-        profile: &'a Profile,
-        program: &'a [u8],
-        opts: &'a StreamOptions,
-        bar: &'a Bar,
-    ) -> Grbl<'a> {
-        let mut lines = Vec::new();
-        let mut at = 0;
-        let mut file_lines = 0;
-        for (n, l) in program.split(|&b| b == b'\n').enumerate() {
-            for part in l.split(|&b| b == b'\r') {
-                at += part.len() + 1;
-                let text = String::from_utf8_lossy(part).to_string();
-                if !text.trim().is_empty() {
-                    lines.push((at.min(program.len()), text, n + 1));
-                    file_lines = n + 1;
-                }
-            }
-        }
-        let port = link.name.clone();
-        Grbl {
-            link,
-            profile,
-            program,
-            opts,
-            bar,
-            port,
-            lines,
-            file_lines,
-            pending: Default::default(),
-            in_flight: 0,
-            acked: 0,
-            acked_bytes: 0,
-            partial: Vec::new(),
-            rep: StreamReport::default(),
-            last_answer: Instant::now(),
-            last_poll: Instant::now(),
-            state: String::new(),
-        }
-    }
-
-    fn position(&self) -> Position {
-        let bytes = self.acked_bytes;
-        let mut p = position(self.bar, bytes, self.program.len());
-        p.line = Some(self.acked);
-        p.lines_total = self.file_lines;
-        p
-    }
-
-    /// Read one answer line if there is one (waits at most the poll interval).
-    fn poll(&mut self) -> Result<Event, StreamError> {
-        if let Some(i) = self.partial.iter().position(|&b| b == b'\n') {
-            let line: Vec<u8> = self.partial.drain(..=i).collect();
-            let text = String::from_utf8_lossy(&line).trim().to_string();
-            if text.is_empty() {
-                return Ok(Event::Nothing);
-            }
-            let r = proto::parse_response(&text);
-            if let Response::Other(_) = &r {
-                self.rep.garbage_bytes += line.len();
-            }
-            return Ok(Event::Answer(r));
-        }
-        let mut buf = [0u8; 512];
-        match self.link.read_some(&mut buf) {
-            Ok(n) => {
-                self.partial.extend_from_slice(&buf[..n]);
-                if n > 0 && self.partial.contains(&b'\n') {
-                    return self.poll();
-                }
-                Ok(Event::Nothing)
-            }
-            Err(_) => Err(StreamError::HungUp {
-                port: self.port.clone(),
-                op: "while streaming G-code",
-                at: self.position(),
-                tool: ToolState::Unknown,
-            }),
-        }
-    }
-
-    fn write_all(&mut self, bytes: &[u8], op: &'static str) -> Result<(), StreamError> {
-        let mut sent = 0;
-        let t = Instant::now();
-        while sent < bytes.len() {
-            match self.link.write_some(&bytes[sent..]) {
-                Ok(k) => sent += k,
-                Err(_) => {
-                    return Err(StreamError::HungUp {
-                        port: self.port.clone(),
-                        op,
-                        at: self.position(),
-                        tool: ToolState::Unknown,
-                    })
-                }
-            }
-            if t.elapsed() > self.opts.timeout {
-                return Err(self.stop(Failure::Timeout(op)));
-            }
-        }
-        Ok(())
-    }
-
-    /// Reset the controller and wait for its welcome.
-    fn wake(&mut self) -> Result<(), StreamError> {
-        self.write_all(&[proto::SOFT_RESET], "resetting GRBL")?;
-        let deadline = Instant::now() + self.opts.wake_timeout;
-        let mut alarm = false;
-        let mut awake = false;
-        while Instant::now() < deadline {
-            match self.poll()? {
-                Event::Answer(Response::Welcome) => {
-                    awake = true;
-                    // Let the messages that follow the welcome arrive.
-                    std::thread::sleep(Duration::from_millis(20));
-                }
-                Event::Answer(Response::Alarm(_)) => alarm = true,
-                Event::Answer(Response::Other(m)) if m.contains("$X") => alarm = true,
-                Event::Answer(_) => {}
-                Event::Nothing if awake => break,
-                Event::Nothing => {}
-            }
-        }
-        if !awake {
-            return Err(StreamError::NoWelcome {
-                port: self.port.clone(),
-                secs: self.opts.wake_timeout.as_secs_f64(),
-            });
-        }
-        self.partial.clear();
-        if alarm {
-            // Locked by an alarm from before (e.g. reset during motion): unlock, and wait for
-            // the answer so that it is not taken for the first line's.
-            self.write_all(b"$X\n", "unlocking GRBL after an alarm")?;
-            let deadline = Instant::now() + self.opts.wake_timeout;
-            loop {
-                match self.poll()? {
-                    Event::Answer(Response::Ok) => break,
-                    Event::Answer(Response::Error(code)) => {
-                        return Err(StreamError::Grbl {
-                            port: self.port.clone(),
-                            code,
-                            meaning: proto::error_meaning(code),
-                            line: 0,
-                            text: "$X (unlock after an alarm)".into(),
-                            at: self.position(),
-                            tool: ToolState::Unknown,
-                        })
-                    }
-                    _ if Instant::now() > deadline => {
-                        return Err(StreamError::NoWelcome {
-                            port: self.port.clone(),
-                            secs: self.opts.wake_timeout.as_secs_f64(),
-                        })
-                    }
-                    _ => {}
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn handle(&mut self, r: Response) -> Result<(), StreamError> {
-        // Only answers to lines count as progress: a controller that reports its status but
-        // never takes another line (stuck in Hold) must still time out.
-        if matches!(r, Response::Ok | Response::Error(_) | Response::Alarm(_)) {
-            self.last_answer = Instant::now();
-        }
-        match r {
-            Response::Ok => {
-                if let Some((i, len)) = self.pending.pop_front() {
-                    self.in_flight -= len;
-                    self.acked = self.lines[i].2;
-                    self.acked_bytes = self.lines[i].0;
-                    self.rep.lines += 1;
-                }
-                Ok(())
-            }
-            Response::Error(code) => {
-                let (i, len) = self.pending.pop_front().unwrap_or((self.acked, 0));
-                self.in_flight = self.in_flight.saturating_sub(len);
-                let text = self.lines.get(i).map(|l| l.1.clone()).unwrap_or_default();
-                let line_no = self.lines.get(i).map_or(i + 1, |l| l.2);
-                let tool = self.lift();
-                Err(StreamError::Grbl {
-                    port: self.port.clone(),
-                    code,
-                    meaning: proto::error_meaning(code),
-                    line: line_no,
-                    text,
-                    at: self.position(),
-                    tool,
-                })
-            }
-            Response::Alarm(code) => {
-                let tool = self.lift();
-                Err(StreamError::Alarm {
-                    port: self.port.clone(),
-                    code,
-                    meaning: proto::alarm_meaning(code),
-                    at: self.position(),
-                    tool,
-                })
-            }
-            Response::Status(s) => {
-                self.state = s;
-                Ok(())
-            }
-            Response::Welcome => {
-                // The controller reset under us: everything in flight is lost.
-                Err(StreamError::HungUp {
-                    port: self.port.clone(),
-                    op: "while streaming G-code (GRBL reset itself)",
-                    at: self.position(),
-                    tool: ToolState::Unknown,
-                })
-            }
-            Response::Other(_) => Ok(()),
-        }
-    }
-
-    /// Stop the job: the tool goes up, and the error says where the job was.
-    fn stop(&mut self, f: Failure) -> StreamError {
-        let tool = self.lift();
-        f.into_error(self.port.clone(), self.position(), tool, self.opts.timeout)
-    }
-
-    /// Feed hold, wait for the hold, soft reset, wait for the welcome, then the tool-up
-    /// command of the profile's cut tool.
-    fn lift(&mut self) -> ToolState {
-        if self.link.write_some(&[proto::FEED_HOLD]).is_err() {
-            return ToolState::Unknown;
-        }
-        let deadline = Instant::now() + Duration::from_secs(2);
-        let mut last_q = Instant::now() - Duration::from_secs(1);
-        while Instant::now() < deadline {
-            if last_q.elapsed() > Duration::from_millis(200) {
-                if self.link.write_some(&[proto::STATUS_QUERY]).is_err() {
-                    return ToolState::Unknown;
-                }
-                last_q = Instant::now();
-            }
-            match self.poll() {
-                Ok(Event::Answer(Response::Status(s))) if s == "Hold:0" || s == "Idle" => break,
-                Ok(_) => {}
-                Err(_) => return ToolState::Unknown,
-            }
-        }
-        if self.link.write_some(&[proto::SOFT_RESET]).is_err() {
-            return ToolState::Unknown;
-        }
-        let deadline = Instant::now() + Duration::from_secs(3);
-        let mut awake = false;
-        let mut alarm = false;
-        while Instant::now() < deadline {
-            match self.poll() {
-                Ok(Event::Answer(Response::Welcome)) => awake = true,
-                Ok(Event::Answer(Response::Alarm(_))) => alarm = true,
-                Ok(Event::Nothing) if awake => break,
-                Ok(_) => {}
-                Err(_) => return ToolState::Unknown,
-            }
-        }
-        if !awake {
-            return ToolState::Unknown;
-        }
-        let mut up = String::new();
-        if alarm {
-            up.push_str("$X\n");
-        }
-        if let Some(t) = self.profile.tool(crate::profile::StrokeKind::Cut) {
-            if let Some(z) = t.z_up {
-                up.push_str(&format!("G0 Z{}\n", crate::output::fmt_mm(z)));
-            } else if let Some(s) = t.servo_up {
-                up.push_str(&format!("M3 S{}\n", crate::output::fmt_mm(s)));
-            }
-        }
-        up.push_str("M5\n");
-        let bytes = up.as_bytes();
-        let mut sent = 0;
-        let deadline = Instant::now() + Duration::from_secs(2);
-        while sent < bytes.len() {
-            match self.link.write_some(&bytes[sent..]) {
-                Ok(k) => sent += k,
-                Err(_) => return ToolState::Unknown,
-            }
-            if Instant::now() > deadline {
-                return ToolState::Unknown;
-            }
-        }
-        let _ = self.link.flush();
-        // Wait for the answers so the command is known to be taken.
-        let want = up.lines().count();
-        let mut got = 0;
-        let deadline = Instant::now() + Duration::from_secs(3);
-        while got < want && Instant::now() < deadline {
-            match self.poll() {
-                Ok(Event::Answer(Response::Ok)) => got += 1,
-                Ok(Event::Answer(Response::Error(_))) => return ToolState::Unknown,
-                Ok(_) => {}
-                Err(_) => return ToolState::Unknown,
-            }
-        }
-        if got == want {
-            ToolState::Lifted
-        } else {
-            ToolState::Unknown
-        }
-    }
-
-    fn run(mut self) -> Result<StreamReport, StreamError> {
-        self.wake()?;
-        let limit = match self.profile.protocol {
-            Protocol::GrblSendResponse => 1,
-            _ => self.profile.buffer.clamp(1, 1 << 20),
-        };
-        let send_response = self.profile.protocol == Protocol::GrblSendResponse;
-        let mut next = 0;
-        self.last_answer = Instant::now();
-        while next < self.lines.len() || !self.pending.is_empty() {
-            if self.opts.cancel.load(Ordering::SeqCst) {
-                return Err(self.stop(Failure::Cancelled));
-            }
-            // Send what fits.
-            if next < self.lines.len() {
-                let text = self.lines[next].1.clone();
-                if text.len() > proto::LINE_MAX {
-                    return Err(StreamError::LineTooLong {
-                        port: self.port.clone(),
-                        line: self.lines[next].2,
-                        len: text.len(),
-                        max: proto::LINE_MAX,
-                    });
-                }
-                let len = text.len() + 1;
-                let system = text.trim_start().starts_with('$');
-                let fits = if send_response || system {
-                    self.pending.is_empty()
-                } else {
-                    (self.pending.is_empty() || self.in_flight + len <= limit)
-                        && !self
-                            .pending
-                            .front()
-                            .is_some_and(|&(i, _)| self.lines[i].1.trim_start().starts_with('$'))
-                };
-                if fits {
-                    let mut bytes = text.into_bytes();
-                    bytes.push(b'\n');
-                    self.write_all(&bytes, "sending G-code")?;
-                    self.pending.push_back((next, len));
-                    self.in_flight += len;
-                    next += 1;
-                    continue;
-                }
-            }
-            // Wait for an answer.
-            match self.poll()? {
-                Event::Answer(r) => self.handle(r)?,
-                Event::Nothing => {
-                    if self.last_answer.elapsed() > self.opts.timeout {
-                        return Err(self.stop(Failure::Timeout(
-                            "waiting for GRBL to answer `ok` (the controller went silent)",
-                        )));
-                    }
-                }
-            }
-            if self.bar.bar.is_some() && self.last_poll.elapsed() > Duration::from_millis(200) {
-                self.last_poll = Instant::now();
-                self.write_all(&[proto::STATUS_QUERY], "asking GRBL for its status")?;
-                let state = format!(" {}", self.state);
-                self.bar.set(self.acked_bytes, &state);
-            }
-        }
-        let _ = self.link.flush();
-        self.rep.bytes = self.program.len();
-        Ok(self.rep)
-    }
-}
 /// Stream `program` through a pseudo-terminal into a new simulator set up by `cfg`, exactly
 /// as flatcut's transport streams to a real port (CTS read from the simulator's flag), then let
 /// the simulated machine work off what it holds, as a real one would: while it makes progress,

@@ -13,13 +13,13 @@
 //!   G0 Z2        (if not up)     M3 S30    } (if not up)
 //!                                G4 P0.15  }
 //!   G0 X10 Y10   travel          G0 X10 Y10                    G0 X10 Y10
-//!   G1 Z-1 F1200 plunge          M3 S90                        M4 S1000
+//!   G1 Z-1 F1200 plunge          M3 S90                        M4 S1000  (first stroke only)
 //!                                G4 P0.15
-//!   G1 X20 Y10   cut             G1 X20 Y10 F3000              G1 X20 Y10 F300
+//!   G1 X20 Y10   cut             G1 X20 Y10 F3000              G1 X20 Y10 F300 (S when it changes)
 //!   G1 X20 Y20                   G1 X20 Y20                    G1 X20 Y20
-//!   G0 Z2        lift            M3 S30                        M5
+//!   G0 Z2        lift            M3 S30                        (nothing: G0 is beam off)
 //!                                G4 P0.15
-//! M5                       spindle / laser off (not repeated right after a laser's M5)
+//! M5                       spindle / laser off
 //! <profile end lines>      verbatim
 //! M2                       program end
 //! ```
@@ -28,8 +28,8 @@
 //! parser): `G21`/`G90`/`G94` modal states, `G0`/`G1` with a modal `F` in mm/min, `G4 P` in
 //! seconds, `M3`/`M4`/`M5` with `S`, `M2` program end; laser mode (`doc/markdown/laser_mode.md`):
 //! `M4 S` is dynamic power, the beam is only on during `G1`; GRBL's line buffer
-//! (`LINE_BUFFER_SIZE` 80 in `grbl/config.h`: a line of 80 characters or more overflows), so
-//! no line here has more than [`LINE_MAX`] characters before its newline.
+//! (`LINE_BUFFER_SIZE` 80 in `grbl/protocol.h`: 80 significant characters or more overflow),
+//! so no line here has more than [`LINE_MAX`] significant characters.
 //!
 //! Choices where the documents are silent:
 //! - Coordinates: every point goes through [`super::to_device`] (axes and units per
@@ -51,15 +51,48 @@
 //!   later strokes start with it up, since every stroke ends with a lift.
 //! - `passes`: a closed stroke (its last point, after rounding, is its first) goes round again
 //!   without lifting; an open one is lifted, moved back to its start and cut again.
+//! - Laser: GRBL's laser mode (`$32=1`, which the streamer checks at connect) keeps the beam
+//!   off during `G0` and scales `M4` power with the actual speed, and it changes `S` on a
+//!   `G1` without stopping; `M4` and `M5` stop the machine until the planner is empty. So the
+//!   beam is turned on once, `M4 S<power>` before the first laser stroke, a stroke of another
+//!   power carries its `S` on its first `G1`, travel is `G0`, and `M5` comes once at the end.
 //! - The end: the tool is up after the last stroke's lift; then `M5` (once), the profile's
 //!   `end` lines, `M2`.
+//! - Every line (and every profile `init`/`end` line) has at most [`LINE_MAX`] significant
+//!   characters, GRBL's limit (spaces and comments not counted).
 
 use super::{device_points, fmt_mm, line_error, one_line, stroke_tool, tool_error, OutputError};
 use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 
-/// Most characters on one line, newline not counted (GRBL's line buffer holds 79).
+/// Most significant characters on one line ([`significant_len`]): GRBL's line buffer
+/// (`LINE_BUFFER_SIZE` 80, `protocol.c`) keeps 79 and answers the 80th with `error:11`.
 pub(crate) const LINE_MAX: usize = 79;
+
+/// The characters of `line` that GRBL's line reader keeps (1.1h and 0.9j `protocol.c`):
+/// not whitespace or control characters, not `/`, nothing inside `( … )` or after `;`.
+pub(crate) fn significant_len(line: &str) -> usize {
+    let mut n = 0;
+    let (mut paren, mut semi) = (false, false);
+    for c in line.bytes() {
+        if c == b'\n' || c == b'\r' {
+            break;
+        }
+        if paren || semi {
+            if c == b')' {
+                paren = false;
+            }
+            continue;
+        }
+        match c {
+            0..=b' ' | b'/' => {}
+            b'(' => paren = true,
+            b';' => semi = true,
+            _ => n += 1,
+        }
+    }
+    n
+}
 /// Largest coordinate magnitude, mm.
 pub(crate) const LIMIT_MM: f64 = 100_000.0;
 /// Seconds to wait after a servo move when the tool does not say.
@@ -171,7 +204,11 @@ struct Writer {
     z: Option<String>,
     /// Last servo `M3 S` value commanded.
     servo: Option<String>,
+    /// `M4` has been sent (laser mode: the beam follows `G1`/`G0` from then on).
     laser_on: bool,
+    /// Laser power in effect (`S`), and the power the next cut should carry when it differs.
+    s: Option<String>,
+    want_s: Option<String>,
     /// Feed in effect.
     feed: Option<String>,
 }
@@ -193,7 +230,6 @@ impl Writer {
         match a {
             Action::Knife { up, .. } if self.z.as_ref() != Some(up) => self.lift(a),
             Action::Servo { up, .. } if self.servo.as_ref() != Some(up) => self.lift(a),
-            Action::Laser { .. } if self.laser_on => self.lift(a),
             _ => {}
         }
     }
@@ -205,10 +241,8 @@ impl Writer {
                 self.z = Some(up.clone());
             }
             Action::Servo { up, dwell, .. } => self.servo_to(up, dwell),
-            Action::Laser { .. } => {
-                self.line("M5");
-                self.laser_on = false;
-            }
+            // Laser mode: the G0 that follows turns the beam off.
+            Action::Laser { .. } => {}
         }
     }
 
@@ -220,20 +254,30 @@ impl Writer {
                 self.feed = Some(feed.to_string());
             }
             Action::Servo { down, dwell, .. } => self.servo_to(down, dwell),
-            Action::Laser { power } => {
+            Action::Laser { power } if !self.laser_on => {
                 self.line(&format!("M4 S{power}"));
                 self.laser_on = true;
+                self.s = Some(power.clone());
+            }
+            Action::Laser { power } => {
+                if self.s.as_ref() != Some(power) {
+                    self.want_s = Some(power.clone());
+                }
             }
         }
     }
 
     fn cut_to(&mut self, (x, y): &(String, String), feed: &str) {
-        if self.feed.as_deref() == Some(feed) {
-            self.line(&format!("G1 X{x} Y{y}"));
-        } else {
-            self.line(&format!("G1 X{x} Y{y} F{feed}"));
+        let mut l = format!("G1 X{x} Y{y}");
+        if self.feed.as_deref() != Some(feed) {
+            l.push_str(&format!(" F{feed}"));
             self.feed = Some(feed.to_string());
         }
+        if let Some(s) = self.want_s.take() {
+            l.push_str(&format!(" S{s}"));
+            self.s = Some(s);
+        }
+        self.line(&l);
     }
 }
 
@@ -244,12 +288,12 @@ fn profile_line<'a>(
     line: &'a str,
 ) -> Result<&'a str, OutputError> {
     let t = one_line(profile, which, line, "block")?;
-    if t.chars().count() > LINE_MAX {
+    if significant_len(t) > LINE_MAX {
         return Err(line_error(
             profile,
             which,
             line,
-            format!("longer than GRBL's {LINE_MAX} characters"),
+            format!("more than the {LINE_MAX} significant characters GRBL keeps (spaces and comments not counted)"),
         ));
     }
     Ok(t)
@@ -410,8 +454,8 @@ mod tests {
         assert_eq!(
             t,
             "G21\nG90\nG94\nM9\n\
-             G0 X1 Y1\nM4 S150\nG1 X2 Y1 F2000\nM5\n\
-             G0 X10 Y10\nM4 S1000\nG1 X20 Y10 F300\nG1 X20 Y20\nG1 X10 Y10\n\
+             G0 X1 Y1\nM4 S150\nG1 X2 Y1 F2000\n\
+             G0 X10 Y10\nG1 X20 Y10 F300 S1000\nG1 X20 Y20\nG1 X10 Y10\n\
              G1 X20 Y10\nG1 X20 Y20\nG1 X10 Y10\nM5\n\
              G0 X0 Y0\nM2\n"
         );
@@ -449,9 +493,14 @@ mod tests {
             (t.z_down, t.z_up) = (Some(2.0), Some(1.0));
         });
         assert!(e.contains("below"), "{e}");
-        let long = format!("init=['G4 P0 ({})']\n{KNIFE}", "x".repeat(80));
+        // A comment and spaces do not count towards GRBL's 79; 80 significant characters do.
+        let spaced = format!("init=['G4 P0 ({})']\n{KNIFE}", "x".repeat(80));
+        assert!(emit(&job, &profile(&spaced)).is_ok());
+        let long = format!("init=['G4 P0{}']\n{KNIFE}", "0".repeat(76));
         let e = emit(&job, &profile(&long)).unwrap_err().to_string();
         assert!(e.contains("init line") && e.contains("79"), "{e}");
+        let fits = format!("init=['G4 P0{}']\n{KNIFE}", "0".repeat(75));
+        assert!(emit(&job, &profile(&fits)).is_ok());
         let far = sheet(vec![stroke(StrokeRole::Cut, &[(0.0, 0.0), (2e5, 0.0)])]);
         let e = emit(&far, &profile(KNIFE))
             .unwrap_err()

@@ -19,10 +19,12 @@
 //! `tools.rs` the tool table and the stroke kinds it maps ([`StrokeKind`]); `serial.rs` the
 //! serial line settings and the streaming protocol.
 
+mod grbl;
 mod read;
 mod serial;
 mod tools;
 
+pub use grbl::GrblMachine;
 pub use read::parse;
 pub use serial::{FlowControl, Parity, Protocol, SerialSettings};
 pub use tools::DEFAULT_PERFORATION;
@@ -179,6 +181,9 @@ pub struct Profile {
     /// (default 0).
     #[serde(default)]
     pub overcut: f64,
+    /// GRBL: the controller's version and motion settings (`[grbl]`, see [`GrblMachine`]).
+    #[serde(default)]
+    pub grbl: GrblMachine,
     /// Commands sent before and after the job, verbatim.
     #[serde(default)]
     pub init: Vec<String>,

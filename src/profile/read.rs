@@ -50,6 +50,7 @@ pub(super) fn positive(v: f64) -> bool {
 
 /// The checks of [`parse`] on a profile that deserialised.
 fn check(p: &Profile) -> Result<(), Problem> {
+    super::grbl::check(&p.grbl).map_err(|(key, m)| problem("grbl", key, m))?;
     if !positive(p.units_per_mm) {
         return Err(problem(
             "",

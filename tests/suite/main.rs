@@ -14,6 +14,7 @@ mod device;
 mod fandisk;
 mod fuzz;
 mod gpgl;
+mod grbl_firmware;
 mod house;
 mod knife;
 mod nest;

@@ -34,6 +34,8 @@
 
 pub(crate) mod gpgl;
 pub mod grbl;
+mod grbl_block;
+mod grbl_system;
 pub(crate) mod hpgl;
 pub(crate) mod record;
 
@@ -370,6 +372,8 @@ impl Line {
     }
 }
 
+// One interpreter per simulator: the size of the enum does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Interp {
     Hpgl(hpgl::Hpgl),
     Grbl(grbl::Grbl),
@@ -401,6 +405,10 @@ struct Device {
     /// Remaining seconds (real time) of each queued motion.
     motion: VecDeque<f64>,
     held: bool,
+    /// GRBL: an `ok` (and maybe a pause) owed once the planner is empty (after a `G4`).
+    owed_ok: Option<bool>,
+    /// GRBL: `M0` holds its `ok` until cycle start.
+    ok_on_resume: bool,
     grbl_lines: usize,
     garbage_sent: bool,
     stalled: bool,
@@ -470,6 +478,8 @@ impl Device {
             backlog_at_grace: None,
             motion: VecDeque::new(),
             held: false,
+            owed_ok: None,
+            ok_on_resume: false,
             grbl_lines: 0,
             garbage_sent: false,
             stalled: false,
@@ -661,6 +671,9 @@ impl Device {
                 }
                 proto::CYCLE_START => {
                     self.held = false;
+                    if std::mem::take(&mut self.ok_on_resume) {
+                        self.out.extend_from_slice(b"ok\r\n");
+                    }
                     return;
                 }
                 proto::SOFT_RESET => {
@@ -668,18 +681,15 @@ impl Device {
                     self.rx.clear();
                     self.motion.clear();
                     self.held = false;
+                    self.owed_ok = None;
+                    self.ok_on_resume = false;
                     g.reset();
                     if in_motion {
                         g.alarm = true;
                         self.rep.alarms.push(3);
-                        self.out.extend_from_slice(b"ALARM:3\r\n");
                     }
-                    self.out.extend_from_slice(b"\r\n");
-                    self.out.extend_from_slice(proto::WELCOME.as_bytes());
-                    self.out.extend_from_slice(b"\r\n");
-                    if g.alarm {
-                        self.out.extend_from_slice(b"[MSG:'$H'|'$X' to unlock]\r\n");
-                    }
+                    let welcome = welcome(g, in_motion);
+                    self.out.extend_from_slice(welcome.as_bytes());
                     return;
                 }
                 _ => {}
@@ -714,10 +724,7 @@ impl Device {
     }
 
     fn scaled(&self, seconds: f64) -> Option<f64> {
-        match self.cfg.time_factor {
-            Some(f) if f > 0.0 && seconds > 0.0 => Some(seconds / f),
-            _ => None,
-        }
+        scale_time(self.cfg.time_factor, seconds)
     }
 
     fn execute(&mut self) {
@@ -759,58 +766,108 @@ impl Device {
                         self.motion.push_back(s);
                     }
                 }
-                Interp::Grbl(g) => {
-                    if self.held || self.motion.len() >= PLANNER_BLOCKS {
+                Interp::Grbl(_) => {
+                    if !self.execute_grbl() {
                         return;
-                    }
-                    let Some(end) = self.rx.iter().position(|&b| b == b'\n' || b == b'\r') else {
-                        return;
-                    };
-                    let raw: Vec<u8> = self.rx.drain(..=end).collect();
-                    let line = String::from_utf8_lossy(&raw[..end]).to_string();
-                    // `$` commands wait for the planner to empty.
-                    if line.trim_start().starts_with('$') && !self.motion.is_empty() {
-                        let mut back = raw;
-                        while let Some(b) = back.pop() {
-                            self.rx.push_front(b);
-                        }
-                        return;
-                    }
-                    self.grbl_lines += 1;
-                    let injected = self
-                        .cfg
-                        .faults
-                        .grbl_error
-                        .filter(|(k, _)| *k == self.grbl_lines)
-                        .map(|(_, c)| c);
-                    let result = match injected {
-                        Some(c) => Err(c),
-                        None => g.execute(&line),
-                    };
-                    match result {
-                        Ok(grbl::Effect::Motion(t)) => {
-                            self.rep.simulated_time_s += t;
-                            if let Some(s) = self.scaled(t) {
-                                self.motion.push_back(s);
-                            }
-                            self.out.extend_from_slice(b"ok\r\n");
-                        }
-                        Ok(grbl::Effect::Text(lines)) => {
-                            for l in lines {
-                                self.out.extend_from_slice(l.as_bytes());
-                                self.out.extend_from_slice(b"\r\n");
-                            }
-                            self.out.extend_from_slice(b"ok\r\n");
-                        }
-                        Err(code) => {
-                            self.rep.errors_sent.push((self.grbl_lines, code));
-                            self.out
-                                .extend_from_slice(format!("error:{code}\r\n").as_bytes());
-                        }
                     }
                 }
             }
         }
+    }
+
+    /// Take one GRBL line off the buffer and answer it; false when nothing more can run now.
+    fn execute_grbl(&mut self) -> bool {
+        let tf = self.cfg.time_factor;
+        let Interp::Grbl(g) = &mut self.interp else {
+            return false;
+        };
+        if self.held || self.motion.len() >= PLANNER_BLOCKS {
+            return false;
+        }
+        if let Some(pause) = self.owed_ok {
+            // GRBL's main loop is in the dwell: nothing else is read until it ends.
+            if !self.motion.is_empty() {
+                return false;
+            }
+            self.owed_ok = None;
+            if pause {
+                self.held = true;
+                self.ok_on_resume = true;
+            } else {
+                self.out.extend_from_slice(b"ok\r\n");
+            }
+        }
+        let Some(end) = self.rx.iter().position(|&b| b == b'\n' || b == b'\r') else {
+            return false;
+        };
+        let line = String::from_utf8_lossy(&self.rx.iter().take(end).copied().collect::<Vec<u8>>())
+            .to_string();
+        // Sync commands wait (their line stays in the buffer) until the planner is empty.
+        if !self.motion.is_empty() && g.needs_sync(&line) {
+            return false;
+        }
+        self.rx.drain(..=end);
+        if self.motion.is_empty() && self.cfg.time_factor.is_some() {
+            g.planner.stop();
+        }
+        self.grbl_lines += 1;
+        let injected = self
+            .cfg
+            .faults
+            .grbl_error
+            .filter(|(k, _)| *k == self.grbl_lines)
+            .map(|(_, c)| c);
+        let busy = !self.motion.is_empty();
+        let result = match injected {
+            Some(c) => Err(c),
+            None => g.execute(&line, busy),
+        };
+        match result {
+            Ok(e) => {
+                self.rep.simulated_time_s += e.seconds + e.correction + e.dwell.unwrap_or(0.0);
+                if let Some(c) = scale_time(tf, -e.correction) {
+                    if let Some(back) = self.motion.back_mut() {
+                        *back = (*back - c).max(0.0);
+                    }
+                }
+                if let Some(s) = scale_time(tf, e.seconds) {
+                    self.motion.push_back(s);
+                }
+                for l in &e.text {
+                    self.out.extend_from_slice(l.as_bytes());
+                    self.out.extend_from_slice(b"\r\n");
+                }
+                if let Some(d) = e.dwell {
+                    if let Some(s) = scale_time(tf, d) {
+                        self.motion.push_back(s);
+                    }
+                    self.owed_ok = Some(e.pause);
+                    return true;
+                }
+                if e.pause {
+                    // GRBL holds in the middle of the line: its `ok` comes after cycle start.
+                    self.held = true;
+                    self.ok_on_resume = true;
+                } else {
+                    self.out.extend_from_slice(b"ok\r\n");
+                }
+                if e.reset {
+                    g.reset();
+                    let w = welcome(g, false);
+                    self.out.extend_from_slice(w.as_bytes());
+                }
+            }
+            Err(code) => {
+                self.rep.errors_sent.push((self.grbl_lines, code));
+                let msg = if g.v0_9 {
+                    format!("error: {}\r\n", proto::error_text_0_9(code))
+                } else {
+                    format!("error:{code}\r\n")
+                };
+                self.out.extend_from_slice(msg.as_bytes());
+            }
+        }
+        true
     }
 
     fn flow_control(&mut self) {
@@ -902,6 +959,42 @@ impl Device {
         let _ = self.slave.take();
         self.rep
     }
+}
+
+/// Real seconds of `seconds` of machine time at time factor `tf` (`None`: motion takes none).
+fn scale_time(tf: Option<f64>, seconds: f64) -> Option<f64> {
+    match tf {
+        Some(f) if f > 0.0 && seconds > 0.0 => Some(seconds / f),
+        _ => None,
+    }
+}
+
+/// What GRBL prints after a reset: the alarm when it was reset in motion, the welcome, the
+/// unlock hint (1.1 or 0.9 words, by the profile).
+fn welcome(g: &grbl::Grbl, alarm: bool) -> String {
+    let mut s = String::new();
+    if alarm {
+        s.push_str(if g.v0_9 {
+            "ALARM: Abort during cycle\r\n"
+        } else {
+            "ALARM:3\r\n"
+        });
+    }
+    s.push_str("\r\n");
+    s.push_str(if g.v0_9 {
+        proto::WELCOME_0_9
+    } else {
+        proto::WELCOME
+    });
+    s.push_str("\r\n");
+    if g.alarm {
+        s.push_str(if g.v0_9 {
+            "['$H'|'$X' to unlock]\r\n"
+        } else {
+            "[MSG:'$H'|'$X' to unlock]\r\n"
+        });
+    }
+    s
 }
 
 /// Draw what the simulator cut, in the machine's axes (mm), and write `<stem>.png` and
