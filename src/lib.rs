@@ -63,12 +63,18 @@
 //!   mod.rs                     Device stage
 //!   check.rs                   Checking an HP-GL program before its first byte goes out
 //!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host (`super::stream`) and the simulate…
+//!   motion.rs                  How long a GRBL machine takes for its moves (trapezoidal speed profiles)
 //!   serial.rs                  The serial transport
-//!   stream.rs                  Streaming a program into a device without ever overrunning it
+//!   stream/
+//!     mod.rs                   Streaming a program into a device without ever overrunning it
+//!     grbl.rs                  GRBL streaming: character counting and send-response, status polling
 //!   sim/
 //!     mod.rs                   The simulated cutter
 //!     gpgl.rs                  The simulated cutter's GP-GL interpreter (Graphtec cutters in native mode)
-//!     grbl.rs                  The simulated cutter's GRBL 1.1 interpreter
+//!     grbl/
+//!       mod.rs                 The simulated cutter's GRBL interpreter, as GRBL 1.1h answers
+//!       system.rs              The simulated GRBL's `$` commands and settings
+//!     grbl_block.rs            Reading one G-code block as GRBL 1.1h's `gc_execute_line` does
 //!     hpgl.rs                  The simulated cutter's HP-GL interpreter
 //!     record.rs                What the simulated cutter remembers of a job
 //! flatten/

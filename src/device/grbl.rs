@@ -14,7 +14,7 @@
 /// GRBL's serial receive buffer, bytes.
 pub const RX_BUFFER: usize = 128;
 /// GRBL's line-length rule, which the G-code writer keeps too.
-pub(crate) use crate::output::gcode::{significant_len, LINE_MAX};
+pub(crate) use crate::profile::{significant_len, LINE_MAX};
 
 /// Real-time commands: picked out of the byte stream as they arrive, never buffered.
 pub(crate) const STATUS_QUERY: u8 = b'?';

@@ -1,5 +1,5 @@
 //! Device stage: how a program reaches a machine ([`check`] of a program before it is sent,
-//! [`serial`] transport, [`stream`] protocols (GRBL streaming in `grbl_stream`)
+//! [`serial`] transport, [`stream`] protocols (GRBL streaming in `stream::grbl`)
 //! with flow control and GRBL character counting, [`grbl`] protocol knowledge), and the
 //! simulated cutter on a pseudo-terminal ([`sim`]) that stands in for a machine. What flatcut
 //! knows about each machine (language, units, serial settings, tool table) is
@@ -7,7 +7,6 @@
 
 pub mod check;
 pub mod grbl;
-mod grbl_stream;
 pub(crate) mod motion;
 pub mod serial;
 pub mod sim;

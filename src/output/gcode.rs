@@ -62,37 +62,9 @@
 //!   characters, GRBL's limit (spaces and comments not counted).
 
 use super::{device_points, fmt_mm, line_error, one_line, stroke_tool, tool_error, OutputError};
-use crate::profile::{Profile, Tool};
+use crate::profile::{significant_len, Profile, Tool, LINE_MAX};
 use crate::toolpath::SheetJob;
 
-/// Most significant characters on one line ([`significant_len`]): GRBL's line buffer
-/// (`LINE_BUFFER_SIZE` 80, `protocol.c`) keeps 79 and answers the 80th with `error:11`.
-pub(crate) const LINE_MAX: usize = 79;
-
-/// The characters of `line` that GRBL's line reader keeps (1.1h and 0.9j `protocol.c`):
-/// not whitespace or control characters, not `/`, nothing inside `( … )` or after `;`.
-pub(crate) fn significant_len(line: &str) -> usize {
-    let mut n = 0;
-    let (mut paren, mut semi) = (false, false);
-    for c in line.bytes() {
-        if c == b'\n' || c == b'\r' {
-            break;
-        }
-        if paren || semi {
-            if c == b')' {
-                paren = false;
-            }
-            continue;
-        }
-        match c {
-            0..=b' ' | b'/' => {}
-            b'(' => paren = true,
-            b';' => semi = true,
-            _ => n += 1,
-        }
-    }
-    n
-}
 /// Largest coordinate magnitude, mm.
 pub(crate) const LIMIT_MM: f64 = 100_000.0;
 /// Seconds to wait after a servo move when the tool does not say.

@@ -10,6 +10,35 @@
 
 use serde::Deserialize;
 
+/// Most significant characters on one line ([`significant_len`]): GRBL's line buffer
+/// (`LINE_BUFFER_SIZE` 80, `protocol.c`) keeps 79 and answers the 80th with `error:11`.
+pub const LINE_MAX: usize = 79;
+
+/// The characters of `line` that GRBL's line reader keeps (1.1h and 0.9j `protocol.c`):
+/// not whitespace or control characters, not `/`, nothing inside `( … )` or after `;`.
+pub fn significant_len(line: &str) -> usize {
+    let mut n = 0;
+    let (mut paren, mut semi) = (false, false);
+    for c in line.bytes() {
+        if c == b'\n' || c == b'\r' {
+            break;
+        }
+        if paren || semi {
+            if c == b')' {
+                paren = false;
+            }
+            continue;
+        }
+        match c {
+            0..=b' ' | b'/' => {}
+            b'(' => paren = true,
+            b';' => semi = true,
+            _ => n += 1,
+        }
+    }
+    n
+}
+
 /// `[grbl]`: the controller's settings as the machine has them.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]

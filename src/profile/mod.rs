@@ -20,6 +20,7 @@
 //! serial line settings and the streaming protocol.
 
 mod grbl;
+pub use grbl::{significant_len, LINE_MAX};
 mod read;
 mod serial;
 mod tools;

@@ -35,7 +35,6 @@
 pub(crate) mod gpgl;
 pub mod grbl;
 mod grbl_block;
-mod grbl_system;
 pub(crate) mod hpgl;
 pub(crate) mod record;
 

@@ -24,16 +24,18 @@
 //!
 //! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
 //! GRBL's bar counts machine time and its status is polled with `?` five times a second while a
-//! job runs (`grbl_stream`).
+//! job runs (`grbl`).
 
 // A stream error carries the job position for the user; it happens at most once per job, so
 // its size on the error path does not matter.
 #![allow(clippy::result_large_err)]
 
-use super::grbl_stream::Grbl;
+mod grbl;
+
 use super::serial::Link;
 use super::sim::{Finish, SimConfig, SimError, SimReport, XOFF, XON};
 use crate::profile::{FlowControl, Language, Profile};
+use grbl::Grbl;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};

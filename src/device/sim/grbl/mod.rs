@@ -34,11 +34,13 @@
 //! into chords within `$12` as `mc_arc` does; `G4` its `P`.
 
 use super::grbl_block::{self as gb, AxisCommand, Block, Motion, NonModal};
-use super::grbl_system::Settings;
+mod system;
+
 use super::record::Recorder;
 use crate::device::motion::Planner;
 use crate::profile::Profile;
 use glam::{DVec2, DVec3};
+use system::Settings;
 
 #[derive(Debug, Clone)]
 enum ToolRule {

@@ -1,5 +1,5 @@
 //! GRBL streaming: the host side of GRBL's character-counting and send-response protocols
-//! (GRBL wiki, "Interface", streaming protocols), driven by [`super::stream::send`].
+//! (GRBL wiki, "Interface", streaming protocols), driven by [`super::send`].
 //!
 //! Lines are sent while the bytes of the lines not yet answered (`ok` or `error:N`) fit in the
 //! device's 128-byte receive buffer; `$` commands are sent alone, after every earlier line is
@@ -29,11 +29,11 @@
 // A stream error carries the job position for the user; it happens at most once per job.
 #![allow(clippy::result_large_err)]
 
-use super::grbl::{self as proto, Response};
-use super::serial::Link;
-use super::stream::{
+use super::{
     position, Bar, Failure, Position, StreamError, StreamOptions, StreamReport, ToolState,
 };
+use crate::device::grbl::{self as proto, Response};
+use crate::device::serial::Link;
 use crate::profile::{Profile, Protocol};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -124,7 +124,7 @@ impl<'a> Grbl<'a> {
         let Some(b) = &self.bar.bar else {
             return self;
         };
-        let mut g = super::sim::grbl::Grbl::new(self.profile);
+        let mut g = crate::device::sim::grbl::Grbl::new(self.profile);
         let mut t = 0.0f64;
         for (_, text, _) in &self.lines {
             if let Ok(e) = g.execute(text, false) {

@@ -7,7 +7,7 @@
 //! `$H` is `error:5` (homing off), any other `$` letter `error:2`. While the machine moves,
 //! `$$ $# $C $X $H $N $n=v` are `error:8`, as GRBL's idle checks say.
 
-use super::grbl::{Effect, Grbl};
+use super::{Effect, Grbl};
 use crate::profile::{GrblMachine, Profile};
 
 /// GRBL 1.1h's settings in `$$` order with their defaults, and whether `$$` prints them as
