@@ -80,7 +80,6 @@
 //! flatten/
 //!   mod.rs                     Flatten stage
 //!   distortion.rs              Distortion of a flat layout against its 3D surface
-//!   overlap.rs                 Triangle-level overlap of flat layouts
 //!   unfold.rs                  Exact unfolding of polyhedral meshes
 //!   charts/
 //!     mod.rs                   Flattening of a segmented smooth surface
@@ -110,7 +109,6 @@
 //!   bench.rs                   The few solver steps that the benchmarks in `benches/nest.rs` time, behind a narrow public entr…
 //!   esicup.rs                  ESICUP strip-packing instances in the JSON form used by jagua-rs and sparrow (see `../shared/da…
 //!   problem.rs                 The nesting problem as data, independent of flatcut's pieces and of the ESICUP files
-//!   reach.rs                   What the nest places for a piece: the polygon that holds everything the cutter will do to it
 //!   collision/
 //!     mod.rs                   Collision detection of the nest stage, in exact `f64` geometry, and the overlap measure the sep…
 //!     overlap.rs               The overlap proxy between two colliding shapes, after sparrow (Gardeyn, Vanden Berghe, Wauters,…

@@ -745,24 +745,18 @@ pub fn write_uv_obj(path: &Path, flats: &[Flat]) -> Result<(), Error> {
             ))
         };
         let comment = format!(
-            "{}: {} pieces, flat coordinates in mm as vt (one per vertex of a piece)\nwritten by flatcut {}",
+            "{}: {} pieces, flat coordinates in mm as vt (one per face corner)\nwritten by flatcut {}",
             flat.surface.name,
             flat.islands.len(),
             env!("CARGO_PKG_VERSION")
         );
-        let text = crate::output::obj::write_pieces(
-            &flat.surface.mesh,
-            &flat.face_2d,
-            &flat.face_island,
-            flat.tolerance,
-            &comment,
-        )
-        .ok_or_else(|| {
-            Error::Usage(format!(
-                "{}: the flat layout does not cover every face corner",
-                file.display()
-            ))
-        })?;
+        let text = crate::output::obj::write(&flat.surface.mesh, Some(&flat.face_2d), &comment)
+            .ok_or_else(|| {
+                Error::Usage(format!(
+                    "{}: the flat layout does not cover every face corner",
+                    file.display()
+                ))
+            })?;
         if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
             create_dir(dir)?;
         }

@@ -4,12 +4,10 @@
 //!
 //! [`unfold`](mod@unfold) is the exact unfolding of polyhedral (developable) meshes. [`param`] flattens
 //! nearly developable disk-topology charts (LSCM / ABF++) and [`distortion`] measures any flat
-//! layout against its mesh (L2 / L∞ stretch, shear, angle defect). [`overlap`] finds the faces of
-//! a layout whose interiors intersect (triangle against triangle, a grid broad phase).
+//! layout against its mesh (L2 / L∞ stretch, shear, angle defect).
 
 pub mod charts;
 pub mod distortion;
-pub mod overlap;
 pub mod param;
 pub mod unfold;
 

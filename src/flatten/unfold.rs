@@ -10,11 +10,11 @@
 //! face moves O(log n) times; overlap is tested triangle against triangle (separating axes)
 //! against a uniform grid of the larger island.
 //!
-//! Overlap is exact ([`super::overlap::exact_eps`]: any depth above rounding): no two faces of
-//! an island cover each other, even by the tiny angle excess of a "planar" region stored with
-//! rounded coordinates (such a vertex ends up on an island's border); faces that merely touch
-//! along a fold or at a vertex never count. [`UnfoldOptions::tolerance`] (0.02 mm, under one
-//! HP-GL plotter unit, capped at 1 % of the mean edge length) is the coincidence distance: after the
+//! Tolerance: real meshes are stored with rounded coordinates, so "planar" regions have tiny
+//! angle defects and an exact test would cut at almost every vertex. Faces may therefore overlap
+//! by less than
+//! [`UnfoldOptions::tolerance`] (0.02 mm, under one HP-GL plotter unit, capped at 1 % of the mean
+//! edge length); faces that merely touch along a fold or at a vertex never count. After the
 //! forest is built, cut edges whose two copies coincide within that distance inside one island
 //! (typically inside planar regions) are joined again, because cutting there would only slit the
 //! material.
@@ -35,9 +35,9 @@ pub struct UnfoldOptions {
     pub convex_weight: f64,
     /// Weight of concave bend angle (fraction of π) in the join priority.
     pub concave_weight: f64,
-    /// Distance (mm) within which the two copies of a cut edge count as coincident (overlap is
-    /// exact, see the module doc). Capped at 1 % of the mean edge length so that tiny meshes
-    /// are not swallowed by it.
+    /// Overlap (depth, in mm) below which faces count as touching, not overlapping; also the
+    /// distance within which the two copies of a cut edge count as coincident. Capped at 1 % of
+    /// the mean edge length so that tiny meshes are not swallowed by it.
     pub tolerance: f64,
 }
 
@@ -224,9 +224,7 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     let mean = lengths.iter().sum::<f64>() / ne.max(1) as f64;
-    // Coincidence of a cut edge's copies; overlap is exact (rounding only).
     let eps = opts.tolerance.min(0.01 * mean);
-    let overlap_eps = super::overlap::exact_eps(mean);
 
     // Grid cell: a little over the typical face size.
     let mut sizes: Vec<f64> = pos
@@ -251,7 +249,7 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         stamp: vec![0; nf],
         round: 0,
         moved: Vec::new(),
-        eps: overlap_eps,
+        eps,
         pos,
         tris,
     };

@@ -19,8 +19,8 @@
 //! - [`bench`](mod@bench): the few solver steps the benchmarks in `benches/nest.rs` time.
 //!
 //! flatcut's pieces: the polygon nested is the cut outline (`outline[0]`, with the holes
-//! `outline[1..]` open to small pieces), grown where a stroke lies outside it ([`reach`]), so
-//! that what [`verify`] checks (every point) is what was nested.
+//! `outline[1..]` open to small pieces); every other stroke of a piece lies inside it (up to
+//! [`Piece::OVERHANG_MM`]).
 //! Orientations per piece come from [`NestOptions::rotations`] (a set, a step or free; per-piece
 //! overrides in [`NestOptions::piece_rotations`]), doubled by mirror images when
 //! [`NestOptions::mirror`]; a piece with a grain line may only turn so that the grain runs along
@@ -43,7 +43,6 @@ pub mod bench;
 pub(crate) mod collision;
 pub mod esicup;
 pub mod problem;
-pub mod reach;
 pub(crate) mod solve;
 
 use crate::geom::polygon;
@@ -268,25 +267,6 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
     }
 }
 
-/// What is cut of a piece, as the nest places it: the outline, grown to hold any stroke
-/// outside it ([`reach::nested_rings`]); an error when it has no usable outline.
-fn nested(piece: &Piece) -> Result<Vec<Vec<DVec2>>, NestError> {
-    let bad = || NestError::BadOutline {
-        piece: piece.name.clone(),
-    };
-    if piece.outline.first().is_none_or(|r| r.len() < 3) {
-        return Err(bad());
-    }
-    let rings = reach::nested_rings(piece);
-    if rings.is_empty()
-        || polygon::signed_area(&rings[0]).abs() <= 0.0
-        || rings.iter().flatten().any(|p| !p.is_finite())
-    {
-        return Err(bad());
-    }
-    Ok(rings)
-}
-
 /// A few pieces on a roll, and a piece that fits a sheet in none of its usual turns, also try
 /// the turns that make them shortest ([`Item::add_shortest_shapes`]); `uw` × `uh` is the room
 /// inside the margins.
@@ -317,7 +297,20 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
     let to_internal = |deg: f64| if roll { deg - 90.0 } else { deg };
     let mut items = Vec::with_capacity(pieces.len());
     for piece in &pieces {
-        let rings = nested(piece)?;
+        let rings: Vec<Vec<DVec2>> = piece
+            .outline
+            .iter()
+            .filter(|r| r.len() >= 3)
+            .cloned()
+            .collect();
+        if piece.outline.first().is_none_or(|r| r.len() < 3)
+            || polygon::signed_area(&rings[0]).abs() <= 0.0
+            || rings.iter().flatten().any(|p| !p.is_finite())
+        {
+            return Err(NestError::BadOutline {
+                piece: piece.name.clone(),
+            });
+        }
         let orients = match piece_orients(piece, opts) {
             Orients::Set(v) => Orients::Set(
                 v.into_iter()
@@ -405,13 +398,7 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
             let last = sol.bins - 1;
             let top = (0..pieces.len())
                 .filter(|&k| placements[k].sheet == last)
-                .flat_map(|k| {
-                    let outer = reach::nested_rings(&pieces[k])
-                        .into_iter()
-                        .next()
-                        .unwrap_or_default();
-                    outer.into_iter().map(move |p| (k, p))
-                })
+                .flat_map(|k| pieces[k].outline[0].iter().map(move |p| (k, *p)))
                 .map(|(k, p)| placements[k].apply(p).y)
                 .fold(m, f64::max);
             let right = (m + sol.length, m, opts.width - m, h - m);
@@ -440,9 +427,8 @@ pub fn nest(pieces: Vec<Piece>, opts: &NestOptions) -> Result<Layout, NestError>
     Ok(layout)
 }
 
-/// Exact check of a layout: every piece's points inside its sheet's margins, and the shapes
-/// nested for two pieces on one sheet ([`reach::nested_rings`]: the outlines, grown where a
-/// stroke lies outside) never closer than the spacing (a piece in another's hole is
+/// Exact check of a layout: every piece's points inside its sheet's margins, and the outlines
+/// of two pieces on one sheet never closer than the spacing (a piece in another's hole is
 /// fine). Returns the first problem found, naming the pieces.
 pub fn verify(layout: &Layout) -> Result<(), String> {
     let m = layout.margin;
@@ -451,7 +437,7 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
         .iter()
         .zip(&layout.placements)
         .map(|(p, at)| {
-            reach::nested_rings(p)
+            p.outline
                 .iter()
                 .map(|r| {
                     let mut r: Vec<DVec2> = r.iter().map(|q| at.apply(*q)).collect();
@@ -466,8 +452,8 @@ pub fn verify(layout: &Layout) -> Result<(), String> {
     for (k, (p, at)) in layout.pieces.iter().zip(&layout.placements).enumerate() {
         let s = &layout.sheets[at.sheet];
         for q in p.points().map(|q| at.apply(q)) {
-            // What was nested holds every point (`reach`): only rounding is let through.
-            let tol = reach::SLACK_MM;
+            // Marks on the border may lie a little outside the cut outline.
+            let tol = Piece::OVERHANG_MM;
             if q.x < m - tol || q.y < m - tol || q.x > s.width - m + tol || q.y > s.height - m + tol
             {
                 return Err(format!(

@@ -18,12 +18,7 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
     let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).expect("pieces");
     let flat = &flats[0];
     assert_eq!(flat.surface.mesh.faces.len(), 12_946);
-    // Overlap is exact (no two faces of an island cover each other by any depth): the tiny
-    // saddles of its nearly planar regions cut it into more islands than a 0.02 mm tolerance did.
-    assert!(flat.islands.len() <= 100, "{} islands", flat.islands.len());
-    assert!(flatcut::flatten::overlap::island_pairs(flat)
-        .iter()
-        .all(|p| p.is_empty()));
+    assert!(flat.islands.len() <= 7, "{} islands", flat.islands.len());
     assert!(flatcut::flatten::unfold::find_overlap(flat).is_none());
 
     let opts = flatcut::nest::NestOptions {

@@ -18,7 +18,6 @@ mod grbl_firmware;
 mod house;
 mod knife;
 mod nest;
-mod overlap;
 mod param;
 mod pattern;
 mod robust;

@@ -21,8 +21,7 @@
 //!
 //! After the thesis' §5.3 ("overlaps cut away", "darts shortened", "a piece over the
 //! material's tolerance"), a chart
-//! - whose layout overlaps itself (two faces whose interiors intersect, by any depth above
-//!   rounding: [`crate::flatten::overlap`]; a global overlap) has
+//! - whose layout overlaps itself deeper than the unfolder's tolerance (a global overlap) has
 //!   the overlapping region cut off (`cut_off`, after Lévy et al. 2002, the thesis' ref. 22:
 //!   the overlapping faces are sorted to the nearer of the two first found overlapping, the
 //!   side with less overlapping area is cut off, again while the rest still overlaps) when
@@ -39,10 +38,7 @@
 //!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
 //!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
 //!
-//! (a chart that overlaps itself and that none of these separates is halved, down to single
-//! faces; and once every chart is laid, any piece that still overlaps itself is split apart and
-//! laid again, so that no output piece overlaps itself), and is split along the bisector of
-//! its two most distant faces
+//! and is split along the bisector of its two most distant faces
 //! (`bisect` of [`crate::geom::cut`]) when
 //! - it has a flipped triangle,
 //! - the parameteriser refuses it (no cut makes it a disk),
@@ -315,33 +311,15 @@ impl Charts<'_> {
         if t.faces.len() > 1 {
             // Overlapping parts go to different pieces: split between the two faces.
             if let Some(pair) = self_overlap(&uv, eps) {
-                if !self.part_overlap(todo, &t, &uv, pair, eps) {
-                    self.split_apart(todo, &t);
+                if self.part_overlap(todo, &t, &uv, pair, eps) {
+                    return Ok(());
                 }
-                return Ok(());
             }
             if stretch.flipped > 0 && self.split_in_two(todo, &t, t.splits) {
                 return Ok(());
             }
         }
         self.relieve(opts, eps, t, uv, stretch, todo, done)
-    }
-
-    /// A chart that overlaps itself and that neither cut-off nor split between its
-    /// overlapping faces separates: halved along its bisector, else one piece per face (a
-    /// piece that overlaps itself is never output).
-    fn split_apart(&self, todo: &mut Vec<Todo>, t: &Todo) {
-        if self.split_in_two(todo, t, t.splits) {
-            return;
-        }
-        for &f in t.faces.iter().rev() {
-            todo.push(Todo {
-                faces: vec![f],
-                splits: t.splits,
-                cuts: Vec::new(),
-                cut_off: false,
-            });
-        }
     }
 
     /// Split a chart that cannot be laid flat in two, or fail on a single face (or a chart
@@ -513,14 +491,14 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     let surface_cuts = edge_ids(&topology, &surface.cuts);
     let mut todo = ctx.initial(&chart_of, &surface_cuts);
     let mut done: Vec<Laid> = Vec::new();
-    // Overlap is exact (rounding only, `super::overlap::exact_eps`), as in `unfold`.
+    // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
     let mean_edge = topology
         .edges
         .iter()
         .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
         .sum::<f64>()
         / topology.edges.len().max(1) as f64;
-    let overlap_eps = super::overlap::exact_eps(mean_edge);
+    let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge);
     let degenerate = |f: usize| FlattenError::Degenerate {
         surface: surface.name.clone(),
         face: f + 1,
@@ -530,29 +508,6 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
     }
     reattach(&ctx, &mut done, opts, overlap_eps);
-    // Every way above checks its layouts; this makes sure no piece that overlaps itself is
-    // output whatever path made it: such a piece is split apart and laid again.
-    for _ in 0..SEPARATE_ROUNDS {
-        let (bad, good): (Vec<Laid>, Vec<Laid>) = std::mem::take(&mut done)
-            .into_iter()
-            .partition(|l| l.faces.len() > 1 && self_overlap(&l.uv, overlap_eps).is_some());
-        done = good;
-        if bad.is_empty() {
-            break;
-        }
-        for l in bad.into_iter().rev() {
-            let t = Todo {
-                faces: l.faces,
-                splits: opts.max_splits,
-                cuts: l.cuts,
-                cut_off: false,
-            };
-            ctx.split_apart(&mut todo, &t);
-        }
-        while let Some(t) = todo.pop() {
-            ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
-        }
-    }
     Ok(assemble(surface, topology, done, opts))
 }
 
@@ -671,7 +626,3 @@ pub fn stretch(flat: &Flat) -> (Vec<Stretch>, Stretch) {
 /// A global overlap is cut off ([`overlap::cut_off`]) when the part cut off has at most this fraction
 /// of the chart's area; a larger one splits the chart between the two overlapping faces.
 const CUT_OFF_AREA: f64 = 0.25;
-
-/// Rounds of splitting apart pieces that still overlap themselves once every chart is laid
-/// (each round at least halves them, so a few suffice).
-const SEPARATE_ROUNDS: usize = 64;

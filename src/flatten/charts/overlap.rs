@@ -1,6 +1,6 @@
 //! Overlap inside one chart's layout, and what is done about it (Julius 2006, thesis §5.3
 //! "fixing gussets and overlaps", after Lévy et al. 2002): the overlapping face pairs found by
-//! a grid over the triangles' boxes ([`overlaps`]), the overlapping region cut off so that
+//! a sweep over the triangles' boxes ([`overlaps`]), the overlapping region cut off so that
 //! every part lays flat without overlap ([`cut_off`]), and the parts cut off re-attached at
 //! the end to a neighbour where the merge criterion holds ([`reattach`]).
 //!
@@ -20,10 +20,40 @@ pub(super) fn self_overlap(uv: &[Vec<DVec2>], eps: f64) -> Option<(usize, usize)
 }
 
 /// Pairs of faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`,
-/// at most `limit` of them, sorted ([`crate::flatten::overlap::pairs`]: triangle against
-/// triangle, a grid broad phase).
+/// at most `limit` of them, in sweep order: a sweep over x of the triangles' boxes.
 pub(super) fn overlaps(uv: &[Vec<DVec2>], eps: f64, limit: usize) -> Vec<(usize, usize)> {
-    crate::flatten::overlap::pairs(uv, eps, limit)
+    let mut out = Vec::new();
+    let mut tris: Vec<([DVec2; 3], usize)> = Vec::new();
+    for (k, c) in uv.iter().enumerate() {
+        for t in polygon::triangulate(c) {
+            tris.push(([c[t[0]], c[t[1]], c[t[2]]], k));
+        }
+    }
+    let mut boxes: Vec<(f64, f64, usize)> = tris
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (t, _))| {
+            polygon::bounds(t.iter().copied()).map(|(lo, hi)| (lo.x, hi.x, i))
+        })
+        .collect();
+    boxes.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    for (k, &(_, hx, i)) in boxes.iter().enumerate() {
+        for &(lx, _, j) in &boxes[k + 1..] {
+            if lx >= hx - eps {
+                break;
+            }
+            if tris[i].1 == tris[j].1 {
+                continue;
+            }
+            if polygon::triangles_overlap(&tris[i].0, &tris[j].0, eps) {
+                out.push((tris[i].1, tris[j].1));
+                if out.len() >= limit {
+                    return out;
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Most overlapping face pairs looked at when cutting an overlap off.
