@@ -67,10 +67,14 @@ pub fn format(path: &Path, bytes: &[u8]) -> Format {
 
 /// Read a mesh file of any format.
 pub fn read(path: &Path) -> Result<RawMesh, SurfaceError> {
-    let bytes = std::fs::read(path).map_err(|source| SurfaceError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    // A regular file under the size limit (`geom::input`): never a device or a FIFO.
+    let bytes =
+        crate::geom::input::read_bytes(path, crate::geom::input::DATA_LIMIT).map_err(|source| {
+            SurfaceError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     match format(path, &bytes) {
         Format::Obj => super::obj::read(path),
         Format::Stl => super::stl::parse(&bytes, path),
