@@ -73,23 +73,9 @@ fn needle_obj_is_refused_before_any_stage_allocates() {
         "v 0 0 0\nv 10 0 0\nv 0 0 1e9\nf 1 2 3\n",
     )
     .unwrap();
-    // As read it is refused as implausibly large; taken at its size on purpose (`--scale 1`),
-    // the range check refuses it before any stage allocates by it.
+    // Refused as implausibly large (issue 21's size check) before any stage allocates by it.
     let o = bounded_in(&dir, &["cut", "needle.obj", "--dry-run", "-o", "out"]);
     refused(&o, &["needle.obj", "larger than 10 m"]);
-    let o = bounded_in(
-        &dir,
-        &[
-            "cut",
-            "needle.obj",
-            "--scale",
-            "1",
-            "--dry-run",
-            "-o",
-            "out",
-        ],
-    );
-    refused(&o, &["needle.obj", "coordinate", "1 km"]);
 }
 
 #[test]
@@ -291,9 +277,9 @@ fn nesting_thousands_of_loose_triangles_is_bounded() {
     let o = bounded(&[
         "cut",
         &obj,
-        // At its size as read (3 mm), as the reproducer was.
-        "--scale",
-        "1",
+        // At its size as read (3 mm across), as the reproducer was.
+        "--size",
+        "3",
         "--dry-run",
         "--nest-time",
         "0",
