@@ -75,6 +75,7 @@
 //!       mod.rs                 The simulated cutter's GRBL interpreter, as GRBL 1.1h answers
 //!       system.rs              The simulated GRBL's `$` commands and settings
 //!     grbl_block.rs            Reading one G-code block as GRBL 1.1h's `gc_execute_line` does
+//!     machine.rs               The simulated cutter's machine thread: line rate, buffer, flow control, answers
 //!     hpgl.rs                  The simulated cutter's HP-GL interpreter
 //!     record.rs                What the simulated cutter remembers of a job
 //! flatten/
