@@ -196,6 +196,25 @@ pub(crate) fn device_points(
     Ok(out)
 }
 
+/// [`device_points`] of a stroke for a language with integer steps (HP-GL plotter units, GP-GL
+/// steps): each rounded once from its absolute position, within ±`limit`, repeats dropped.
+pub(crate) fn integer_steps(
+    profile: &Profile,
+    sheet: &SheetJob,
+    index: usize,
+    stroke: &Stroke,
+    (limit, units): (f64, &'static str),
+) -> Result<Vec<(i64, i64)>, OutputError> {
+    let fits = |v: f64| v.round().is_finite() && v.round().abs() <= limit;
+    let mut pts: Vec<(i64, i64)> =
+        device_points(profile, sheet, index, stroke, (limit, units), fits)?
+            .iter()
+            .map(|d| (d.x.round() as i64, d.y.round() as i64))
+            .collect();
+    pts.dedup();
+    Ok(pts)
+}
+
 /// The program for one sheet in the profile's language: HP-GL or Roland CAMM-GL mode 2
 /// (`hpgl::emit`), GRBL G-code (`gcode::emit`) or Graphtec GP-GL ([`gpgl`]), by
 /// `profile.language` and `profile.dialect`.

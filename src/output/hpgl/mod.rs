@@ -55,7 +55,7 @@
 //! [`read`] is the one HP-GL reader (instructions, numbers, pen-down paths) that the tests and
 //! the simulated cutter use.
 
-use super::{device_points, one_line, stroke_tool, tool_error, OutputError};
+use super::{integer_steps, one_line, stroke_tool, tool_error, OutputError};
 use crate::profile::{Profile, Tool};
 use crate::toolpath::SheetJob;
 use std::fmt::Write;
@@ -186,12 +186,7 @@ pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, Outpu
         };
         let tool = check_tool(profile, kind.name(), tool)?;
         let range = (limit as f64, "plotter units");
-        let fits = |v: f64| v.round().is_finite() && v.round().abs() <= limit as f64;
-        let mut pts: Vec<(i64, i64)> = device_points(profile, sheet, index, stroke, range, fits)?
-            .iter()
-            .map(|d| (d.x.round() as i64, d.y.round() as i64))
-            .collect();
-        pts.dedup();
+        let pts = integer_steps(profile, sheet, index, stroke, range)?;
         let Some(&(x0, y0)) = pts.first() else {
             continue;
         };
