@@ -695,3 +695,57 @@ fn without_flow_control_the_buffer_paces_the_stream() {
     r.unwrap();
     assert!(rep.overruns > 0);
 }
+
+/// A controller that takes the first lines, then reports `Run` at one position for ever and
+/// never answers `ok` again (a stuck machine, as grbl-sim is when its stepper starves on a
+/// loaded host): the job times out instead of waiting for ever.
+#[test]
+fn a_grbl_that_says_run_but_never_moves_times_out() {
+    use serialport::SerialPort;
+    use std::io::{Read, Write};
+    let p = grbl_profile("grbl-character-counting");
+    let (mut master, slave) = serialport::TTYPort::pair().expect("pty pair");
+    let path = slave.name().unwrap();
+    let peer = std::thread::spawn(move || {
+        master.set_timeout(Duration::from_millis(20)).ok();
+        let started = std::time::Instant::now();
+        let (mut lines, mut buf) = (0usize, [0u8; 256]);
+        while started.elapsed() < Duration::from_secs(20) {
+            let n = match master.read(&mut buf) {
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::TimedOut => continue,
+                Err(_) => break,
+            };
+            for &b in &buf[..n] {
+                let answer: &[u8] = match b {
+                    0x18 => b"\r\nGrbl 1.1h ['$' for help]\r\n",
+                    b'?' => b"<Run|MPos:1.000,2.000,0.000|FS:3000,0>\r\n",
+                    b'\n' => {
+                        lines += 1;
+                        if lines <= 5 {
+                            b"ok\r\n"
+                        } else {
+                            b""
+                        }
+                    }
+                    _ => b"",
+                };
+                if master.write_all(answer).is_err() {
+                    return lines;
+                }
+            }
+        }
+        lines
+    });
+    let mut link = serial::open(&p, &path, None).unwrap();
+    let t = std::time::Instant::now();
+    let r = stream::send(&mut link, &p, gcode_job(3).as_bytes(), &opts(1.0));
+    let took = t.elapsed();
+    drop(link);
+    drop(slave);
+    let e = r.unwrap_err();
+    assert!(matches!(e, StreamError::Timeout { .. }), "{e}");
+    assert!(e.to_string().contains("neither answered nor moved"), "{e}");
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    assert!(peer.join().unwrap() > 5);
+}

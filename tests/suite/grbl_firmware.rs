@@ -21,7 +21,7 @@ use std::io::{Read, Write};
 use std::os::fd::{FromRawFd, IntoRawFd, OwnedFd};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{mpsc, Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 /// GRBL's default steps per mm (`$100`–`$102`), which the tests keep.
@@ -64,7 +64,9 @@ pub fn firmware(ver: &str) -> Option<PathBuf> {
     // checkouts running tests at once), then keeps it under the version's name.
     let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("peers");
     let dest = root.join(format!("grbl-sim-{ver}-{}", std::process::id()));
-    let o = Command::new("bash")
+    // `timeout`: a build that hangs fails the test instead of holding the run.
+    let o = Command::new("timeout")
+        .args(["600", "bash"])
         .arg(&peers)
         .arg(&dest)
         .arg(ver)
@@ -82,9 +84,15 @@ pub fn firmware(ver: &str) -> Option<PathBuf> {
     Some(exe)
 }
 
+/// How long one firmware may run before the watchdog kills it: each test needs a few seconds
+/// of machine time, and a firmware (or a sender) that hangs must end the test, not the run.
+const WATCHDOG: Duration = Duration::from_secs(120);
+
 /// A running firmware on a pty pair.
 pub struct Firmware {
-    child: Child,
+    child: Arc<Mutex<Child>>,
+    /// Dropping it tells the watchdog that the test is over.
+    _watch: mpsc::Sender<()>,
     _turn: std::sync::MutexGuard<'static, ()>,
     /// The slave side's path (what flatcut opens).
     pub path: String,
@@ -114,8 +122,20 @@ impl Firmware {
             .stderr(std::fs::File::create(dir.join("stderr.log")).expect("stderr log"))
             .spawn()
             .expect("start grbl_sim");
+        let child = Arc::new(Mutex::new(child));
+        let (watch, over) = mpsc::channel::<()>();
+        let doomed = Arc::clone(&child);
+        let what = format!("GRBL {ver} ({name})");
+        std::thread::spawn(move || {
+            if over.recv_timeout(WATCHDOG) == Err(mpsc::RecvTimeoutError::Timeout) {
+                // Killing the firmware hangs up the pty: whatever waits on it ends with an error.
+                eprintln!("watchdog: {what} still running after {WATCHDOG:?}, killed");
+                let _ = doomed.lock().unwrap_or_else(|e| e.into_inner()).kill();
+            }
+        });
         let mut fw = Firmware {
             child,
+            _watch: watch,
             _turn: turn,
             path,
             slave,
@@ -208,8 +228,9 @@ impl Firmware {
 
 impl Drop for Firmware {
     fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        let mut c = self.child.lock().unwrap_or_else(|e| e.into_inner());
+        let _ = c.kill();
+        let _ = c.wait();
     }
 }
 
