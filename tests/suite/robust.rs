@@ -2,7 +2,7 @@
 //! left the knife down, wrote outside the output folder or echoed a file, now end within
 //! 10 s and 1 GB with exit 1 and a message (or 0 and a correct result).
 //!
-//! The binary runs under `ulimit -v` (1 GiB of address space) and a 10 s deadline
+//! The binary runs under `ulimit -v` (1 GiB of address space) and `ulimit -t` (10 s of CPU)
 //! ([`bounded`]); library-level cases check the same bounds on the function at fault.
 
 use crate::common::*;
@@ -14,11 +14,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Run `flatcut` in `cwd` under 1 GiB of address space; fails the test after 10 s.
+/// Run `flatcut` in `cwd` under 1 GiB of address space and 10 s of CPU (`ulimit -t`: the
+/// bound holds on a loaded machine too, where wall time would not); a run that sleeps instead
+/// (a hang waiting on something) fails the test after 60 s of wall time.
 fn bounded_in(cwd: &Path, args: &[&str]) -> Output {
+    use std::os::unix::process::ExitStatusExt;
     let mut child = Command::new("sh")
         .arg("-c")
-        .arg("ulimit -v 1048576; exec \"$0\" \"$@\"")
+        .arg("ulimit -v 1048576; ulimit -t 10; exec \"$0\" \"$@\"")
         .arg(env!("CARGO_BIN_EXE_flatcut"))
         .args(args)
         .current_dir(cwd)
@@ -36,14 +39,19 @@ fn bounded_in(cwd: &Path, args: &[&str]) -> Output {
         if child.try_wait().expect("wait").is_some() {
             break;
         }
-        if t0.elapsed() > Duration::from_secs(10) {
+        if t0.elapsed() > Duration::from_secs(60) {
             let _ = child.kill();
             let _ = child.wait();
-            panic!("flatcut {args:?} ran over 10 s");
+            panic!("flatcut {args:?} ran over 60 s of wall time");
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-    child.wait_with_output().expect("output")
+    let o = child.wait_with_output().expect("output");
+    // SIGXCPU (24) from `ulimit -t`, or SIGKILL once past the hard limit.
+    if matches!(o.status.signal(), Some(24) | Some(9)) {
+        panic!("flatcut {args:?} used over 10 s of CPU");
+    }
+    o
 }
 
 fn bounded(args: &[&str]) -> Output {
