@@ -452,7 +452,6 @@ fn simulate_obeys_ctrl_c_while_the_device_works_off_its_buffer() {
 }
 
 #[test]
-#[ignore = "fails since the GRBL/GP-GL merge (the stream ends Ok after a stall); see the issue 22 note"]
 fn a_stalled_device_is_reported_with_the_bytes_it_executed() {
     let mut profile = flatcut::profile::find("sim").unwrap();
     profile.serial.flow_control = flatcut::profile::FlowControl::XonXoff;
