@@ -4,6 +4,8 @@
 //! - [`mesh`]: polygon meshes, edge adjacency, Newell normals, signed dihedral angles.
 //! - [`obj`]: the Wavefront OBJ writer.
 //! - [`curve`]: boundary curves sampled to a tolerance, B-spline knots and derivatives.
+//! - [`bspline`]: B-spline curves (clamped or periodic) as sparse linear rows of their control
+//!   points, for the spline developables' solver.
 //! - [`polygon`], [`boolean`], [`segment`]: 2D polygons (area, triangulation, overlap, poles,
 //!   line crossings), their booleans and offsets, point and segment distances (2D and 3D).
 //! - [`hull`]: 3D convex hulls and the local-convexity test of an edge.
@@ -16,6 +18,7 @@
 //!   position.
 
 pub mod boolean;
+pub mod bspline;
 pub mod curve;
 pub mod cut;
 pub mod font;

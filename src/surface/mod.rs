@@ -18,6 +18,8 @@
 //! - [`geodesic`]/: Bo & Wang 2007, *Geodesic-Controlled Developable Surfaces*: a flat sheet
 //!   bent along control curves (bent sheets).
 //! - [`dcharts`]/: Julius 2006, D-Charts: a smooth mesh segmented into nearly developable charts.
+//! - [`spline`]/: Tang, Bo, Wallner, Pottmann 2016: spline developables between B-spline
+//!   curves, made developable by guided projection.
 //! - [`dcs`]: Julius 2006, §6 DCS approximation: a mesh moved towards a developable one.
 //! - [`source`], [`material`], [`segment`]: what a surface is built from (the spec's
 //!   reader fills them): the surface description, the material, the D-Charts options.
@@ -36,6 +38,7 @@ pub mod segment;
 pub mod size;
 pub mod solids;
 pub mod source;
+pub mod spline;
 pub mod stl;
 pub mod strip;
 mod weld;

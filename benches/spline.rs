@@ -1,0 +1,64 @@
+//! One guided-projection iteration of spline developables (issue 24, Tang et al. 2016 Fig. 17):
+//! a two-strip problem of 36 control points (Fig. 13's size; the paper: 0.04 s per iteration)
+//! and a 44-strip chain of 270 control points (near Fig. 12's 48 strips, 270 points; the
+//! paper: 0.36 s). The goal is 10× faster than the paper. Each sample times one
+//! `Problem::iterate` from a freshly set-up, non-developable start (the set-up is not timed).
+//! Run: `cargo bench --bench spline`.
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use flatcut::geom::bspline::BSpline;
+use flatcut::surface::spline::solve::{Model, Problem};
+use glam::DVec3;
+
+/// `curves` wavy open cubic curves of `count` control points, 40 mm apart, twisted so that no
+/// strip is developable as given.
+fn chain(curves: usize, count: usize) -> Model {
+    let c = (0..curves)
+        .map(|k| {
+            (0..count)
+                .map(|j| {
+                    let (x, y) = (j as f64 * 30.0, k as f64 * 40.0);
+                    let z = 20.0 * ((j as f64) * 0.7 + (k as f64) * 0.9).sin();
+                    DVec3::new(x, y, z)
+                })
+                .collect()
+        })
+        .collect();
+    Model {
+        basis: BSpline::new(3, count, false).expect("cubic"),
+        curves: c,
+        apex: None,
+        fixed: Vec::new(),
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    for (name, m) in [
+        ("36 control points, 2 strips", chain(3, 12)),
+        ("270 control points, 44 strips", chain(45, 6)),
+    ] {
+        let p = Problem::new(&m).expect("set up");
+        eprintln!(
+            "{name}: {} unknowns, start sine {:.3e}",
+            p.unknowns(),
+            p.sine()
+        );
+        c.bench_function(&format!("spline one iteration, {name}"), |b| {
+            b.iter_batched(
+                || Problem::new(&m).expect("set up"),
+                |mut p| {
+                    p.iterate(0.1, 0.01, 1).expect("iterate");
+                    p
+                },
+                BatchSize::SmallInput,
+            )
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
+    targets = bench
+}
+criterion_main!(benches);

@@ -1,0 +1,397 @@
+//! Spline developables (Tang, Bo, Wallner, Pottmann 2016, *Interactive design of developable
+//! surfaces*, §2 and §3.2; issue 24): the ruled surface s(u, v) = (1 − v) a(u) + v b(u)
+//! between B-spline curves of one degree and control-point count (or a cone: one curve and an
+//! apex), made developable by guided projection ([`solve`]), then sampled into a triangle mesh
+//! whose rulings are exact edges, for the exact unfolder.
+//!
+//! Several curves make a chain of strips, curve k to curve k + 1, each with its own normals;
+//! their shared curves are creases with no condition yet (`free`: the curved-fold, geodesic
+//! and smooth conditions of eq. 7–8 are not implemented).
+//!
+//! Choices where the paper is silent:
+//!
+//! - Output sampling: each span is cut into N equal parameter steps with N the smallest that
+//!   keeps the chordal error `max|a″| h²/8` (of both curves) within `tolerance`, at least 2
+//!   and at most 512 per span. Each quad a_i a_i+1 b_i+1 b_i becomes the triangles
+//!   (a_i, a_i+1, b_i+1) and (a_i, b_i+1, b_i), so that rulings a_i b_i are edges; a cone's
+//!   triangles share one apex vertex. A closed surface repeats its first ruling at the end (the
+//!   seam is cut).
+//! - A striction point (where rulings cross, the curve of regression) at a parameter v in
+//!   [0, 1] of a sampled ruling is refused, naming u (0-based span parameter) and v; a cone's
+//!   apex (v = 1) is allowed.
+//! - Figures (report.json): `iterations`, `largest_sine` (the intrinsic developability sine at
+//!   64 parameters per span after the solve), `solver_sine` (at the solver's samples),
+//!   `flatness_delta` (Fig. 17's δ: distance of the diagonals of each sampled quad over the
+//!   mean of its two ruling-free edges, largest), `isometry_error` (largest relative
+//!   difference between a quad's second diagonal in 3D and in its two triangles unfolded),
+//!   `control_points_moved_mm`. Seconds per iteration are not written there (the report must
+//!   be byte-identical between runs); `benches/spline.rs` measures them.
+//! - A final sine above 1e-6 is a warning.
+
+pub mod solve;
+
+use super::strip::BendLines;
+use super::Bend;
+use crate::geom::bspline::BSpline;
+use crate::geom::mesh::{Face, Mesh};
+use glam::DVec3;
+pub use solve::{Model, Report, SolveError, SolveOptions};
+
+/// A spline surface as the spec describes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplineSpec {
+    /// Control points of each curve, all of one count.
+    pub curves: Vec<Vec<DVec3>>,
+    /// A cone's apex (with exactly one curve).
+    pub apex: Option<DVec3>,
+    pub degree: usize,
+    pub closed: bool,
+    /// Fixed control points (curve, index), 0-based; curve `curves.len()` is the apex.
+    pub fixed: Vec<(usize, usize)>,
+    pub options: SolveOptions,
+    /// Chordal tolerance of the output sampling (mm).
+    pub tolerance: f64,
+    pub bend_lines: BendLines,
+}
+
+/// The solved surface, sampled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solved {
+    pub model: Model,
+    pub report: Report,
+    pub mesh: Mesh,
+    pub bends: Vec<Bend>,
+    pub figures: Vec<(&'static str, f64)>,
+    pub warnings: Vec<String>,
+}
+
+/// What can go wrong making a spline surface.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SplineError {
+    #[error("{0}")]
+    Shape(String),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error("the rulings cross inside the strip (a striction point, the curve of regression) at u = {u:.4}, v = {v:.4} of strip {strip}: the sheet would fold over itself there; move the curves apart or reduce the twist")]
+    Striction { u: f64, v: f64, strip: usize },
+}
+
+/// Check the spec's shapes and build the model.
+pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
+    let count = spec.curves.first().map_or(0, Vec::len);
+    let basis = BSpline::new(spec.degree, count, spec.closed)
+        .map_err(|e| SplineError::Shape(format!("curve 1: {e}")))?;
+    if let Some(k) = spec.curves.iter().position(|c| c.len() != count) {
+        return Err(SplineError::Shape(format!(
+            "curve {} has {} control points, curve 1 has {count}: all curves need the same count",
+            k + 1,
+            spec.curves[k].len()
+        )));
+    }
+    match (spec.apex, spec.curves.len()) {
+        (Some(_), 1) | (None, 2..) => {}
+        (Some(_), n) => {
+            return Err(SplineError::Shape(format!(
+                "a cone takes one curve and `apex`, got {n} curves"
+            )))
+        }
+        (None, n) => {
+            return Err(SplineError::Shape(format!(
+                "a spline surface needs two or more curves (or one and `apex`), got {n}"
+            )))
+        }
+    }
+    Ok(Model {
+        basis,
+        curves: spec.curves.clone(),
+        apex: spec.apex,
+        fixed: spec.fixed.clone(),
+    })
+}
+
+/// Solve and sample a spline surface.
+pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
+    let mut m = model(spec)?;
+    let report = solve::solve(&mut m, &spec.options)?;
+    let params = sample_params(&m, spec.tolerance);
+    check_striction(&m, &params)?;
+    let (mesh, rulings) = sample_mesh(&m, &params);
+    let bends = bends(&mesh, &rulings, spec.bend_lines, m.apex.is_some());
+    let (delta, iso) = quad_figures(&m, &params);
+    let sine = dense_sine(&m, 64);
+    let mut warnings = Vec::new();
+    if sine > 1e-6 {
+        warnings.push(format!(
+            "the solve stopped at a developability sine of {sine:.2e} (above 1e-6) after {} iterations: the blank will need some stretching; raise `max_iterations` or free some control points",
+            report.iterations
+        ));
+    }
+    let figures = vec![
+        ("iterations", report.iterations as f64),
+        ("largest_sine", sine),
+        ("solver_sine", report.sines.last().copied().unwrap_or(0.0)),
+        ("flatness_delta", delta),
+        ("isometry_error", iso),
+        ("control_points_moved_mm", report.moved),
+    ];
+    Ok(Solved {
+        model: m,
+        report,
+        mesh,
+        bends,
+        figures,
+        warnings,
+    })
+}
+
+/// The strips of a model: (curve a, curve b or None for the apex).
+fn strips(m: &Model) -> Vec<(usize, Option<usize>)> {
+    match m.apex {
+        Some(_) => vec![(0, None)],
+        None => (0..m.curves.len() - 1).map(|c| (c, Some(c + 1))).collect(),
+    }
+}
+
+/// Point and tangent of curve `c` (or the apex) at `u`.
+fn at(m: &Model, c: Option<usize>, u: f64) -> (DVec3, Option<DVec3>) {
+    match c {
+        Some(c) => (
+            m.basis.eval(&m.curves[c], u),
+            Some(m.basis.deriv(&m.curves[c], u)),
+        ),
+        None => (m.apex.unwrap_or_default(), None),
+    }
+}
+
+/// The largest intrinsic developability sine at `per` parameters per span.
+pub fn dense_sine(m: &Model, per: usize) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (a, b) in strips(m) {
+        for k in 0..=m.basis.spans() * per {
+            let u = k as f64 / per as f64;
+            let (pa, ta) = at(m, Some(a), u);
+            let (pb, tb) = at(m, b, u);
+            worst = worst.max(solve::plane_sine(pb - pa, ta.unwrap_or_default(), tb));
+        }
+    }
+    worst
+}
+
+/// Output parameters over the whole curve (ends included).
+fn sample_params(m: &Model, tol: f64) -> Vec<f64> {
+    let mut out = vec![0.0];
+    for s in 0..m.basis.spans() {
+        let mut m2: f64 = 0.0;
+        for c in &m.curves {
+            for i in 0..=4 {
+                let r = m.basis.rows(s as f64 + i as f64 / 4.0);
+                m2 = m2.max(crate::geom::bspline::apply(&r.d2, c).length());
+            }
+        }
+        let n = if m2 > 0.0 {
+            (m2 / (8.0 * tol.max(1e-6))).sqrt().ceil() as usize
+        } else {
+            1
+        };
+        let n = n.clamp(2, 512);
+        out.extend((1..=n).map(|i| s as f64 + i as f64 / n as f64));
+    }
+    out
+}
+
+/// Refuse rulings that cross inside a strip: at each sampled ruling, the parameter v where
+/// (1 − v) a′ + v b′ is along the ruling (the surface's singular point on it).
+fn check_striction(m: &Model, params: &[f64]) -> Result<(), SplineError> {
+    for (k, (a, b)) in strips(m).into_iter().enumerate() {
+        for &u in params {
+            let (pa, ta) = at(m, Some(a), u);
+            let (pb, tb) = at(m, b, u);
+            let e = pb - pa;
+            let ta = ta.unwrap_or_default();
+            let tb = tb.unwrap_or_default();
+            let n = e.cross(ta) + e.cross(tb);
+            let t = n.cross(e).normalize_or_zero();
+            let (beta, delta) = (ta.dot(t), tb.dot(t));
+            let scale = ta.length().max(tb.length()).max(1e-300);
+            if (beta - delta).abs() <= 1e-12 * scale {
+                continue; // parallel rulings here (a cylinder point)
+            }
+            let v = beta / (beta - delta);
+            let top = if b.is_none() { 1.0 - 1e-9 } else { 1.0 + 1e-9 };
+            if v >= -1e-9 && v <= top {
+                return Err(SplineError::Striction { u, v, strip: k + 1 });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The triangle mesh and its rulings: (face before, face after, corner of the ruling in the
+/// face before) for each interior ruling, in order along the strips.
+fn sample_mesh(m: &Model, params: &[f64]) -> (Mesh, Vec<(usize, usize, usize)>) {
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    let mut rulings = Vec::new();
+    let k = params.len();
+    let mut row_a: Vec<usize> = Vec::new();
+    let first = strips(m).first().map_or(0, |s| s.0);
+    for &u in params {
+        row_a.push(vertices.len());
+        vertices.push(at(m, Some(first), u).0);
+    }
+    for (a, b) in strips(m) {
+        debug_assert!(a + 1 == b.unwrap_or(a + 1) || b.is_none());
+        let face0 = faces.len();
+        match b {
+            None => {
+                let apex = vertices.len();
+                vertices.push(m.apex.unwrap_or_default());
+                for i in 0..k - 1 {
+                    let f = [row_a[i], row_a[i + 1], apex];
+                    faces.push(Face {
+                        verts: f.to_vec(),
+                        line: None,
+                    });
+                    if i > 0 {
+                        // Ruling a_i–apex: corner 1 of the face before, shared with this one.
+                        rulings.push((face0 + i - 1, face0 + i, 1));
+                    }
+                }
+            }
+            Some(b) => {
+                let row_b: Vec<usize> = params
+                    .iter()
+                    .map(|&u| {
+                        vertices.push(m.basis.eval(&m.curves[b], u));
+                        vertices.len() - 1
+                    })
+                    .collect();
+                for i in 0..k - 1 {
+                    let (a0, a1, b0, b1) = (row_a[i], row_a[i + 1], row_b[i], row_b[i + 1]);
+                    faces.push(Face {
+                        verts: vec![a0, a1, b1],
+                        line: None,
+                    });
+                    faces.push(Face {
+                        verts: vec![a0, b1, b0],
+                        line: None,
+                    });
+                    if i > 0 {
+                        // Ruling a_i–b_i: corner 2 (b_i → a_i) of this quad's second
+                        // triangle, shared with the previous quad's first.
+                        rulings.push((face0 + 2 * i + 1, face0 + 2 * (i - 1), 2));
+                    }
+                }
+                row_a = row_b;
+            }
+        }
+    }
+    (Mesh { vertices, faces }, rulings)
+}
+
+/// Bend lines on the rulings per `lines` (as strips pick them: all, none, or a spacing with
+/// the angles in between summed).
+fn bends(
+    mesh: &Mesh,
+    rulings: &[(usize, usize, usize)],
+    lines: BendLines,
+    _cone: bool,
+) -> Vec<Bend> {
+    const EPS_DEG: f64 = 0.01;
+    let mut out: Vec<Bend> = Vec::new();
+    let mut acc = 0.0;
+    let mut along = 0.0;
+    let mut last_pick = 0.0;
+    let mut prev_mid: Option<DVec3> = None;
+    for &(f, g, corner) in rulings {
+        let (va, vb) = crate::geom::mesh::Topology::corner_verts(mesh, f, corner);
+        let mid = 0.5 * (mesh.vertices[va] + mesh.vertices[vb]);
+        if let Some(p) = prev_mid {
+            along += mid.distance(p);
+        }
+        prev_mid = Some(mid);
+        let Some(angle) = mesh.signed_dihedral(f, corner, g) else {
+            continue;
+        };
+        acc += angle;
+        let deg = angle.to_degrees();
+        let verts = if va < vb { [va, vb] } else { [vb, va] };
+        match lines {
+            BendLines::None => {}
+            BendLines::All => {
+                if deg.abs() > EPS_DEG {
+                    out.push(Bend {
+                        verts,
+                        angle_deg: deg,
+                    });
+                }
+            }
+            BendLines::Spacing(s) => {
+                if along - last_pick >= s && deg.abs() > EPS_DEG {
+                    out.push(Bend {
+                        verts,
+                        angle_deg: f64::to_degrees(acc),
+                    });
+                    acc = 0.0;
+                    last_pick = along;
+                }
+            }
+        }
+    }
+    if let (BendLines::Spacing(_), Some(last)) = (lines, out.last_mut()) {
+        last.angle_deg += f64::to_degrees(acc);
+    }
+    out
+}
+
+/// Fig. 17's face flatness δ (largest) and the largest isometry error of the sampled quads.
+fn quad_figures(m: &Model, params: &[f64]) -> (f64, f64) {
+    let (mut delta, mut iso): (f64, f64) = (0.0, 0.0);
+    for (a, b) in strips(m) {
+        let Some(b) = b else { continue };
+        for w in params.windows(2) {
+            let a0 = m.basis.eval(&m.curves[a], w[0]);
+            let a1 = m.basis.eval(&m.curves[a], w[1]);
+            let b0 = m.basis.eval(&m.curves[b], w[0]);
+            let b1 = m.basis.eval(&m.curves[b], w[1]);
+            let short = 0.5 * (a0.distance(a1) + b0.distance(b1));
+            if short > 0.0 {
+                delta = delta.max(line_distance(a0, b1, a1, b0) / short);
+            }
+            // Unfold (a0, a1, b1) and (a0, b1, b0) about a0–b1 and compare |a1 − b0|.
+            let d3 = a1.distance(b0);
+            let d2 = unfolded_distance(a0, b1, a1, b0);
+            if d3 > 0.0 {
+                iso = iso.max((d2 - d3).abs() / d3);
+            }
+        }
+    }
+    (delta, iso)
+}
+
+/// Distance between the lines p + s(q − p) and r + t(w − r).
+fn line_distance(p: DVec3, q: DVec3, r: DVec3, w: DVec3) -> f64 {
+    let n = (q - p).cross(w - r);
+    let len = n.length();
+    if len <= 1e-300 {
+        return 0.0;
+    }
+    (r - p).dot(n).abs() / len
+}
+
+/// Distance of `x` and `y` after the triangles (p, q, x) and (p, q, y) are unfolded into one
+/// plane on opposite sides of p–q.
+fn unfolded_distance(p: DVec3, q: DVec3, x: DVec3, y: DVec3) -> f64 {
+    let axis = (q - p).normalize_or_zero();
+    let flat = |v: DVec3| {
+        let d = v - p;
+        let along = d.dot(axis);
+        (along, (d - axis * along).length())
+    };
+    let (xa, xh) = flat(x);
+    let (ya, yh) = flat(y);
+    ((xa - ya).powi(2) + (xh + yh).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,185 @@
+//! Spline developables with exact answers (issue 24's acceptance shapes, at the library level).
+
+use super::*;
+
+fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpec {
+    SplineSpec {
+        curves,
+        apex,
+        degree: 3,
+        closed,
+        fixed: Vec::new(),
+        options: SolveOptions::default(),
+        tolerance: 0.05,
+        bend_lines: BendLines::All,
+    }
+}
+
+fn wave() -> Vec<DVec3> {
+    (0..8)
+        .map(|i| DVec3::new(i as f64 * 30.0, 40.0 * (i as f64).sin(), 0.0))
+        .collect()
+}
+
+fn circle(r: f64, z: f64, phase: f64) -> Vec<DVec3> {
+    (0..8)
+        .map(|i| {
+            let t = phase + i as f64 * std::f64::consts::TAU / 8.0;
+            DVec3::new(r * t.cos(), r * t.sin(), z)
+        })
+        .collect()
+}
+
+fn mesh_area(m: &Mesh) -> f64 {
+    (0..m.faces.len()).map(|f| m.face_area(f)).sum()
+}
+
+/// Area of the ruled surface by the midpoint rule (exact in v for the shapes used here).
+fn quadrature_area(m: &Model) -> f64 {
+    let per = 2000;
+    let mut area = 0.0;
+    for k in 0..m.basis.spans() * per {
+        let u = (k as f64 + 0.5) / per as f64;
+        let (pa, ta) = at(m, Some(0), u);
+        let (pb, tb) = if m.apex.is_some() {
+            at(m, None, u)
+        } else {
+            at(m, Some(1), u)
+        };
+        let (ta, tb) = (ta.unwrap_or_default(), tb.unwrap_or_default());
+        for j in 0..20 {
+            let v = (j as f64 + 0.5) / 20.0;
+            let su = ta * (1.0 - v) + tb * v;
+            area += su.cross(pb - pa).length() / (per as f64 * 20.0);
+        }
+    }
+    area
+}
+
+fn curve_length(m: &Model, c: usize) -> f64 {
+    let per = 4000;
+    (0..m.basis.spans() * per)
+        .map(|k| {
+            let u = (k as f64 + 0.5) / per as f64;
+            m.basis.deriv(&m.curves[c], u).length() / per as f64
+        })
+        .sum()
+}
+
+#[test]
+fn cylinder_is_a_fixed_point() {
+    let a = wave();
+    let b: Vec<DVec3> = a.iter().map(|p| *p + DVec3::Z * 150.0).collect();
+    let s = spec(vec![a.clone(), b.clone()], None, false);
+    let out = build(&s).unwrap();
+    for (p, q) in out.model.curves[0].iter().zip(&a) {
+        assert!(p.distance(*q) <= 1e-9);
+    }
+    for (p, q) in out.model.curves[1].iter().zip(&b) {
+        assert!(p.distance(*q) <= 1e-9);
+    }
+    assert!(dense_sine(&out.model, 200) <= 1e-12);
+    let l = curve_length(&out.model, 0);
+    let area = mesh_area(&out.mesh);
+    assert!(
+        (area - l * 150.0).abs() / (l * 150.0) < 1e-3,
+        "{area} vs {}",
+        l * 150.0
+    );
+    // Quads of a cylinder are planar: δ and the isometry error vanish.
+    let fig = |k: &str| out.figures.iter().find(|f| f.0 == k).unwrap().1;
+    assert!(fig("flatness_delta") < 1e-9);
+    assert!(fig("isometry_error") < 1e-9);
+    assert!(!out.bends.is_empty());
+}
+
+#[test]
+fn cone_both_forms_are_fixed_points_with_their_area() {
+    let a = circle(100.0, 0.0, 0.1);
+    let p = DVec3::new(10.0, -5.0, 200.0);
+    let b: Vec<DVec3> = a.iter().map(|x| p + 0.4 * (*x - p)).collect();
+    for s in [
+        spec(vec![a.clone(), b], None, true),
+        spec(vec![a.clone()], Some(p), true),
+    ] {
+        let out = build(&s).unwrap();
+        assert!(out.report.moved <= 1e-9, "moved {}", out.report.moved);
+        assert!(dense_sine(&out.model, 200) <= 1e-10);
+        let q = quadrature_area(&out.model);
+        let area = mesh_area(&out.mesh);
+        assert!((area - q).abs() / q < 1e-3, "{area} vs {q}");
+    }
+}
+
+#[test]
+fn loft_between_twisted_rims_becomes_developable() {
+    let a = circle(100.0, 0.0, 0.0);
+    let b = circle(60.0, 120.0, 0.45);
+    let s = spec(vec![a, b], None, true);
+    let m0 = model(&s).unwrap();
+    let sine0 = dense_sine(&m0, 64);
+    assert!(
+        sine0 > 1e-2,
+        "the rims must not be developable as given ({sine0})"
+    );
+    let area0 = quadrature_area(&m0);
+    let out = build(&s).unwrap();
+    let sine = dense_sine(&out.model, 200);
+    assert!(
+        sine <= 1e-6,
+        "sine {sine} after {} iterations",
+        out.report.iterations
+    );
+    assert!(quadrature_area(&out.model) >= 0.5 * area0);
+    assert!(out.report.moved > 0.1);
+    assert!(out.warnings.is_empty());
+}
+
+#[test]
+fn loft_with_one_rim_fixed_keeps_it() {
+    let a = circle(100.0, 0.0, 0.0);
+    let b = circle(60.0, 120.0, 0.3);
+    let mut s = spec(vec![a.clone(), b], None, true);
+    s.fixed = (0..8).map(|j| (0, j)).collect();
+    let out = build(&s).unwrap();
+    assert_eq!(out.model.curves[0], a);
+    assert!(dense_sine(&out.model, 200) <= 1e-6);
+}
+
+#[test]
+fn crossing_rulings_are_refused_with_u_and_v() {
+    // A flat strip whose rulings all cross its middle: developable, but it folds over itself.
+    let a: Vec<DVec3> = (0..5)
+        .map(|i| DVec3::new(i as f64 * 25.0, 0.0, 0.0))
+        .collect();
+    let b: Vec<DVec3> = (0..5)
+        .map(|i| DVec3::new(100.0 - i as f64 * 25.0, 50.0, 0.0))
+        .collect();
+    let err = build(&spec(vec![a, b], None, false)).unwrap_err();
+    match err {
+        SplineError::Striction { v, .. } => assert!((v - 0.5).abs() < 1e-6),
+        other => panic!("{other}"),
+    }
+    assert!(err_text().contains("u = "));
+}
+
+fn err_text() -> String {
+    SplineError::Striction {
+        u: 1.0,
+        v: 0.5,
+        strip: 1,
+    }
+    .to_string()
+}
+
+#[test]
+fn unequal_curves_and_a_cone_with_two_curves_are_refused() {
+    let mut s = spec(vec![wave(), wave()[..7].to_vec()], None, false);
+    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+    s.curves = vec![wave(), wave()];
+    s.apex = Some(DVec3::Z);
+    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+    s.curves = vec![wave()];
+    s.apex = None;
+    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+}
