@@ -110,60 +110,11 @@ impl BSpline {
         let p = self.degree;
         let u = u.clamp(0.0, self.spans() as f64);
         let k = self.knot_span(u);
-        // Basis of every degree 0..=p on span k: b[d][j] = N_{k−d+j, d}(u).
-        let mut b = vec![vec![1.0]];
-        for d in 1..=p {
-            let prev = &b[d - 1];
-            let mut cur = vec![0.0; d + 1];
-            for j in 0..=d {
-                let i = k + j - d; // basis N_{i,d}
-                let mut v = 0.0;
-                if j >= 1 {
-                    let den = self.knots[i + d] - self.knots[i];
-                    if den > 0.0 {
-                        v += (u - self.knots[i]) / den * prev[j - 1];
-                    }
-                }
-                if j < d {
-                    let den = self.knots[i + d + 1] - self.knots[i + 1];
-                    if den > 0.0 {
-                        v += (self.knots[i + d + 1] - u) / den * prev[j];
-                    }
-                }
-                cur[j] = v;
-            }
-            b.push(cur);
-        }
-        // Derivative of the degree-d basis from degree d−1 coefficients `c` (indexed like b[d−1]
-        // but as coefficients of the lower-degree functions): N′_{i,d} = d/(t_{i+d} − t_i)
-        // N_{i,d−1} − d/(t_{i+d+1} − t_{i+1}) N_{i+1,d−1}.
-        let deriv = |d: usize, lower: &[f64]| -> Vec<f64> {
-            let mut out = vec![0.0; d + 1];
-            for (j, o) in out.iter_mut().enumerate() {
-                let i = k + j - d;
-                if j >= 1 {
-                    let den = self.knots[i + d] - self.knots[i];
-                    if den > 0.0 {
-                        *o += d as f64 / den * lower[j - 1];
-                    }
-                }
-                if j < d {
-                    let den = self.knots[i + d + 1] - self.knots[i + 1];
-                    if den > 0.0 {
-                        *o -= d as f64 / den * lower[j];
-                    }
-                }
-            }
-            out
-        };
-        let d1 = deriv(p, &b[p - 1]);
-        let d2 = if p >= 2 {
-            // N″_{·,p} = derivative formula applied to N′_{·,p−1}.
-            let lower = deriv(p - 1, &b[p - 2]);
-            deriv(p, &lower)
-        } else {
-            vec![0.0; p + 1]
-        };
+        // N_{k−p..=k, p}(u) and their first two derivatives (Piegl & Tiller A2.3); above the
+        // degree they are zero.
+        let ders = super::curve::ders_basis(k, u, p, 2.min(p), &self.knots);
+        let zero = vec![0.0; p + 1];
+        let (d1, d2) = (&ders[1], ders.get(2).unwrap_or(&zero));
         let index = |j: usize| {
             let i = k + j - p;
             if self.closed {
@@ -174,9 +125,9 @@ impl BSpline {
         };
         let row = |w: &[f64]| -> Vec<(usize, f64)> { (0..=p).map(|j| (index(j), w[j])).collect() };
         Rows {
-            point: row(&b[p]),
-            d1: row(&d1),
-            d2: row(&d2),
+            point: row(&ders[0]),
+            d1: row(d1),
+            d2: row(d2),
         }
     }
 

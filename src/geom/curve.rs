@@ -352,7 +352,7 @@ fn span(len: usize, p: usize, knots: &[f64], u: f64) -> usize {
 }
 
 /// Basis function derivatives (Piegl & Tiller, The NURBS Book, algorithm A2.3).
-fn ders_basis(i: usize, u: f64, p: usize, n: usize, knots: &[f64]) -> Vec<Vec<f64>> {
+pub(crate) fn ders_basis(i: usize, u: f64, p: usize, n: usize, knots: &[f64]) -> Vec<Vec<f64>> {
     let mut ndu = vec![vec![0.0; p + 1]; p + 1];
     let mut left = vec![0.0; p + 1];
     let mut right = vec![0.0; p + 1];
