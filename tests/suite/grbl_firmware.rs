@@ -217,6 +217,44 @@ impl Firmware {
             .collect()
     }
 
+    /// Whether the simulated machine has frozen: it takes a 0.5 mm move and then reports
+    /// `Run` at one position for 0.6 s, where a working GRBL is done in milliseconds.
+    ///
+    /// grbl-sim emulates the AVR's interrupt flag with a plain variable that its serial-
+    /// interrupt thread and GRBL's main loop both save, clear and restore (`sreg = SREG; cli();
+    /// …; SREG = sreg;` in `system_set_exec_state_flag`, called on every `?`); when the two
+    /// interleave, the flag stays cleared and the stepper timer never fires again, not even
+    /// after a soft reset (GRBL enables interrupts once, at power-up), while `?` is still
+    /// answered. A real AVR runs one of the two at a time, and no host can cause the state:
+    /// GRBL in `Run` steps until its planner is empty.
+    pub fn frozen(&mut self) -> bool {
+        std::thread::sleep(Duration::from_millis(300));
+        self.read_until(|_| false, Duration::from_millis(100));
+        for l in ["$X", "G91 G0 X0.5", "G90"] {
+            let a = self.ask(l);
+            if a.last().map(String::as_str) != Some("ok") {
+                return false;
+            }
+        }
+        let mut seen = Vec::new();
+        for _ in 0..3 {
+            std::thread::sleep(Duration::from_millis(300));
+            if self.slave.write_all(b"?").is_err() {
+                return false;
+            }
+            let got = self.read_until(|l| l.starts_with('<'), Duration::from_secs(2));
+            let Some(l) = got.last().filter(|l| l.starts_with("<Run")) else {
+                return false;
+            };
+            let at = l
+                .split("MPos:")
+                .nth(1)
+                .and_then(|r| r.split(['|', 'W']).next());
+            seen.push(at.map(str::to_string));
+        }
+        seen[0].is_some() && seen.iter().all(|a| *a == seen[0])
+    }
+
     /// Bytes GRBL's receive buffer dropped.
     pub fn overflows(&self) -> usize {
         std::fs::read_to_string(self.dir.join("stderr.log"))
@@ -258,15 +296,55 @@ fn open_link(p: &Profile, path: &str) -> serial::Link {
     panic!("open {path}: {last:?}")
 }
 
-/// Stream `program` to the firmware with flatcut's sender.
+/// Stream `program` to the firmware with flatcut's sender. A job that times out on a frozen
+/// simulator (see [`Firmware::frozen`]) ends the attempt with a panic that begins [`FROZEN`], so that
+/// [`on_firmware`] can run the test again on a fresh firmware.
 fn send(
-    fw: &Firmware,
+    fw: &mut Firmware,
     p: &Profile,
     program: &[u8],
     o: &StreamOptions,
 ) -> Result<stream::StreamReport, StreamError> {
     let mut link = open_link(p, &fw.path);
-    stream::send(&mut link, p, program, o)
+    let r = stream::send(&mut link, p, program, o);
+    drop(link);
+    if let Err(e @ StreamError::Timeout { .. }) = &r {
+        if fw.frozen() {
+            panic!("{FROZEN} {}: {e}", fw.path);
+        }
+    }
+    r
+}
+
+/// How a test attempt that ended on a frozen simulator, not on anything flatcut did, begins
+/// its panic message.
+const FROZEN: &str = "grbl-sim froze:";
+
+/// How many times a test runs when the simulator freezes under it.
+const ATTEMPTS: usize = 5;
+
+/// Run `body` on a fresh GRBL `ver`, again (up to [`ATTEMPTS`] in all) when the simulator
+/// froze under it; any other failure fails the test at once. Without the firmware it skips.
+fn on_firmware(ver: &str, name: &str, speed: f64, body: impl Fn(Firmware)) {
+    for attempt in 1..=ATTEMPTS {
+        let Some(fw) = Firmware::start(ver, name, speed) else {
+            return;
+        };
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(fw))) {
+            Ok(()) => return,
+            Err(e) => {
+                let frozen = e
+                    .downcast_ref::<String>()
+                    .filter(|m| m.starts_with(FROZEN))
+                    .cloned();
+                match frozen {
+                    Some(m) if attempt < ATTEMPTS => eprintln!("GRBL {ver} ({name}), again: {m}"),
+                    Some(m) => panic!("GRBL {ver} ({name}), in all {ATTEMPTS} attempts: {m}"),
+                    None => std::panic::resume_unwind(e),
+                }
+            }
+        }
+    }
 }
 
 /// The end positions of the program's moves, as GRBL plans them: absolute mm, a move to
@@ -340,41 +418,40 @@ fn short_job() -> flatcut::toolpath::SheetJob {
 #[test]
 fn each_grbl_profile_runs_a_short_job_on_grbl_1_1h() {
     for name in ["grbl-laser", "grbl-dragknife", "grbl-pen"] {
-        let Some(mut fw) = Firmware::start("1.1h", name, 4.0) else {
-            return;
-        };
-        fw.settings(FAST);
-        if name == "grbl-laser" {
-            fw.settings(&["$32=1"]);
-        }
-        let p = quick(name);
-        let program = flatcut::output::program(&short_job(), &p).unwrap();
-        let r = send(&fw, &p, &program, &opts(20.0));
-        let text = String::from_utf8(program.clone()).unwrap();
-        let r = r.unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(r.lines, text.lines().count(), "{name}");
-        // Let the planner log the last blocks.
-        std::thread::sleep(Duration::from_millis(300));
-        assert_eq!(
-            fw.overflows(),
-            0,
-            "{name}: GRBL's receive buffer overflowed"
-        );
-        let want = program_moves(&text, 0.0);
-        let got = fw.blocks();
-        assert_eq!(
-            got.len(),
-            want.len(),
-            "{name}: blocks {got:?}\nmoves {want:?}"
-        );
-        for (g, w) in got.iter().zip(&want) {
-            for i in 0..3 {
-                assert!(
-                    (g[i] - w[i]).abs() <= 1.0 / STEPS_PER_MM,
-                    "{name}: {g:?} vs {w:?}"
-                );
+        on_firmware("1.1h", name, 4.0, |mut fw| {
+            fw.settings(FAST);
+            if name == "grbl-laser" {
+                fw.settings(&["$32=1"]);
             }
-        }
+            let p = quick(name);
+            let program = flatcut::output::program(&short_job(), &p).unwrap();
+            let r = send(&mut fw, &p, &program, &opts(20.0));
+            let text = String::from_utf8(program.clone()).unwrap();
+            let r = r.unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(r.lines, text.lines().count(), "{name}");
+            // Let the planner log the last blocks.
+            std::thread::sleep(Duration::from_millis(300));
+            assert_eq!(
+                fw.overflows(),
+                0,
+                "{name}: GRBL's receive buffer overflowed"
+            );
+            let want = program_moves(&text, 0.0);
+            let got = fw.blocks();
+            assert_eq!(
+                got.len(),
+                want.len(),
+                "{name}: blocks {got:?}\nmoves {want:?}"
+            );
+            for (g, w) in got.iter().zip(&want) {
+                for i in 0..3 {
+                    assert!(
+                        (g[i] - w[i]).abs() <= 1.0 / STEPS_PER_MM,
+                        "{name}: {g:?} vs {w:?}"
+                    );
+                }
+            }
+        });
     }
 }
 
@@ -594,160 +671,162 @@ fn the_simulator_answers_like_grbl_1_1h() {
 
 #[test]
 fn a_laser_job_with_held_oks_outlasts_a_short_timeout() {
-    let Some(mut fw) = Firmware::start("1.1h", "held-ok", 4.0) else {
-        return;
-    };
-    fw.settings(FAST);
-    fw.settings(&["$32=1"]);
-    let p = quick("grbl-laser");
-    // M5 waits for the 20 mm move (1 s of machine time, more on a loaded host): its `ok` is
-    // held far beyond the 0.5 s timeout, but the moving position is progress.
-    let job = "G21\nG90\nG94\nM4 S1000\nG1 X20 F1200\nM5\nM2\n";
-    let t = Instant::now();
-    let r = send(&fw, &p, job.as_bytes(), &opts(0.5));
-    let r = r.unwrap_or_else(|e| panic!("{e}"));
-    assert!(t.elapsed() > Duration::from_secs(1), "{:?}", t.elapsed());
-    assert_eq!(r.lines, 7);
-    assert!(StreamOptions::default().timeout >= Duration::from_secs(60));
-    assert_eq!(fw.overflows(), 0);
-    let b = fw.blocks();
-    assert!((b.last().unwrap()[0] - 20.0).abs() < 0.01, "{b:?}");
+    on_firmware("1.1h", "held-ok", 4.0, |mut fw| {
+        fw.settings(FAST);
+        fw.settings(&["$32=1"]);
+        let p = quick("grbl-laser");
+        // M5 waits for the 20 mm move (1 s of machine time, more on a loaded host): its `ok` is
+        // held far beyond the 0.5 s timeout, but the moving position is progress.
+        let job = "G21\nG90\nG94\nM4 S1000\nG1 X20 F1200\nM5\nM2\n";
+        let t = Instant::now();
+        let r = send(&mut fw, &p, job.as_bytes(), &opts(0.5));
+        let r = r.unwrap_or_else(|e| panic!("{e}"));
+        assert!(t.elapsed() > Duration::from_secs(1), "{:?}", t.elapsed());
+        assert_eq!(r.lines, 7);
+        assert!(StreamOptions::default().timeout >= Duration::from_secs(60));
+        assert_eq!(fw.overflows(), 0);
+        let b = fw.blocks();
+        assert!((b.last().unwrap()[0] - 20.0).abs() < 0.01, "{b:?}");
+    });
 }
 
 #[test]
 fn a_firmware_error_stops_the_job_with_the_tool_lifted() {
-    let Some(mut fw) = Firmware::start("1.1h", "error", 4.0) else {
-        return;
-    };
-    fw.settings(FAST);
-    let p = quick("grbl-dragknife");
-    // The knife is down (Z-1) when GRBL refuses line 7.
-    let job = "G21\nG90\nG94\nG0 Z2\nG0 X2 Y2\nG1 Z-1 F6000\nG5 X3\nG1 X4\nG0 Z2\nM2\n";
-    let e = send(&fw, &p, job.as_bytes(), &opts(5.0)).unwrap_err();
-    let msg = e.to_string();
-    assert!(
-        matches!(
-            e,
-            StreamError::Grbl {
-                code: 20,
-                line: 7,
-                ..
-            }
-        ),
-        "{msg}"
-    );
-    assert!(
-        msg.contains("G5 X3") && msg.contains("tool lifted"),
-        "{msg}"
-    );
-    std::thread::sleep(Duration::from_millis(300));
-    fw.slave.write_all(b"?").unwrap();
-    let st = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
-    let z: f64 = st
-        .last()
-        .and_then(|l| l.split("MPos:").nth(1))
-        .and_then(|m| m.split([',', '|']).nth(2))
-        .and_then(|z| z.parse().ok())
-        .unwrap_or(f64::NAN);
-    assert_eq!(z, 2.0, "{st:?}");
+    on_firmware("1.1h", "error", 4.0, |mut fw| {
+        fw.settings(FAST);
+        let p = quick("grbl-dragknife");
+        // The knife is down (Z-1) when GRBL refuses line 7.
+        let job = "G21\nG90\nG94\nG0 Z2\nG0 X2 Y2\nG1 Z-1 F6000\nG5 X3\nG1 X4\nG0 Z2\nM2\n";
+        let e = send(&mut fw, &p, job.as_bytes(), &opts(5.0)).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(
+                e,
+                StreamError::Grbl {
+                    code: 20,
+                    line: 7,
+                    ..
+                }
+            ),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("G5 X3") && msg.contains("tool lifted"),
+            "{msg}"
+        );
+        std::thread::sleep(Duration::from_millis(300));
+        fw.slave.write_all(b"?").unwrap();
+        let st = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
+        let z: f64 = st
+            .last()
+            .and_then(|l| l.split("MPos:").nth(1))
+            .and_then(|m| m.split([',', '|']).nth(2))
+            .and_then(|z| z.parse().ok())
+            .unwrap_or(f64::NAN);
+        assert_eq!(z, 2.0, "{st:?}");
+    });
 }
 
 #[test]
 fn a_reset_during_motion_stops_the_job_and_the_next_one_runs() {
-    let Some(fw) = Firmware::start("1.1h", "reset", 4.0) else {
-        return;
-    };
-    let mut fw = fw;
-    fw.settings(FAST);
-    let p = quick("grbl-dragknife");
-    let job = "G21\nG90\nG94\nG0 Z2\nG0 X0 Y0\nG1 Z-1 F6000\nG1 X40 F1200\nG1 Y5\nG0 Z2\nM2\n";
-    let (path, p2) = (fw.path.clone(), p.clone());
-    let t = std::thread::spawn(move || {
-        let mut link = open_link(&p2, &path);
-        stream::send(&mut link, &p2, job.as_bytes(), &opts(5.0))
+    on_firmware("1.1h", "reset", 4.0, |mut fw| {
+        fw.settings(FAST);
+        let p = quick("grbl-dragknife");
+        let job = "G21\nG90\nG94\nG0 Z2\nG0 X0 Y0\nG1 Z-1 F6000\nG1 X40 F1200\nG1 Y5\nG0 Z2\nM2\n";
+        let (path, p2) = (fw.path.clone(), p.clone());
+        let t = std::thread::spawn(move || {
+            let mut link = open_link(&p2, &path);
+            stream::send(&mut link, &p2, job.as_bytes(), &opts(5.0))
+        });
+        // Someone presses reset while the knife cuts the 40 mm line (2 s of machine time).
+        std::thread::sleep(Duration::from_millis(1500));
+        fw.slave.write_all(&[0x18]).unwrap();
+        let e = t.join().unwrap().unwrap_err();
+        if matches!(e, StreamError::Timeout { .. }) && fw.frozen() {
+            panic!("{FROZEN} {}: {e}", fw.path);
+        }
+        assert!(
+            matches!(
+                e,
+                StreamError::Alarm { code: 3, .. } | StreamError::HungUp { .. }
+            ),
+            "{e}"
+        );
+        // The next job unlocks the alarm and runs.
+        let r = send(&mut fw, &p, b"G21\nG90\nG0 Z2\nG0 X1 Y1\nM2\n", &opts(5.0));
+        r.unwrap_or_else(|e| panic!("after the reset: {e}"));
+        assert_eq!(fw.overflows(), 0);
     });
-    // Someone presses reset while the knife cuts the 40 mm line (2 s of machine time).
-    std::thread::sleep(Duration::from_millis(1500));
-    fw.slave.write_all(&[0x18]).unwrap();
-    let e = t.join().unwrap().unwrap_err();
-    assert!(
-        matches!(
-            e,
-            StreamError::Alarm { code: 3, .. } | StreamError::HungUp { .. }
-        ),
-        "{e}"
-    );
-    // The next job unlocks the alarm and runs.
-    let r = send(&fw, &p, b"G21\nG90\nG0 Z2\nG0 X1 Y1\nM2\n", &opts(5.0));
-    r.unwrap_or_else(|e| panic!("after the reset: {e}"));
-    assert_eq!(fw.overflows(), 0);
 }
 
 #[test]
 fn character_counting_fills_but_never_overflows_the_128_byte_buffer() {
-    let Some(mut fw) = Firmware::start("1.1h", "counting", 4.0) else {
-        return;
-    };
-    fw.settings(FAST);
-    let p = quick("grbl-dragknife");
-    // 150 tiny moves: the planner fills and lines wait in GRBL's receive buffer.
-    let mut job = String::from("G21\nG90\nG94\nG1 F6000\n");
-    for k in 1..=150 {
-        job.push_str(&format!(
-            "G1 X{:.3} Y{:.3}\n",
-            k as f64 * 0.05,
-            (k % 2) as f64 * 0.05
-        ));
-    }
-    job.push_str("M2\n");
-    send(&fw, &p, job.as_bytes(), &opts(5.0)).unwrap_or_else(|e| panic!("{e}"));
-    std::thread::sleep(Duration::from_millis(300));
-    assert_eq!(fw.overflows(), 0);
-    assert_eq!(fw.blocks().len(), 150);
-    // The check can fail: a host that does not count overflows the firmware's buffer.
-    let mut naive = String::new();
-    for k in 1..=40 {
-        naive.push_str(&format!("G1 X{:.3} Y1\n", k as f64 * 0.1));
-    }
-    fw.slave.write_all(naive.as_bytes()).unwrap();
-    let deadline = Instant::now() + Duration::from_secs(10);
-    while fw.overflows() == 0 && Instant::now() < deadline {
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    assert!(fw.overflows() > 0, "no RX overflow logged for a naive host");
+    on_firmware("1.1h", "counting", 4.0, |mut fw| {
+        fw.settings(FAST);
+        let p = quick("grbl-dragknife");
+        // 150 tiny moves: the planner fills and lines wait in GRBL's receive buffer.
+        let mut job = String::from("G21\nG90\nG94\nG1 F6000\n");
+        for k in 1..=150 {
+            job.push_str(&format!(
+                "G1 X{:.3} Y{:.3}\n",
+                k as f64 * 0.05,
+                (k % 2) as f64 * 0.05
+            ));
+        }
+        job.push_str("M2\n");
+        send(&mut fw, &p, job.as_bytes(), &opts(5.0)).unwrap_or_else(|e| panic!("{e}"));
+        std::thread::sleep(Duration::from_millis(300));
+        assert_eq!(fw.overflows(), 0);
+        assert_eq!(fw.blocks().len(), 150);
+        // The check can fail: a host that does not count overflows the firmware's buffer.
+        let mut naive = String::new();
+        for k in 1..=40 {
+            naive.push_str(&format!("G1 X{:.3} Y1\n", k as f64 * 0.1));
+        }
+        fw.slave.write_all(naive.as_bytes()).unwrap();
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while fw.overflows() == 0 && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        assert!(fw.overflows() > 0, "no RX overflow logged for a naive host");
+    });
 }
 
 #[test]
 fn grbl_0_9j_runs_a_job_and_its_text_errors_stop_the_next() {
-    let Some(mut fw) = Firmware::start("0.9j", "v0_9", 4.0) else {
-        return;
-    };
-    fw.settings(FAST);
-    let p = quick("grbl-pen");
-    let program = flatcut::output::program(&short_job(), &p).unwrap();
-    let text = String::from_utf8(program.clone()).unwrap();
-    let r = send(&fw, &p, &program, &opts(10.0)).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(r.lines, text.lines().count());
-    std::thread::sleep(Duration::from_millis(300));
-    assert_eq!(fw.overflows(), 0);
-    let (got, want) = (fw.blocks(), program_moves(&text, 0.0));
-    assert_eq!(got.len(), want.len(), "{got:?}\n{want:?}");
-    // GRBL 0.9 says `error: Unsupported command`: an error all the same.
-    let e = send(&fw, &p, b"G21\nG0 X1\nG5 X1\nG0 X2\n", &opts(5.0)).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            StreamError::Grbl {
-                code: 20,
-                line: 3,
-                ..
-            }
-        ),
-        "{e}"
-    );
-    // Its status `<Idle,MPos:…>` is read: a held `ok` does not time out on 0.9 either.
-    let r = send(&fw, &p, b"G21\nG1 X20 F1200\nG4 P0\nG0 X0\n", &opts(0.5));
-    r.unwrap_or_else(|e| panic!("0.9 status: {e}"));
+    on_firmware("0.9j", "v0_9", 4.0, |mut fw| {
+        fw.settings(FAST);
+        let p = quick("grbl-pen");
+        let program = flatcut::output::program(&short_job(), &p).unwrap();
+        let text = String::from_utf8(program.clone()).unwrap();
+        let r = send(&mut fw, &p, &program, &opts(10.0)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(r.lines, text.lines().count());
+        std::thread::sleep(Duration::from_millis(300));
+        assert_eq!(fw.overflows(), 0);
+        let (got, want) = (fw.blocks(), program_moves(&text, 0.0));
+        assert_eq!(got.len(), want.len(), "{got:?}\n{want:?}");
+        // GRBL 0.9 says `error: Unsupported command`: an error all the same.
+        let e = send(&mut fw, &p, b"G21\nG0 X1\nG5 X1\nG0 X2\n", &opts(5.0)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                StreamError::Grbl {
+                    code: 20,
+                    line: 3,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // Its status `<Idle,MPos:…>` is read: a held `ok` does not time out on 0.9 either.
+        let r = send(
+            &mut fw,
+            &p,
+            b"G21\nG1 X20 F1200\nG4 P0\nG0 X0\n",
+            &opts(0.5),
+        );
+        r.unwrap_or_else(|e| panic!("0.9 status: {e}"));
+    });
 }
 
 #[test]
@@ -778,4 +857,39 @@ fn the_house_on_grbl_laser_turns_the_beam_on_once() {
     assert_eq!(count("M4"), 1, "M4");
     assert_eq!(count("M5"), 1, "M5");
     assert!(text.lines().all(|l| l.len() <= 79));
+}
+
+/// The simulator reports where the machine is along the move in progress, as GRBL does from
+/// its step counts: a host that watches the position for signs of life (flatcut's GRBL sender
+/// does) sees a long move advance, not a machine parked at the move's end.
+#[test]
+fn the_simulators_status_moves_along_a_long_move() {
+    let p = profile::find("grbl-dragknife").unwrap();
+    let mut cfg = flatcut::device::sim::SimConfig::new(p);
+    cfg.time_factor = Some(1.0);
+    let h = flatcut::device::sim::spawn(cfg).unwrap();
+    let mut sim = raw_port(&h.path);
+    let mut partial = Vec::new();
+    for l in ["G21", "G90", "G0 Z0", "G1 X40 F600"] {
+        assert_eq!(ask(&mut sim, &mut partial, l).last().unwrap(), "ok", "{l}");
+    }
+    // 40 mm at 10 mm/s: 4 s of motion, asked about at about 1, 2 and 3 s.
+    let mut xs = Vec::new();
+    for _ in 0..3 {
+        std::thread::sleep(Duration::from_secs(1));
+        sim.write_all(b"?").unwrap();
+        let a = read_answer(&mut sim, &mut partial, |l| l.starts_with('<'));
+        let status = a.last().unwrap().clone();
+        assert!(status.starts_with("<Run|MPos:"), "{status}");
+        let x: f64 = status["<Run|MPos:".len()..]
+            .split(',')
+            .next()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{status}"));
+        xs.push(x);
+    }
+    assert!(xs[0] > 0.0 && xs[2] < 40.0, "{xs:?}");
+    assert!(xs[0] < xs[1] && xs[1] < xs[2], "{xs:?}");
+    drop(sim);
+    let _ = h.stop();
 }

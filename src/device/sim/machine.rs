@@ -4,6 +4,7 @@
 //! the device would. [`super::spawn`] starts it; [`super::SimHandle`] steers it.
 
 use super::*;
+use glam::DVec3;
 use serialport::SerialPort;
 
 /// One direction of a serial line: bytes complete one every `1 / rate` seconds.
@@ -78,8 +79,8 @@ pub(super) struct Device {
     stopped_at: Option<Instant>,
     taken_since_stop: usize,
     backlog_at_grace: Option<usize>,
-    /// Remaining seconds (real time) of each queued motion.
-    motion: VecDeque<f64>,
+    /// Each queued motion, the one in progress first.
+    motion: VecDeque<Queued>,
     held: bool,
     /// GRBL: an `ok` (and maybe a pause) owed once the planner is empty (after a `G4`).
     owed_ok: Option<bool>,
@@ -336,7 +337,10 @@ impl Device {
                     } else {
                         "Run"
                     };
-                    let s = g.status(state);
+                    // Where the machine is: along the move in progress, as GRBL counts its
+                    // steps, or at the end of the last line when nothing moves.
+                    let at = self.motion.front().map_or(g.pos, Queued::position);
+                    let s = g.status(state, at);
                     self.out.extend_from_slice(s.as_bytes());
                     self.out.extend_from_slice(b"\r\n");
                     return;
@@ -390,11 +394,11 @@ impl Device {
         }
         let mut left = dt;
         while let Some(front) = self.motion.front_mut() {
-            if *front > left {
-                *front -= left;
+            if front.left > left {
+                front.left -= left;
                 break;
             }
-            left -= *front;
+            left -= front.left;
             self.motion.pop_front();
         }
     }
@@ -425,7 +429,7 @@ impl Device {
                     let t = m.execute(&instr);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
-                        self.motion.push_back(s);
+                        self.motion.push_back(Queued::still(s, DVec3::ZERO));
                     }
                 }
                 Interp::Gpgl(m) => {
@@ -439,7 +443,7 @@ impl Device {
                     let t = m.execute(&instr);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
-                        self.motion.push_back(s);
+                        self.motion.push_back(Queued::still(s, DVec3::ZERO));
                     }
                 }
                 Interp::Grbl(_) => {
@@ -494,6 +498,7 @@ impl Device {
             .filter(|(k, _)| *k == self.grbl_lines)
             .map(|(_, c)| c);
         let busy = !self.motion.is_empty();
+        let from = g.pos;
         let result = match injected {
             Some(c) => Err(c),
             None => g.execute(&line, busy),
@@ -503,11 +508,17 @@ impl Device {
                 self.rep.simulated_time_s += e.seconds + e.correction + e.dwell.unwrap_or(0.0);
                 if let Some(c) = scale_time(tf, -e.correction) {
                     if let Some(back) = self.motion.back_mut() {
-                        *back = (*back - c).max(0.0);
+                        back.left = (back.left - c).max(0.0);
+                        back.total = (back.total - c).max(back.left);
                     }
                 }
                 if let Some(s) = scale_time(tf, e.seconds) {
-                    self.motion.push_back(s);
+                    self.motion.push_back(Queued {
+                        left: s,
+                        total: s,
+                        from,
+                        to: g.pos,
+                    });
                 }
                 for l in &e.text {
                     self.out.extend_from_slice(l.as_bytes());
@@ -515,7 +526,7 @@ impl Device {
                 }
                 if let Some(d) = e.dwell {
                     if let Some(s) = scale_time(tf, d) {
-                        self.motion.push_back(s);
+                        self.motion.push_back(Queued::still(s, g.pos));
                     }
                     self.owed_ok = Some(e.pause);
                     return true;
@@ -634,6 +645,36 @@ impl Device {
         }
         let _ = self.slave.take();
         self.rep
+    }
+}
+
+/// One queued motion: the real seconds left of its whole, and the straight line it takes
+/// (an arc reports its chord: the status position is only for a host to see motion).
+struct Queued {
+    left: f64,
+    total: f64,
+    from: DVec3,
+    to: DVec3,
+}
+
+impl Queued {
+    /// A wait in one place (a dwell, or an HP-GL/GP-GL instruction, whose status is not asked).
+    fn still(seconds: f64, at: DVec3) -> Self {
+        Queued {
+            left: seconds,
+            total: seconds,
+            from: at,
+            to: at,
+        }
+    }
+
+    fn position(&self) -> DVec3 {
+        let done = if self.total > 0.0 {
+            (1.0 - self.left / self.total).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        self.from.lerp(self.to, done)
     }
 }
 

@@ -13,8 +13,9 @@
 //! empty (`M3`/`M4`/`M5`, `S` changes, `G4`, `M2`, and any line once the planner is full), so a
 //! long move can hold the next answer for minutes. While a job runs the status is asked with
 //! `?` (a real-time byte, never counted in the buffer) five times a second, and a machine
-//! whose position moves or whose state is `Run` or `Hold` (a pause waiting to resume) counts
-//! as busy: the timeout is about a machine that makes no progress at all.
+//! whose position moves, that enters `Run`, or that is held (`Hold`, `Door`: a pause waiting
+//! for its operator) counts as busy. A machine that says `Run` but stays at one position for
+//! the whole timeout has stopped: the timeout is about a machine that makes no progress.
 //!
 //! At connect the welcome says which GRBL it is (`Grbl 0.9…`: text errors and the 0.9 status,
 //! read alike). On GRBL 1.1 a laser profile (tools with `power`) needs laser mode, `$32=1`, and
@@ -331,8 +332,12 @@ impl<'a> Grbl<'a> {
                 })
             }
             Response::Status(s) => {
-                // A moving or busy machine is making progress even when no `ok` comes.
-                if s.busy() || (s.mpos.is_some() && self.mpos.is_some() && s.mpos != self.mpos) {
+                // A moving machine, or one paused by its operator (Hold, Door), is making
+                // progress even when no `ok` comes; one that says Run but has not moved for the
+                // whole timeout has stopped.
+                let moved = s.mpos.is_some() && self.mpos.is_some() && s.mpos != self.mpos;
+                let paused = s.busy() && s.state != "Run" && s.state != "Jog";
+                if moved || paused || (s.busy() && s.state != self.state) {
                     self.last_answer = Instant::now();
                 }
                 self.state = s.state;

@@ -669,20 +669,20 @@ impl Grbl {
     }
 
     /// A status report in the firmware's format (1.1: `|` fields; 0.9: `,` fields with WPos).
-    pub fn status(&self, state: &str) -> String {
-        let w = self.pos - self.offset();
+    pub fn status(&self, state: &str, at: DVec3) -> String {
+        let w = at - self.offset();
         if self.v0_9 {
             let state = state.split(':').next().unwrap_or(state);
             return format!(
                 "<{state},MPos:{:.3},{:.3},{:.3},WPos:{:.3},{:.3},{:.3}>",
-                self.pos.x, self.pos.y, self.pos.z, w.x, w.y, w.z
+                at.x, at.y, at.z, w.x, w.y, w.z
             );
         }
         format!(
             "<{state}|MPos:{:.3},{:.3},{:.3}|FS:{},{}>",
-            self.pos.x,
-            self.pos.y,
-            self.pos.z,
+            at.x,
+            at.y,
+            at.z,
             self.feed,
             if self.spindle_on { self.s } else { 0.0 }
         )
