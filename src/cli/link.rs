@@ -18,7 +18,8 @@
 //! the same one.
 //!
 //! **Media.** Before the first byte, a job wider than the profile's `media_width` (the largest
-//! x of its strokes, across the media) is refused, naming both sizes.
+//! x of its strokes, across the media) or longer than its `media_length` (the largest y, along
+//! the media) is refused, naming both sizes; `send` checks a program file alike.
 
 use crate::device::sim::{self, SimConfig};
 use crate::device::stream::{self, StreamOptions};
@@ -104,38 +105,58 @@ pub fn deliver_run(
 }
 
 /// A job whose strokes reach further across the media (sheet x) than the profile's
-/// `media_width` is an error naming both sizes; `media_width = 0` (unknown) passes.
+/// `media_width`, or further along it (sheet y) than its `media_length`, is an error naming
+/// both sizes; a size of 0 (unknown, or a roll) passes.
 pub fn check_media(profile: &Profile, job: &crate::toolpath::Job) -> Result<(), Error> {
-    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
-        return Ok(());
-    }
     for (i, sheet) in job.sheets.iter().enumerate() {
         let points = || sheet.strokes.iter().flat_map(|s| &s.points);
         let wide = points().map(|q| q.x).fold(0.0, f64::max);
         let long = points().map(|q| q.y).fold(0.0, f64::max);
-        if wide > profile.media_width + 1e-6 {
-            return Err(Error::Usage(format!(
-                "{} sheet {} is {wide:.1} × {long:.1} mm ({wide:.1} mm across the media), wider than the {:.0} mm media of device `{}` ({}): nothing was sent; nest it on a narrower sheet or split the piece",
-                job.name,
-                i + 1,
-                profile.media_width,
-                profile.name,
-                profile.source
-            )));
-        }
+        let what = format!("{} sheet {} is {wide:.1} × {long:.1} mm", job.name, i + 1);
+        media_fits(
+            profile,
+            &what,
+            wide,
+            long,
+            "nest it on a smaller sheet or split the piece",
+        )?;
     }
     Ok(())
 }
 
-/// `send`: an HP-GL or GP-GL program that reaches further across the media than the profile's
-/// `media_width` is refused before the first byte, as [`check_media`] does for a job (its
-/// tool-down points, in the machine's axes: across the media is the machine's Y when the
-/// profile exchanges the axes, else X). G-code programs are not read here.
+/// `what` reaches `wide` mm across the media and `long` mm along it: an error when that is
+/// more than the profile's media (a size of 0 is not checked).
+fn media_fits(
+    profile: &Profile,
+    what: &str,
+    wide: f64,
+    long: f64,
+    hint: &str,
+) -> Result<(), Error> {
+    let over = |reach: f64, size: f64| size.is_finite() && size > 0.0 && reach > size + 1e-6;
+    let (name, source) = (&profile.name, &profile.source);
+    if over(wide, profile.media_width) {
+        return Err(Error::Usage(format!(
+            "{what} ({wide:.1} mm across the media), wider than the {:.0} mm media of device `{name}` ({source}): nothing was sent; {hint}",
+            profile.media_width
+        )));
+    }
+    if over(long, profile.media_length) {
+        return Err(Error::Usage(format!(
+            "{what} ({long:.1} mm along the media), longer than the {:.0} mm the device `{name}` can cut ({source}): nothing was sent; {hint}",
+            profile.media_length
+        )));
+    }
+    Ok(())
+}
+
+/// `send`: a program that reaches further across or along the media than the profile's
+/// `media_width` and `media_length` is refused before the first byte, as [`check_media`] does
+/// for a job. HP-GL and GP-GL: its tool-down points, in the machine's axes (across the media
+/// is the machine's Y when the profile exchanges the axes, else X), their span. G-code: every
+/// move, from the work zero (a flatbed's origin corner), which nothing may pass below either.
 pub fn check_program_media(profile: &Profile, name: &str, bytes: &[u8]) -> Result<(), Error> {
     use crate::profile::Language;
-    if profile.media_width.is_nan() || profile.media_width <= 0.0 {
-        return Ok(());
-    }
     let points: Vec<(i64, i64)> = match profile.language {
         Language::Hpgl => crate::output::hpgl::parse(&String::from_utf8_lossy(bytes))
             .map(|v| v.into_iter().flat_map(|s| s.points).collect())
@@ -143,24 +164,48 @@ pub fn check_program_media(profile: &Profile, name: &str, bytes: &[u8]) -> Resul
         Language::Gpgl => crate::output::gpgl::parse(bytes)
             .map(|v| v.into_iter().flat_map(|s| s.points).collect())
             .unwrap_or_default(),
-        Language::Gcode => return Ok(()),
+        Language::Gcode => {
+            let Some([x0, y0, x1, y1]) = crate::output::gcode_reach(bytes) else {
+                return Ok(());
+            };
+            let (lo_across, lo_along, hi_across, hi_along) = if profile.axes.swap_xy {
+                (y0, x0, y1, x1)
+            } else {
+                (x0, y0, x1, y1)
+            };
+            let (wide, long) = (hi_across.max(0.0), hi_along.max(0.0));
+            let what = format!("{name}: its moves reach {wide:.1} × {long:.1} mm");
+            media_fits(
+                profile,
+                &what,
+                wide,
+                long,
+                "move the work zero or nest it smaller",
+            )?;
+            let below = lo_across.min(lo_along);
+            if below < -1e-6 && (profile.media_width > 0.0 || profile.media_length > 0.0) {
+                return Err(Error::Usage(format!(
+                    "{name}: its moves go {:.1} mm below the work zero, off the bed of device `{}` ({}): nothing was sent",
+                    -below, profile.name, profile.source
+                )));
+            }
+            return Ok(());
+        }
     };
     let across = |p: &(i64, i64)| if profile.axes.swap_xy { p.1 } else { p.0 };
-    let (lo, hi) = points
-        .iter()
-        .map(across)
-        .fold((i64::MAX, i64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-    if hi < lo {
+    let along = |p: &(i64, i64)| if profile.axes.swap_xy { p.0 } else { p.1 };
+    let span = |f: &dyn Fn(&(i64, i64)) -> i64| {
+        let (lo, hi) = points
+            .iter()
+            .map(f)
+            .fold((i64::MAX, i64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+        (hi >= lo).then(|| (hi - lo) as f64 / profile.units_per_mm)
+    };
+    let (Some(wide), Some(long)) = (span(&across), span(&along)) else {
         return Ok(());
-    }
-    let wide = (hi - lo) as f64 / profile.units_per_mm;
-    if wide > profile.media_width + 1e-6 {
-        return Err(Error::Usage(format!(
-            "{name}: its cuts span {wide:.1} mm across the media, wider than the {:.0} mm media of device `{}` ({}): nothing was sent",
-            profile.media_width, profile.name, profile.source
-        )));
-    }
-    Ok(())
+    };
+    let what = format!("{name}: its cuts span {wide:.1} × {long:.1} mm");
+    media_fits(profile, &what, wide, long, "nest it on a smaller sheet")
 }
 
 /// [`deliver`], printing what it says unless `quiet`.

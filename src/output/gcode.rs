@@ -340,6 +340,91 @@ pub(crate) fn emit(sheet: &SheetJob, profile: &Profile) -> Result<Vec<u8>, Outpu
     Ok(w.out.into_bytes())
 }
 
+/// Where a G-code program takes the machine: the least and greatest X and Y that its moves
+/// reach, `[x_min, y_min, x_max, y_max]` in mm, or `None` when no line moves in X or Y. It
+/// follows `G20`/`G21` (inches, millimetres) and `G90`/`G91` (absolute, incremental from the
+/// start at 0,0), skips comments (`;…`, `(…)`) and lines that set coordinates without moving
+/// (`G92`, `G10`, `G28.1`, `G30.1`), and counts an arc by its end point. For checking a program
+/// against the machine's work area before it is sent; not a G-code validator.
+pub fn reach(program: &[u8]) -> Option<[f64; 4]> {
+    let text = String::from_utf8_lossy(program);
+    let (mut inch, mut relative) = (false, false);
+    let mut pos = [0.0f64; 2];
+    let mut out: Option<[f64; 4]> = None;
+    for line in text.lines() {
+        let mut code = String::with_capacity(line.len());
+        let mut depth = 0usize;
+        for c in line.chars() {
+            match c {
+                ';' if depth == 0 => break,
+                '(' => depth += 1,
+                ')' => depth = depth.saturating_sub(1),
+                _ if depth == 0 && !c.is_whitespace() => code.push(c.to_ascii_uppercase()),
+                _ => {}
+            }
+        }
+        let mut words: Vec<(char, &str)> = Vec::new();
+        let mut rest = code.as_str();
+        while let Some(letter) = rest.chars().next() {
+            let tail = &rest[letter.len_utf8()..];
+            let end = tail
+                .find(|c: char| c.is_ascii_alphabetic())
+                .unwrap_or(tail.len());
+            words.push((letter, &tail[..end]));
+            rest = &tail[end..];
+        }
+        let g = |w: &str| {
+            words
+                .iter()
+                .any(|&(l, v)| l == 'G' && v.parse::<f64>().ok() == w.parse::<f64>().ok())
+        };
+        if g("20") {
+            inch = true;
+        }
+        if g("21") {
+            inch = false;
+        }
+        if g("90") {
+            relative = false;
+        }
+        if g("91") {
+            relative = true;
+        }
+        if g("92") || g("10") || g("28.1") || g("30.1") || g("53") {
+            continue;
+        }
+        let scale = if inch { 25.4 } else { 1.0 };
+        let mut moved = false;
+        for &(l, v) in &words {
+            let axis = match l {
+                'X' => 0,
+                'Y' => 1,
+                _ => continue,
+            };
+            let Ok(v) = v.parse::<f64>() else { continue };
+            if !v.is_finite() {
+                continue;
+            }
+            pos[axis] = if relative {
+                pos[axis] + v * scale
+            } else {
+                v * scale
+            };
+            moved = true;
+        }
+        if moved {
+            let r = out.get_or_insert([pos[0], pos[1], pos[0], pos[1]]);
+            *r = [
+                r[0].min(pos[0]),
+                r[1].min(pos[1]),
+                r[2].max(pos[0]),
+                r[3].max(pos[1]),
+            ];
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -681,5 +766,17 @@ mod tests {
 
     fn down_paths(program: &str, p: &Profile) -> Vec<Vec<DVec2>> {
         run(program, p).paths
+    }
+
+    #[test]
+    fn reach_follows_units_modes_and_comments() {
+        let p = b"G21\nG90 (abs)\nG0 X10 Y-5 ; travel\nG1 X250.5 Y40 F600\n(G1 X999)\nG92 X0 Y0\nG20\nG0 X1 Y1\nG91\nG1 X-2 Y0.5\nM2\n";
+        let r = reach(p).unwrap();
+        let want = [-25.4, -5.0, 250.5, 40.0];
+        for k in 0..4 {
+            assert!((r[k] - want[k]).abs() < 1e-9, "{r:?}");
+        }
+        assert_eq!(reach(b"G21\nG90\nM3 S10\nM2\n"), None);
+        assert_eq!(reach(b"\xff\xfe G1 Xnan Y"), None);
     }
 }

@@ -25,6 +25,7 @@ use glam::DVec2;
 pub mod dxf;
 pub mod files;
 pub(crate) mod gcode;
+pub use gcode::reach as gcode_reach;
 pub mod gpgl;
 pub mod hpgl;
 pub mod obj;

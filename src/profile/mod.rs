@@ -156,6 +156,10 @@ pub struct Profile {
     /// Largest width the machine can cut (mm); 0 when unknown.
     #[serde(default)]
     pub media_width: f64,
+    /// Longest the machine can cut along the media (mm): a flatbed's or a mat's length, or a
+    /// roll cutter's longest tracked cut; 0 when unknown or unlimited.
+    #[serde(default)]
+    pub media_length: f64,
     #[serde(default)]
     pub axes: Axes,
     #[serde(default)]

@@ -113,15 +113,17 @@ fn check(p: &Profile) -> Result<(), Problem> {
             ),
         ));
     }
-    if !(p.media_width.is_finite() && p.media_width >= 0.0) {
-        return Err(problem(
-            "",
-            "media_width",
-            format!(
-                "must be 0 (unknown) or a width in mm, got {}",
-                p.media_width
-            ),
-        ));
+    for (key, v) in [
+        ("media_width", p.media_width),
+        ("media_length", p.media_length),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(problem(
+                "",
+                key,
+                format!("must be 0 (unknown) or a size in mm, got {v}"),
+            ));
+        }
     }
     if p.buffer == 0 {
         return Err(problem("", "buffer", "must be at least 1 byte"));

@@ -375,3 +375,67 @@ fn a_blank_wider_than_the_media_is_refused_before_the_first_byte() {
     let rep = h.stop().unwrap();
     assert_eq!(rep.bytes_received, 0);
 }
+
+/// A flatbed has a length as well as a width: `send` reads a G-code program's moves and
+/// refuses one that leaves the bed (longer than `media_length`, wider than `media_width`, or
+/// below the work zero) before the first byte; one inside the bed goes.
+#[test]
+fn a_gcode_program_off_the_bed_is_refused_before_the_first_byte() {
+    let out = scratch("media-long");
+    let p = profile::find("grbl-pen").unwrap();
+    assert!(p.media_length > 0.0 && p.media_width > 0.0);
+    let cases = [
+        (
+            "long",
+            format!("G21\nG90\nG0 X10 Y{:.1}\nM2\n", p.media_length + 50.0),
+            Some(format!(
+                "{:.1} mm along the media), longer than the {:.0} mm",
+                p.media_length + 50.0,
+                p.media_length
+            )),
+        ),
+        (
+            "inches",
+            // 20 in = 508 mm across, wider than the bed though the number is small.
+            "G20\nG90\nG0 X20 Y1\nM2\n".to_string(),
+            Some(format!("wider than the {:.0} mm media", p.media_width)),
+        ),
+        (
+            "below",
+            "G21\nG91\nG0 X10 Y10\nG0 X-25\nG90\nM2\n".to_string(),
+            Some("15.0 mm below the work zero".to_string()),
+        ),
+        ("fits", "G21\nG90\nG0 X10 Y20\nG0 X0 Y0\nM2\n".to_string(), None),
+    ];
+    for (name, program, refusal) in cases {
+        let file = out.join(format!("{name}.gcode"));
+        std::fs::write(&file, &program).unwrap();
+        let h = sim_for("grbl-pen");
+        let o = flatcut(&[
+            "send",
+            file.to_str().unwrap(),
+            "--device",
+            "grbl-pen",
+            "--port",
+            &h.path,
+            "--timeout",
+            "10",
+        ]);
+        let e = stderr(&o);
+        match refusal {
+            Some(want) => {
+                assert_eq!(o.status.code(), Some(1), "{name}: {e}");
+                assert!(
+                    e.contains(&want) && e.contains("nothing was sent") && e.contains(name),
+                    "{name}: {e}"
+                );
+                std::thread::sleep(Duration::from_millis(200));
+                assert_eq!(h.stop().unwrap().bytes_received, 0, "{name}");
+            }
+            None => {
+                assert!(o.status.success(), "{name}: {e}");
+                assert!(h.stop().unwrap().bytes_received > 0, "{name}");
+            }
+        }
+    }
+}
