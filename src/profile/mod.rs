@@ -27,7 +27,7 @@ mod tools;
 
 pub use grbl::GrblMachine;
 pub use read::parse;
-pub use serial::{FlowControl, Parity, Protocol, SerialSettings};
+pub use serial::{FlowControl, Parity, Protocol, SerialSettings, StatusQuery};
 pub use tools::DEFAULT_PERFORATION;
 pub(crate) use tools::TOOL_KINDS;
 pub use tools::{StrokeKind, Tool};
@@ -452,6 +452,26 @@ mod tests {
     fn begins(text: &str, prefix: &str) {
         let e = error(text);
         assert!(e.starts_with(prefix), "{e}");
+    }
+
+    #[test]
+    fn status_query_is_for_hpgl_and_media_sizes_are_sizes() {
+        says(
+            &format!("{GCODE}[serial]\nbaud=115200\nstatus_query='esc-b'\n"),
+            "status_query",
+        );
+        says(
+            &format!("{GCODE}[serial]\nbaud=115200\nstatus_query='oa'\n"),
+            "status_query",
+        );
+        let hpgl = format!("{HPGL}[serial]\nbaud=9600\nstatus_query='esc-b'\n[tools.cut]\npen=1\n");
+        assert_eq!(
+            parse(&hpgl, "x.toml").unwrap().serial.status_query,
+            StatusQuery::EscB
+        );
+        says(&format!("{HPGL}media_length=-1\n"), "media_length");
+        assert_eq!(bundled("grbl-pen").media_length, 400.0);
+        assert_eq!(bundled("roland-gx24").media_length, 0.0);
     }
 
     #[test]

@@ -125,6 +125,13 @@ fn check(p: &Profile) -> Result<(), Problem> {
             ));
         }
     }
+    if p.serial.status_query != super::StatusQuery::None && p.language != Language::Hpgl {
+        return Err(problem(
+            "serial",
+            "status_query",
+            "`esc-b` is HP's RS-232 device control, for HP-GL devices only",
+        ));
+    }
     if p.buffer == 0 {
         return Err(problem("", "buffer", "must be at least 1 byte"));
     }

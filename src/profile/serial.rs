@@ -15,6 +15,22 @@ pub struct SerialSettings {
     pub stop_bits: u8,
     #[serde(default)]
     pub flow_control: FlowControl,
+    /// How a buffered (HP-GL) device can be asked, while it holds the host off, whether it is
+    /// still working: `esc-b` for HP's RS-232 device-control query `ESC . B` (output buffer
+    /// space), which the device answers at once, even with its buffer full.
+    #[serde(default)]
+    pub status_query: StatusQuery,
+}
+
+/// A buffered device's output channel, for asking it how it is doing while it holds the host off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum StatusQuery {
+    /// No output channel (or none flatcut uses): a hold longer than the timeout is a stop.
+    #[default]
+    None,
+    /// `ESC . B`: the device answers its free buffer space in bytes, then CR.
+    EscB,
 }
 
 fn default_data_bits() -> u8 {
@@ -32,6 +48,7 @@ impl Default for SerialSettings {
             parity: Parity::None,
             stop_bits: 1,
             flow_control: FlowControl::None,
+            status_query: StatusQuery::None,
         }
     }
 }

@@ -753,3 +753,46 @@ fn a_grbl_that_says_run_but_never_moves_times_out() {
     assert!(took < Duration::from_secs(10), "{took:?}");
     assert!(peer.join().unwrap() > 5);
 }
+
+/// An HP-GL device that holds the host off (XOFF) for longer than the timeout while it works
+/// off long moves: without an output channel that is a stop; with `status_query = "esc-b"`
+/// the host asks `ESC . B` and a growing free space is progress, so the job completes, and
+/// the queries are neither violations nor garbage.
+#[test]
+fn a_busy_hpgl_device_that_answers_esc_b_outlasts_the_timeout() {
+    // 40 moves of 100 mm at 20 cm/s (0.5 s each), ×4: a hold works off ~13 of them, 1.6 s.
+    let mut s = String::from("IN;SP1;PU0,0;\n");
+    for k in 0..40 {
+        s.push_str(&format!("PD{},0;\n", if k % 2 == 0 { 4000 } else { 0 }));
+    }
+    s.push_str("PU;SP0;\n");
+    let plain = hpgl_profile(115_200, "xon-xoff", 256);
+    let (r, rep) = run(
+        &plain,
+        s.as_bytes(),
+        Some(4.0),
+        Faults::default(),
+        &opts(0.8),
+    );
+    let e = r.unwrap_err();
+    assert!(e.to_string().contains("waiting for XON"), "{e}");
+    assert_eq!(rep.flow_violations, 0);
+
+    let mut asking = plain.clone();
+    asking.serial.status_query = flatcut::profile::StatusQuery::EscB;
+    let t = std::time::Instant::now();
+    let (r, rep) = run(
+        &asking,
+        s.as_bytes(),
+        Some(4.0),
+        Faults::default(),
+        &opts(0.8),
+    );
+    let r = r.unwrap_or_else(|e| panic!("{e}"));
+    assert!(t.elapsed() > Duration::from_secs(3), "{:?}", t.elapsed());
+    assert_eq!(r.bytes, s.len());
+    assert!(r.xoff_received > 0);
+    assert_eq!(r.garbage_bytes, 0);
+    assert_eq!(rep.violations(), 0, "{rep:?}");
+    assert_eq!(rep.bytes_received, s.len(), "the queries are not data");
+}

@@ -405,7 +405,11 @@ fn a_gcode_program_off_the_bed_is_refused_before_the_first_byte() {
             "G21\nG91\nG0 X10 Y10\nG0 X-25\nG90\nM2\n".to_string(),
             Some("15.0 mm below the work zero".to_string()),
         ),
-        ("fits", "G21\nG90\nG0 X10 Y20\nG0 X0 Y0\nM2\n".to_string(), None),
+        (
+            "fits",
+            "G21\nG90\nG0 X10 Y20\nG0 X0 Y0\nM2\n".to_string(),
+            None,
+        ),
     ];
     for (name, program, refusal) in cases {
         let file = out.join(format!("{name}.gcode"));

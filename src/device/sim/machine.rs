@@ -88,6 +88,13 @@ pub(super) struct Device {
     ok_on_resume: bool,
     grbl_lines: usize,
     garbage_sent: bool,
+    /// The device answers HP's `ESC . B` (profile `status_query = "esc-b"`).
+    esc_b: bool,
+    /// Bytes of a device-control sequence (`ESC . X`) read so far.
+    esc: u8,
+    /// With `esc_b`: data bytes read past the skid while the host is held off, which a
+    /// stopped transmitter would still hold (taken into the buffer when the stop ends).
+    held_back: VecDeque<u8>,
     stalled: bool,
     rep: SimReport,
     /// Answers produced, then queued for the line.
@@ -159,6 +166,9 @@ impl Device {
             ok_on_resume: false,
             grbl_lines: 0,
             garbage_sent: false,
+            esc_b: !grbl && p.serial.status_query == crate::profile::StatusQuery::EscB,
+            esc: 0,
+            held_back: VecDeque::new(),
             stalled: false,
             rep,
             out: Vec::new(),
@@ -197,7 +207,9 @@ impl Device {
             };
             let on_line = rx_line.ready(now, waiting);
             let mut allowance = on_line;
-            if self.stopped {
+            // A device with an output channel reads on while it holds the host off, to answer
+            // device-control queries; it counts any other byte past the skid as a violation.
+            if self.stopped && !self.esc_b {
                 allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
                 self.watch_backlog(waiting);
             }
@@ -223,7 +235,7 @@ impl Device {
                         for &b in &buf[..k] {
                             self.receive(b);
                         }
-                        if self.stopped {
+                        if self.stopped && !self.esc_b {
                             self.taken_since_stop += k;
                         }
                     }
@@ -319,6 +331,10 @@ impl Device {
     }
 
     fn receive(&mut self, b: u8) {
+        // Device-control queries are not data: they are not counted as received.
+        if self.esc_b && !self.stalled && self.device_control(b) {
+            return;
+        }
         self.rep.bytes_received += 1;
         // A stalled device still fills its buffer (and asks to stop) but answers nothing.
         if self.stalled {
@@ -376,6 +392,49 @@ impl Device {
             }
         }
         self.buffer(b);
+    }
+
+    /// HP's RS-232 device control, handled as bytes arrive, ahead of the buffer: `ESC . B` is
+    /// answered with the free buffer space and CR; other `ESC . X` sequences are taken and
+    /// ignored. True when `b` was part of one, or was held back: while the host is held off the
+    /// device reads on (to see the queries), takes a skid's worth of data and holds the rest
+    /// back as a stopped transmitter would; data written later than [`STOP_GRACE`] after the
+    /// stop is a flow-control violation.
+    fn device_control(&mut self, b: u8) -> bool {
+        match (self.esc, b) {
+            (0, 0x1b) => {
+                self.esc = 1;
+                return true;
+            }
+            (1, b'.') => {
+                self.esc = 2;
+                return true;
+            }
+            (2, c) => {
+                self.esc = 0;
+                if c == b'B' {
+                    let free = self.cap.saturating_sub(self.rx.len());
+                    self.out.extend_from_slice(format!("{free}\r").as_bytes());
+                }
+                return true;
+            }
+            _ => self.esc = 0,
+        }
+        if self.stopped {
+            if self.taken_since_stop < SKID {
+                self.taken_since_stop += 1;
+                return false;
+            }
+            // What the host had written before it could act on the stop is not held against
+            // it; what it writes later is.
+            if self.stopped_at.is_some_and(|t| t.elapsed() > STOP_GRACE) {
+                self.rep.flow_violations += 1;
+            }
+            self.rep.bytes_received += 1;
+            self.held_back.push_back(b);
+            return true;
+        }
+        false
     }
 
     fn buffer(&mut self, b: u8) {
@@ -586,6 +645,9 @@ impl Device {
                     }
                     self.stopped = false;
                     self.stopped_at = None;
+                    while let Some(b) = self.held_back.pop_front() {
+                        self.buffer(b);
+                    }
                 }
             }
         }

@@ -19,7 +19,10 @@
 //!   growing within [`STOP_GRACE`] of the stop, or the growth is counted as
 //!   `flow_violations`. (Only stops longer than the grace can catch a host this way; the
 //!   grace is long enough for a loaded machine's kernel to act on XOFF.) This lets a plain program using the kernel's XON/XOFF (`stty ixon`)
-//!   stream into the simulator.
+//!   stream into the simulator. A profile with `status_query = "esc-b"` answers HP's
+//!   `ESC . B` with its free buffer space as the bytes arrive, also while it holds the host
+//!   off: it then reads on, takes the skid, holds the rest back as the stopped transmitter
+//!   would and counts data that comes later than the grace as violations.
 //! - **Execution.** HP-GL and GP-GL (`gpgl`) instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the

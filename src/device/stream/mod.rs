@@ -7,7 +7,12 @@
 //!   flow control nothing reports a full buffer, so byte b is not sent before the device can
 //!   have executed byte b − `buffer`, estimated from the program's own speeds (line time plus
 //!   motion time, +10 %): safe, slower than the machine could go; profiles should say
-//!   `xon-xoff` or `rts-cts` wherever the machine can.
+//!   `xon-xoff` or `rts-cts` wherever the machine can. A device that holds the host off longer
+//!   than the timeout has stopped, unless its profile gives an output channel
+//!   (`status_query = "esc-b"`): then it is asked HP's `ESC . B` twice a second, which it
+//!   answers at once with its free buffer space, and space that changed is progress (a long
+//!   move works off no byte until it ends: one move longer than the timeout still needs a
+//!   longer `--timeout`).
 //! - **GRBL character counting** (GRBL wiki, "Interface", streaming protocols): lines are sent
 //!   while the bytes of the lines not yet answered (`ok` or `error:N`) fit in the device's
 //!   128-byte receive buffer. `$` commands are sent alone, after every earlier line is
@@ -34,7 +39,7 @@ mod grbl;
 
 use super::serial::Link;
 use super::sim::{Finish, SimConfig, SimError, SimReport, XOFF, XON};
-use crate::profile::{FlowControl, Language, Profile};
+use crate::profile::{FlowControl, Language, Profile, StatusQuery};
 use grbl::Grbl;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -392,6 +397,8 @@ fn buffered(
     let total = program.len();
     let port = link.name.clone();
     let mut last_bar = Instant::now();
+    // The device's answers to `ESC . B` while it holds us off (profiles with an output channel).
+    let mut query = (profile.serial.status_query == StatusQuery::EscB).then(Query::default);
 
     let fail = |link: &mut Link, kind: Failure, sent: usize, stopped: bool| -> StreamError {
         let at = unanswered_position(bar, sent, total, profile.buffer);
@@ -420,6 +427,7 @@ fn buffered(
                 &mut rep,
                 &mut stopped,
                 &mut last_progress,
+                query.as_mut(),
             ),
             Err(_) => return Err(fail(link, Failure::HungUp("while sending"), sent, stopped)),
         }
@@ -436,18 +444,32 @@ fn buffered(
                 };
                 return Err(fail(link, Failure::Timeout(op), sent, stopped));
             }
+            // A device with an output channel is asked how much room it has: room that grows
+            // is a device at work, however long it holds us off.
+            if let Some(q) = query.as_mut() {
+                if q.asked.is_none_or(|t| t.elapsed() > QUERY_EVERY) {
+                    if link.write_some(ESC_B).is_err() {
+                        return Err(fail(
+                            link,
+                            Failure::HungUp("while asking the device for its buffer space"),
+                            sent,
+                            stopped,
+                        ));
+                    }
+                    q.asked = Some(Instant::now());
+                }
+            }
             // Wait for the next byte (XON) or the CTS line.
-            if flow == FlowControl::XonXoff {
-                match link.read_some(&mut input[..1]) {
-                    Ok(1) => match input[0] {
-                        XON => {
-                            stopped = false;
-                            last_progress = Instant::now();
-                        }
-                        XOFF => {}
-                        _ => rep.garbage_bytes += 1,
-                    },
-                    Ok(_) => {}
+            if flow == FlowControl::XonXoff || query.is_some() {
+                match link.read_some(&mut input[..]) {
+                    Ok(n) => take_in(
+                        &input[..n],
+                        flow,
+                        &mut rep,
+                        &mut stopped,
+                        &mut last_progress,
+                        query.as_mut(),
+                    ),
                     Err(_) => {
                         return Err(fail(
                             link,
@@ -513,16 +535,57 @@ fn buffered(
     Ok(rep)
 }
 
+/// HP's device-control query for the free buffer space (`ESC . B`).
+const ESC_B: &[u8] = b"\x1b.B";
+/// How often a device that holds the host off is asked for its buffer space.
+const QUERY_EVERY: Duration = Duration::from_millis(500);
+
+/// The state of `ESC . B` queries: when the last went out, the answer being read, the last
+/// answer (free bytes).
+#[derive(Default)]
+struct Query {
+    asked: Option<Instant>,
+    line: Vec<u8>,
+    free: Option<usize>,
+}
+
 /// Take in bytes the device sent while a buffered program goes out: XOFF stops the sender and
-/// XON resumes it (under XON/XOFF flow control); anything else is counted as garbage.
+/// XON resumes it (under XON/XOFF flow control); with `query`, digits ending in CR are an
+/// answer to `ESC . B`, progress when the free space differs from the last answer; anything
+/// else is counted as garbage.
 fn take_in(
     bytes: &[u8],
     flow: FlowControl,
     rep: &mut StreamReport,
     stopped: &mut bool,
     last_progress: &mut Instant,
+    mut query: Option<&mut Query>,
 ) {
     for &b in bytes {
+        if let Some(q) = query.as_deref_mut() {
+            if b.is_ascii_digit() && q.line.len() < 12 {
+                q.line.push(b);
+                continue;
+            }
+            if (b == b'\r' || b == b'\n') && !q.line.is_empty() {
+                let free = std::str::from_utf8(&q.line)
+                    .ok()
+                    .and_then(|t| t.parse().ok());
+                if free.is_some() && free != q.free {
+                    if q.free.is_some() {
+                        *last_progress = Instant::now();
+                    }
+                    q.free = free;
+                }
+                q.line.clear();
+                continue;
+            }
+            if b == b'\r' || b == b'\n' {
+                continue;
+            }
+            rep.garbage_bytes += q.line.len();
+            q.line.clear();
+        }
         match b {
             XOFF if flow == FlowControl::XonXoff => {
                 if !*stopped {
