@@ -118,6 +118,12 @@ pub struct FittingArgs {
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// A device without a pen (a knife-only cutter): draw the labels, seam marks and bend notes
+    /// first with a pen in the knife holder (`<name>-pen.plt`), stop with the tool up for the
+    /// knife (Enter, or a line on standard input), then cut. Without it they are left out, with
+    /// a warning.
+    #[arg(long)]
+    pub tool_change: bool,
     /// Units of the dimensions and the thickness: mm (default), cm, m or in (the
     /// tolerance and the sheet flags stay in mm).
     #[arg(long, value_name = "mm|cm|m|in", value_parser = super::args::parse_units)]
@@ -287,7 +293,10 @@ pub fn run(a: &FittingArgs) -> Result<(), Error> {
         &spec,
         &profile,
         &Search::default(),
-        &Toolpath::default(),
+        &Toolpath {
+            tool_change: a.tool_change,
+            ..Toolpath::default()
+        },
         &extras,
     )?;
     if !a.quiet {

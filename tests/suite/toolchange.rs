@@ -443,3 +443,47 @@ fn a_gcode_program_off_the_bed_is_refused_before_the_first_byte() {
         }
     }
 }
+
+/// `fitting` takes `--tool-change` as `cut` does: on a knife-only cutter the bend notes and
+/// labels are a pen pass of their own instead of being left out.
+#[test]
+fn a_fitting_on_a_knife_only_cutter_gets_a_pen_pass_with_tool_change() {
+    let fit = |name: &str, extra: &[&str]| {
+        let out = scratch(name);
+        let mut args = vec![
+            "fitting",
+            "cone",
+            "--bottom-diameter",
+            "300",
+            "--top-diameter",
+            "160",
+            "--height",
+            "200",
+            "--device",
+            "roland-gx24",
+            "--dry-run",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = flatcut(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        (out, report)
+    };
+    let (plain, report) = fit("fitting-plain", &[]);
+    assert!(!plain.join("cone-pen.plt").exists());
+    assert!(report["dropped"][0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("--tool-change"));
+    let (changed, report) = fit("fitting-pen", &["--tool-change"]);
+    assert!(report.get("dropped").is_none(), "{report}");
+    let pen = std::fs::read_to_string(changed.join("cone-pen.plt")).unwrap();
+    let strokes = flatcut::output::hpgl::parse(&pen).unwrap();
+    assert!(strokes.len() > 5, "{} pen strokes", strokes.len());
+    assert!(strokes.iter().all(|s| s.force.is_none()));
+}
