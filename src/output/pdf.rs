@@ -1,0 +1,456 @@
+//! PDF output: a vector document of a [`Job`], 1:1 in millimetres, one page per sheet, written
+//! with `pdf-writer` (no system packages, no fonts).
+//!
+//! Choices:
+//! - Units: each page's `MediaBox` is the sheet, in points (1 mm = 72/25.4 pt); the content
+//!   stream starts with a `cm` of that factor, so every coordinate in it is the job's own
+//!   millimetres, x right, y up, origin at the sheet's lower-left corner — the job's frame,
+//!   with no flip. Coordinates are rounded once to 0.001 mm. A sheet whose size is zero,
+//!   negative or not a number gets a 1 mm side so that the page stays valid.
+//! - Layers: the stroke roles are grouped into optional content groups (`/OCProperties` in the
+//!   catalog, all on, the viewer's layer panel opened with `/PageMode /UseOC`) that a viewer
+//!   or printer can switch: `Cut` (cuts and notches), `Folds` (mountain and valley), `Marks`,
+//!   `Labels`, `Seams`, `Grain`, `Weed`, and `Test squares`. A group exists only if the job
+//!   has a stroke of it (the test squares always). Each role's strokes on a page are one
+//!   `/OC /ocN BDC … EMC` section, drawn in `DRAW_ORDER` (cuts on top), with the SVG's
+//!   colours, widths and dash patterns (in mm). Labels and edge ids are the single-stroke
+//!   font's strokes already in the job, so no font is embedded.
+//! - Test squares: a 50 mm and a 2 in (50.8 mm) square, outlined 0.2 mm black, with "50 mm" and
+//!   "2 in" inside in the single-stroke font ([`crate::geom::font`]). They go side by side (or
+//!   stacked, if that fits better) into the first corner of the page, `SQUARE_INSET_MM` from
+//!   its edges, that keeps `SQUARE_CLEARANCE_MM` from every stroke and is not inside a piece:
+//!   top left, top right, bottom right, bottom left. With no free corner, the first free spot
+//!   of a grid over the page; with none either, the top-left corner over the pieces — they are
+//!   in their own layer, so they can be switched off ([`test_squares`] says which).
+//! - Content streams are not compressed: the files stay readable and diffable, and the
+//!   tests read the coordinates back. Output is a pure function of the job: no dates, no file
+//!   id, fixed object numbers.
+
+use glam::DVec2;
+use pdf_writer::types::{LineCapStyle, LineJoinStyle, PageMode};
+use pdf_writer::{Content, Finish, Name, Pdf, Rect, Ref, TextStr};
+
+use super::{role_style, DRAW_ORDER};
+use crate::toolpath::{Job, SheetJob, Stroke, StrokeRole};
+
+/// Points per millimetre.
+pub const PT_PER_MM: f64 = 72.0 / 25.4;
+
+/// The sides of the test squares, mm: 50 mm and 2 in.
+pub const TEST_SQUARE_SIDES_MM: [f64; 2] = [50.0, 50.8];
+
+/// Gap between the two test squares, mm.
+const SQUARE_GAP_MM: f64 = 4.0;
+
+/// Distance of the test squares from the page's edges, mm.
+pub const SQUARE_INSET_MM: f64 = 5.0;
+
+/// Smallest distance from the test squares to any stroke, mm.
+pub const SQUARE_CLEARANCE_MM: f64 = 3.0;
+
+/// Outline width of the test squares, mm.
+const SQUARE_LINE_MM: f64 = 0.2;
+
+/// Cap height of the test squares' captions, mm.
+const CAPTION_MM: f64 = 3.0;
+
+/// A switchable layer of the document (an optional content group).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Layer {
+    Cut,
+    Folds,
+    Marks,
+    Labels,
+    Seams,
+    Grain,
+    Weed,
+    TestSquares,
+}
+
+impl Layer {
+    /// Every layer, in the order of the viewer's layer panel.
+    pub const ALL: [Layer; 8] = [
+        Layer::Cut,
+        Layer::Folds,
+        Layer::Marks,
+        Layer::Labels,
+        Layer::Seams,
+        Layer::Grain,
+        Layer::Weed,
+        Layer::TestSquares,
+    ];
+
+    /// The layer a stroke of `role` is drawn in.
+    pub fn of(role: StrokeRole) -> Layer {
+        match role {
+            StrokeRole::Cut | StrokeRole::Notch => Layer::Cut,
+            StrokeRole::FoldMountain | StrokeRole::FoldValley => Layer::Folds,
+            StrokeRole::Mark => Layer::Marks,
+            StrokeRole::Label => Layer::Labels,
+            StrokeRole::Seam => Layer::Seams,
+            StrokeRole::Grain => Layer::Grain,
+            StrokeRole::Weed => Layer::Weed,
+        }
+    }
+
+    /// The name a viewer shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layer::Cut => "Cut",
+            Layer::Folds => "Folds",
+            Layer::Marks => "Marks",
+            Layer::Labels => "Labels",
+            Layer::Seams => "Seams",
+            Layer::Grain => "Grain",
+            Layer::Weed => "Weed",
+            Layer::TestSquares => "Test squares",
+        }
+    }
+}
+
+/// One test square: its lower-left corner on the sheet and its side, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TestSquare {
+    pub corner: DVec2,
+    pub side: f64,
+}
+
+/// Where the test squares of a sheet go (see the module doc), and whether that spot is free
+/// (`false`: no free spot was found and they lie over the pieces).
+pub fn test_squares(sheet: &SheetJob) -> (Vec<TestSquare>, bool) {
+    let (w, h) = page_size_mm(sheet);
+    let [a, b] = TEST_SQUARE_SIDES_MM;
+    // Offsets of the squares' corners from the block's lower-left corner; the block's size.
+    let row = (
+        [DVec2::ZERO, DVec2::new(a + SQUARE_GAP_MM, 0.0)],
+        a + SQUARE_GAP_MM + b,
+        b,
+    );
+    let column = (
+        [DVec2::ZERO, DVec2::new(0.0, a + SQUARE_GAP_MM)],
+        b,
+        a + SQUARE_GAP_MM + b,
+    );
+    let obstacles = Obstacles::of(sheet);
+    let squares = |(offsets, _, _): &([DVec2; 2], f64, f64), at: DVec2| {
+        offsets
+            .iter()
+            .zip(TEST_SQUARE_SIDES_MM)
+            .map(|(o, side)| TestSquare {
+                corner: at + *o,
+                side,
+            })
+            .collect::<Vec<_>>()
+    };
+    let i = SQUARE_INSET_MM;
+    let fits = |bw: f64, bh: f64| bw + 2.0 * i <= w && bh + 2.0 * i <= h;
+    for arr in [&row, &column] {
+        let (_, bw, bh) = *arr;
+        if !fits(bw, bh) {
+            continue;
+        }
+        let corners = [
+            DVec2::new(i, h - i - bh),
+            DVec2::new(w - i - bw, h - i - bh),
+            DVec2::new(w - i - bw, i),
+            DVec2::new(i, i),
+        ];
+        if let Some(&at) = corners.iter().find(|&&at| obstacles.free(at, bw, bh)) {
+            return (squares(arr, at), true);
+        }
+    }
+    for arr in [&row, &column] {
+        let (_, bw, bh) = *arr;
+        if !fits(bw, bh) {
+            continue;
+        }
+        // At most 40 × 40 spots, top to bottom, left to right.
+        let (sx, sy) = ((w - 2.0 * i - bw) / 40.0, (h - 2.0 * i - bh) / 40.0);
+        for r in 0..=40 {
+            for c in 0..=40 {
+                let at = DVec2::new(i + f64::from(c) * sx, h - i - bh - f64::from(r) * sy);
+                if obstacles.free(at, bw, bh) {
+                    return (squares(arr, at), true);
+                }
+            }
+        }
+    }
+    let arr = if !fits(row.1, row.2) && fits(column.1, column.2) {
+        &column
+    } else {
+        &row
+    };
+    (squares(arr, DVec2::new(i, h - i - arr.2)), false)
+}
+
+/// The strokes of a sheet as segments with their bounds, and the closed cut outlines (the
+/// pieces), for [`test_squares`].
+struct Obstacles {
+    segments: Vec<(DVec2, DVec2)>,
+    outlines: Vec<Vec<DVec2>>,
+}
+
+impl Obstacles {
+    fn of(sheet: &SheetJob) -> Self {
+        let mut segments = Vec::new();
+        let mut outlines = Vec::new();
+        for s in &sheet.strokes {
+            let Some(pts) = drawable(s) else { continue };
+            segments.extend(pts.windows(2).map(|w| (w[0], w[1])));
+            if s.closed {
+                if let (Some(&a), Some(&b)) = (pts.last(), pts.first()) {
+                    segments.push((a, b));
+                }
+                if s.role == StrokeRole::Cut {
+                    outlines.push(pts);
+                }
+            } else if pts.len() == 1 {
+                segments.push((pts[0], pts[0]));
+            }
+        }
+        Obstacles { segments, outlines }
+    }
+
+    /// Whether the block at `at` (lower-left), `bw` × `bh`, grown by the clearance, touches no
+    /// stroke and does not lie inside a piece.
+    fn free(&self, at: DVec2, bw: f64, bh: f64) -> bool {
+        let c = SQUARE_CLEARANCE_MM;
+        let lo = at - DVec2::splat(c);
+        let hi = at + DVec2::new(bw + c, bh + c);
+        if self
+            .segments
+            .iter()
+            .any(|&(p, q)| segment_meets_box(p, q, lo, hi))
+        {
+            return false;
+        }
+        let centre = (lo + hi) / 2.0;
+        !self.outlines.iter().any(|o| inside(centre, o))
+    }
+}
+
+/// Whether segment `p`–`q` meets the box `lo`..`hi` (Liang–Barsky clipping).
+fn segment_meets_box(p: DVec2, q: DVec2, lo: DVec2, hi: DVec2) -> bool {
+    let d = q - p;
+    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+    for (dp, lo_gap, hi_gap) in [(d.x, p.x - lo.x, hi.x - p.x), (d.y, p.y - lo.y, hi.y - p.y)] {
+        // Inside the slab: −dp·t ≤ lo_gap and dp·t ≤ hi_gap.
+        for (a, b) in [(-dp, lo_gap), (dp, hi_gap)] {
+            if a == 0.0 {
+                if b < 0.0 {
+                    return false;
+                }
+            } else {
+                let t = b / a;
+                if a < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+            }
+        }
+    }
+    t0 <= t1
+}
+
+/// Even-odd point in polygon.
+fn inside(p: DVec2, poly: &[DVec2]) -> bool {
+    let mut inside = false;
+    let n = poly.len();
+    for k in 0..n {
+        let (a, b) = (poly[k], poly[(k + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// The points of a stroke to draw: none with a non-finite coordinate, a closed stroke without
+/// its repeated end point; `None` for a stroke with nothing to draw.
+fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
+    if s.points.is_empty() || s.points.iter().any(|p| !p.is_finite()) {
+        return None;
+    }
+    let mut pts = s.points.clone();
+    if s.closed && pts.len() > 2 && pts[0].distance(pts[pts.len() - 1]) <= 1e-9 {
+        pts.pop();
+    }
+    Some(pts)
+}
+
+/// The page size of a sheet, mm: its own, or 1 mm for a side that is not a positive number.
+fn page_size_mm(sheet: &SheetJob) -> (f64, f64) {
+    let ok = |v: f64| if v.is_finite() && v > 0.0 { v } else { 1.0 };
+    (ok(sheet.width), ok(sheet.height))
+}
+
+/// A coordinate in mm, rounded to 0.001 mm, for the content stream.
+fn mm(v: f64) -> f32 {
+    ((v * 1000.0).round() / 1000.0) as f32
+}
+
+/// The layers the job uses, in panel order: those of its strokes' roles and the test squares.
+fn layers_used(job: &Job) -> Vec<Layer> {
+    let mut used: Vec<Layer> = job
+        .sheets
+        .iter()
+        .flat_map(|s| &s.strokes)
+        .filter(|s| drawable(s).is_some())
+        .map(|s| Layer::of(s.role))
+        .chain([Layer::TestSquares])
+        .collect();
+    used.sort();
+    used.dedup();
+    used
+}
+
+/// Renders the whole job as one PDF document, a page per sheet.
+pub fn render(job: &Job) -> Vec<u8> {
+    let layers = layers_used(job);
+    let catalog_id = Ref::new(1);
+    let pages_id = Ref::new(2);
+    let layer_ids: Vec<Ref> = (0..layers.len()).map(|k| Ref::new(3 + k as i32)).collect();
+    let first_page = 3 + layers.len() as i32;
+    // Per sheet: its page, then its content stream.
+    let page_ids: Vec<Ref> = (0..job.sheets.len())
+        .map(|k| Ref::new(first_page + 2 * k as i32))
+        .collect();
+    // Resource names of the layers in the pages: /oc1, /oc2, …
+    let oc_names: Vec<String> = (1..=layers.len()).map(|k| format!("oc{k}")).collect();
+    let oc_name = |layer: Layer| -> &[u8] {
+        let k = layers.iter().position(|l| *l == layer).unwrap_or(0);
+        oc_names.get(k).map_or(b"oc1", |s| s.as_bytes())
+    };
+
+    let mut pdf = Pdf::new();
+    let mut catalog = pdf.catalog(catalog_id);
+    catalog.pages(pages_id).page_mode(PageMode::UseOC);
+    let mut props = catalog.insert(Name(b"OCProperties")).dict();
+    props
+        .insert(Name(b"OCGs"))
+        .array()
+        .items(layer_ids.iter().copied());
+    let mut config = props.insert(Name(b"D")).dict();
+    config.pair(Name(b"Name"), TextStr("Layers"));
+    config.pair(Name(b"BaseState"), Name(b"ON"));
+    config
+        .insert(Name(b"Order"))
+        .array()
+        .items(layer_ids.iter().copied());
+    config.finish();
+    props.finish();
+    catalog.finish();
+
+    pdf.pages(pages_id)
+        .kids(page_ids.iter().copied())
+        .count(page_ids.len() as i32);
+    for (layer, id) in layers.iter().zip(&layer_ids) {
+        pdf.indirect(*id)
+            .dict()
+            .pair(Name(b"Type"), Name(b"OCG"))
+            .pair(Name(b"Name"), TextStr(layer.name()));
+    }
+
+    for (sheet, &page_id) in job.sheets.iter().zip(&page_ids) {
+        let content_id = Ref::new(page_id.get() + 1);
+        let (w, h) = page_size_mm(sheet);
+        let mut page = pdf.page(page_id);
+        page.parent(pages_id)
+            .media_box(Rect::new(
+                0.0,
+                0.0,
+                (w * PT_PER_MM) as f32,
+                (h * PT_PER_MM) as f32,
+            ))
+            .contents(content_id);
+        let mut resources = page.resources();
+        let mut named = resources.insert(Name(b"Properties")).dict();
+        for (layer, id) in layers.iter().zip(&layer_ids) {
+            named.pair(Name(oc_name(*layer)), *id);
+        }
+        named.finish();
+        resources.finish();
+        page.finish();
+        let content = page_content(sheet, &oc_name);
+        pdf.stream(content_id, &content);
+    }
+    pdf.finish()
+}
+
+/// The content stream of one sheet's page; `oc_name` gives the resource name of a layer.
+fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Vec<u8> {
+    let mut c = Content::new();
+    let k = PT_PER_MM as f32;
+    c.transform([k, 0.0, 0.0, k, 0.0, 0.0]);
+    c.set_line_cap(LineCapStyle::RoundCap);
+    c.set_line_join(LineJoinStyle::RoundJoin);
+    for role in DRAW_ORDER {
+        let strokes: Vec<(Vec<DVec2>, bool)> = sheet
+            .strokes
+            .iter()
+            .filter(|s| s.role == role)
+            .filter_map(|s| drawable(s).map(|p| (p, s.closed)))
+            .collect();
+        if strokes.is_empty() {
+            continue;
+        }
+        let style = role_style(role);
+        let [r, g, b] = style.rgb.map(|v| f32::from(v) / 255.0);
+        c.begin_marked_content_with_properties(Name(b"OC"))
+            .properties_named(Name(oc_name(Layer::of(role))));
+        c.save_state();
+        c.set_stroke_rgb(r, g, b);
+        c.set_line_width(super::svg::stroke_width_mm(role) as f32);
+        if !style.dash_mm.is_empty() {
+            c.set_dash_pattern(style.dash_mm.iter().map(|&d| d as f32), 0.0);
+        }
+        for (pts, closed) in &strokes {
+            path(&mut c, pts, *closed);
+        }
+        c.stroke();
+        c.restore_state();
+        c.end_marked_content();
+    }
+
+    let (squares, _) = test_squares(sheet);
+    c.begin_marked_content_with_properties(Name(b"OC"))
+        .properties_named(Name(oc_name(Layer::TestSquares)));
+    c.save_state();
+    c.set_stroke_rgb(0.0, 0.0, 0.0);
+    c.set_line_width(SQUARE_LINE_MM as f32);
+    for sq in &squares {
+        let p = sq.corner;
+        c.rect(mm(p.x), mm(p.y), mm(sq.side), mm(sq.side));
+        let text = if sq.side == TEST_SQUARE_SIDES_MM[0] {
+            "50 mm"
+        } else {
+            "2 in"
+        };
+        let (glyphs, _) = crate::geom::font::text_strokes(text, CAPTION_MM);
+        let at = p + DVec2::splat(CAPTION_MM);
+        for g in glyphs {
+            let pts: Vec<DVec2> = g.iter().map(|q| at + *q).collect();
+            path(&mut c, &pts, false);
+        }
+    }
+    c.stroke();
+    c.restore_state();
+    c.end_marked_content();
+    c.finish().to_vec()
+}
+
+/// Appends one subpath through `pts` (a dot for a single point), closed with `h` if `closed`.
+fn path(c: &mut Content, pts: &[DVec2], closed: bool) {
+    let Some(first) = pts.first() else { return };
+    c.move_to(mm(first.x), mm(first.y));
+    if pts.len() == 1 {
+        c.line_to(mm(first.x), mm(first.y));
+    }
+    for p in &pts[1..] {
+        c.line_to(mm(p.x), mm(p.y));
+    }
+    if closed {
+        c.close_path();
+    }
+}
