@@ -16,12 +16,13 @@
 //!   colours, widths and dash patterns (in mm). Labels and edge ids are the single-stroke
 //!   font's strokes already in the job, so no font is embedded.
 //! - Test squares: a 50 mm and a 2 in (50.8 mm) square, outlined 0.2 mm black, with "50 mm" and
-//!   "2 in" inside in the single-stroke font ([`crate::geom::font`]). They go side by side (or
-//!   stacked, if that fits better) into the first corner of the page, `SQUARE_INSET_MM` from
-//!   its edges, that keeps `SQUARE_CLEARANCE_MM` from every stroke and is not inside a piece:
-//!   top left, top right, bottom right, bottom left. With no free corner, the first free spot
-//!   of a grid over the page; with none either, the top-left corner over the pieces — they are
-//!   in their own layer, so they can be switched off ([`test_squares`] says which).
+//!   "2 in" inside in the single-stroke font ([`crate::geom::font`]). A spot is free if it is
+//!   `SQUARE_INSET_MM` inside the page's edges, keeps `SQUARE_CLEARANCE_MM` from every stroke
+//!   and is not inside a piece; the squares go, `SQUARE_GAP_MM` apart, side by side into the
+//!   first free corner (top left, top right, bottom right, bottom left) or else the first free
+//!   spot of a grid over the page; failing that stacked, the same way; failing that each on
+//!   its own. With no free spot at all they go into the top-left corner over the pieces: they
+//!   are in their own layer, so they can be switched off ([`test_squares`] says which).
 //! - Content streams are not compressed: the files stay readable and diffable, and the
 //!   tests read the coordinates back. Output is a pure function of the job: no dates, no file
 //!   id, fixed object numbers.
@@ -120,67 +121,60 @@ pub struct TestSquare {
 pub fn test_squares(sheet: &SheetJob) -> (Vec<TestSquare>, bool) {
     let (w, h) = page_size_mm(sheet);
     let [a, b] = TEST_SQUARE_SIDES_MM;
-    // Offsets of the squares' corners from the block's lower-left corner; the block's size.
-    let row = (
-        [DVec2::ZERO, DVec2::new(a + SQUARE_GAP_MM, 0.0)],
-        a + SQUARE_GAP_MM + b,
-        b,
-    );
-    let column = (
-        [DVec2::ZERO, DVec2::new(0.0, a + SQUARE_GAP_MM)],
-        b,
-        a + SQUARE_GAP_MM + b,
-    );
-    let obstacles = Obstacles::of(sheet);
-    let squares = |(offsets, _, _): &([DVec2; 2], f64, f64), at: DVec2| {
-        offsets
-            .iter()
-            .zip(TEST_SQUARE_SIDES_MM)
-            .map(|(o, side)| TestSquare {
-                corner: at + *o,
-                side,
-            })
-            .collect::<Vec<_>>()
-    };
+    let step = a + SQUARE_GAP_MM;
+    let mut obstacles = Obstacles::of(sheet);
+    let square = |at: DVec2, side: f64| TestSquare { corner: at, side };
+    // Side by side, then stacked.
+    if let Some(at) = find_spot(&obstacles, w, h, step + b, b) {
+        return (vec![square(at, a), square(at + DVec2::X * step, b)], true);
+    }
+    if let Some(at) = find_spot(&obstacles, w, h, b, step + b) {
+        return (vec![square(at, a), square(at + DVec2::Y * step, b)], true);
+    }
+    // Each where it finds room, the second clear of the first.
+    if let Some(at_a) = find_spot(&obstacles, w, h, a, a) {
+        obstacles.boxes.push((at_a, at_a + DVec2::splat(a)));
+        if let Some(at_b) = find_spot(&obstacles, w, h, b, b) {
+            return (vec![square(at_a, a), square(at_b, b)], true);
+        }
+    }
     let i = SQUARE_INSET_MM;
-    let fits = |bw: f64, bh: f64| bw + 2.0 * i <= w && bh + 2.0 * i <= h;
-    for arr in [&row, &column] {
-        let (_, bw, bh) = *arr;
-        if !fits(bw, bh) {
-            continue;
-        }
-        let corners = [
-            DVec2::new(i, h - i - bh),
-            DVec2::new(w - i - bw, h - i - bh),
-            DVec2::new(w - i - bw, i),
-            DVec2::new(i, i),
-        ];
-        if let Some(&at) = corners.iter().find(|&&at| obstacles.free(at, bw, bh)) {
-            return (squares(arr, at), true);
-        }
+    if step + b + 2.0 * i > w && b + 2.0 * i <= w {
+        // Stacked, if only that fits across the page.
+        let at = DVec2::new(i, h - i - step - b);
+        return (vec![square(at, a), square(at + DVec2::Y * step, b)], false);
     }
-    for arr in [&row, &column] {
-        let (_, bw, bh) = *arr;
-        if !fits(bw, bh) {
-            continue;
-        }
-        // At most 40 × 40 spots, top to bottom, left to right.
-        let (sx, sy) = ((w - 2.0 * i - bw) / 40.0, (h - 2.0 * i - bh) / 40.0);
-        for r in 0..=40 {
-            for c in 0..=40 {
-                let at = DVec2::new(i + f64::from(c) * sx, h - i - bh - f64::from(r) * sy);
-                if obstacles.free(at, bw, bh) {
-                    return (squares(arr, at), true);
-                }
-            }
-        }
+    let at = DVec2::new(i, h - i - b);
+    (vec![square(at, a), square(at + DVec2::X * step, b)], false)
+}
+
+/// The first free spot (lower-left corner) for a `bw` × `bh` block on a `w` × `h` page,
+/// `SQUARE_INSET_MM` inside its edges: a corner (top left, top right, bottom right, bottom
+/// left), else the first of a grid of at most 41 × 41 spots, top to bottom, left to right.
+fn find_spot(obstacles: &Obstacles, w: f64, h: f64, bw: f64, bh: f64) -> Option<DVec2> {
+    let i = SQUARE_INSET_MM;
+    let (room_x, room_y) = (w - 2.0 * i - bw, h - 2.0 * i - bh);
+    if room_x < 0.0 || room_y < 0.0 {
+        return None;
     }
-    let arr = if !fits(row.1, row.2) && fits(column.1, column.2) {
-        &column
-    } else {
-        &row
-    };
-    (squares(arr, DVec2::new(i, h - i - arr.2)), false)
+    let corners = [
+        DVec2::new(i, i + room_y),
+        DVec2::new(i + room_x, i + room_y),
+        DVec2::new(i + room_x, i),
+        DVec2::new(i, i),
+    ];
+    let grid = (0..=40).flat_map(|r| {
+        (0..=40).map(move |c| {
+            DVec2::new(
+                i + room_x * f64::from(c) / 40.0,
+                i + room_y * (1.0 - f64::from(r) / 40.0),
+            )
+        })
+    });
+    corners
+        .into_iter()
+        .chain(grid)
+        .find(|&at| obstacles.free(at, bw, bh))
 }
 
 /// The strokes of a sheet as segments with their bounds, and the closed cut outlines (the
@@ -188,6 +182,8 @@ pub fn test_squares(sheet: &SheetJob) -> (Vec<TestSquare>, bool) {
 struct Obstacles {
     segments: Vec<(DVec2, DVec2)>,
     outlines: Vec<Vec<DVec2>>,
+    /// Squares placed already (lower-left, upper-right corners).
+    boxes: Vec<(DVec2, DVec2)>,
 }
 
 impl Obstacles {
@@ -208,7 +204,11 @@ impl Obstacles {
                 segments.push((pts[0], pts[0]));
             }
         }
-        Obstacles { segments, outlines }
+        Obstacles {
+            segments,
+            outlines,
+            boxes: Vec::new(),
+        }
     }
 
     /// Whether the block at `at` (lower-left), `bw` × `bh`, grown by the clearance, touches no
