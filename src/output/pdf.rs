@@ -266,10 +266,16 @@ fn inside(p: DVec2, poly: &[DVec2]) -> bool {
     inside
 }
 
-/// The points of a stroke to draw: none with a non-finite coordinate, a closed stroke without
-/// its repeated end point; `None` for a stroke with nothing to draw.
+/// Largest coordinate drawn, mm (10 km): beyond it f32 loses the 0.001 mm and, far beyond,
+/// the number itself.
+const MAX_COORD_MM: f64 = 1e7;
+
+/// The points of a stroke to draw: none with a non-finite coordinate or one beyond
+/// `MAX_COORD_MM`, a closed stroke without its repeated end point; `None` for a stroke with
+/// nothing to draw.
 fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
-    if s.points.is_empty() || s.points.iter().any(|p| !p.is_finite()) {
+    let bad = |p: &DVec2| !(p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM);
+    if s.points.is_empty() || s.points.iter().any(bad) {
         return None;
     }
     let mut pts = s.points.clone();
@@ -279,9 +285,10 @@ fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
     Some(pts)
 }
 
-/// The page size of a sheet, mm: its own, or 1 mm for a side that is not a positive number.
+/// The page size of a sheet, mm: its own, or 1 mm for a side that is not a positive number
+/// up to `MAX_COORD_MM`.
 fn page_size_mm(sheet: &SheetJob) -> (f64, f64) {
-    let ok = |v: f64| if v.is_finite() && v > 0.0 { v } else { 1.0 };
+    let ok = |v: f64| if v > 0.0 && v <= MAX_COORD_MM { v } else { 1.0 };
     (ok(sheet.width), ok(sheet.height))
 }
 
@@ -452,5 +459,156 @@ fn path(c: &mut Content, pts: &[DVec2], closed: bool) {
     }
     if closed {
         c.close_path();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::fixtures::{sheet, stroke};
+
+    fn job(sheets: Vec<SheetJob>) -> Job {
+        Job {
+            name: "t".into(),
+            sheets,
+        }
+    }
+
+    /// The content streams of a document, as text, page by page.
+    fn contents(pdf: &[u8]) -> Vec<String> {
+        let text = String::from_utf8_lossy(pdf).into_owned();
+        text.split(">>\nstream\n")
+            .skip(1)
+            .filter_map(|s| s.split("endstream").next())
+            .map(str::to_string)
+            .collect()
+    }
+
+    #[test]
+    fn pages_layers_and_coordinates() {
+        let mut big = sheet(vec![
+            stroke(
+                StrokeRole::Cut,
+                &[(60.0, 10.0), (90.0, 10.0), (90.0, 40.0), (60.0, 10.0)],
+            ),
+            stroke(StrokeRole::FoldValley, &[(61.0, 20.0), (80.5, 20.25)]),
+        ]);
+        big.width = 300.0;
+        big.height = 200.0;
+        let doc = render(&job(vec![big, sheet(vec![])]));
+        let text = String::from_utf8_lossy(&doc).into_owned();
+        assert!(text.starts_with("%PDF-1.7"));
+        assert!(text.contains("/Count 2"));
+        // 300 × 200 mm in points.
+        assert!(
+            text.contains("/MediaBox [0 0 850.3937 566.92914]"),
+            "{text}"
+        );
+        assert!(text.contains("/MediaBox [0 0 283.46457 283.46457]"));
+        // Layers: only those used, and the test squares.
+        for name in ["(Cut)", "(Folds)", "(Test squares)"] {
+            assert!(
+                text.contains(&format!("/Type /OCG\n  /Name {name}")),
+                "{name}"
+            );
+        }
+        assert!(!text.contains("(Marks)"));
+        assert!(text.contains("/OCProperties"));
+        let pages = contents(&doc);
+        assert_eq!(pages.len(), 2);
+        let p = &pages[0];
+        assert!(p.starts_with("2.8346457 0 0 2.8346457 0 0 cm"), "{p}");
+        // The cut, closed without its repeated end, in mm; the fold in its own section.
+        assert!(p.contains("/OC /oc1 BDC"), "{p}");
+        assert!(p.contains("60 10 m\n90 10 l\n90 40 l\nh\n"), "{p}");
+        assert!(p.contains("61 20 m\n80.5 20.25 l\n"), "{p}");
+        assert!(p.contains("[2 1] 0 d"), "valley dashes: {p}");
+        assert_eq!(p.matches("BDC").count(), p.matches("EMC").count());
+        // Two test squares on each page.
+        for p in &pages {
+            assert_eq!(p.matches(" re").count(), 2, "{p}");
+        }
+    }
+
+    #[test]
+    fn squares_keep_clear_of_the_pieces() {
+        // A piece in the top-left corner: the squares go to the top right.
+        let mut s = sheet(vec![stroke(
+            StrokeRole::Cut,
+            &[(0.0, 100.0), (100.0, 100.0), (100.0, 300.0), (0.0, 100.0)],
+        )]);
+        s.width = 300.0;
+        s.height = 300.0;
+        let (sq, free) = test_squares(&s);
+        assert!(free);
+        assert_eq!(sq.len(), 2);
+        assert_eq!(
+            sq[0].corner,
+            DVec2::new(300.0 - 5.0 - 104.8, 300.0 - 5.0 - 50.8)
+        );
+        assert_eq!((sq[0].side, sq[1].side), (50.0, 50.8));
+        assert!((sq[1].corner.x - sq[0].corner.x - 54.0).abs() < 1e-9);
+        // A piece covering the whole page, its outline outside the squares' reach: inside a
+        // piece is not free, so they lie over it and say so.
+        let mut s = sheet(vec![stroke(
+            StrokeRole::Cut,
+            &[
+                (1.0, 1.0),
+                (299.0, 1.0),
+                (299.0, 299.0),
+                (1.0, 299.0),
+                (1.0, 1.0),
+            ],
+        )]);
+        s.width = 300.0;
+        s.height = 300.0;
+        let (sq, free) = test_squares(&s);
+        assert!(!free);
+        assert_eq!(sq[0].corner, DVec2::new(5.0, 300.0 - 5.0 - 50.8));
+        // An empty narrow sheet: stacked.
+        let mut s = sheet(vec![]);
+        s.width = 70.0;
+        s.height = 300.0;
+        let (sq, free) = test_squares(&s);
+        assert!(free);
+        assert_eq!(sq[0].corner.x, sq[1].corner.x);
+    }
+
+    #[test]
+    fn boxes_and_segments() {
+        let (lo, hi) = (DVec2::ZERO, DVec2::new(10.0, 10.0));
+        let seg = |a: (f64, f64), b: (f64, f64)| {
+            segment_meets_box(DVec2::new(a.0, a.1), DVec2::new(b.0, b.1), lo, hi)
+        };
+        assert!(seg((-5.0, 5.0), (15.0, 5.0)));
+        assert!(seg((2.0, 2.0), (3.0, 3.0)));
+        assert!(seg((-1.0, 5.0), (5.0, -1.0)));
+        assert!(!seg((-5.0, 11.0), (15.0, 11.0)));
+        assert!(!seg((-5.0, 5.0), (3.0, 15.0)));
+        assert!(seg((5.0, 5.0), (5.0, 5.0)));
+        assert!(!seg((11.0, 5.0), (11.0, 5.0)));
+    }
+
+    #[test]
+    fn bad_input_does_not_panic_and_output_is_stable() {
+        let mut s = sheet(vec![
+            stroke(StrokeRole::Cut, &[(f64::NAN, 1.0), (2.0, 2.0)]),
+            stroke(StrokeRole::Label, &[]),
+            stroke(StrokeRole::Mark, &[(1e300, 3.0), (4.0, 3.0)]),
+            stroke(StrokeRole::Grain, &[(5.0, 5.0)]),
+        ]);
+        s.width = f64::NAN;
+        s.height = -3.0;
+        let doc = render(&job(vec![s.clone()]));
+        let text = String::from_utf8_lossy(&doc).into_owned();
+        assert!(
+            text.contains("/MediaBox [0 0 2.8346457 2.8346457]"),
+            "{text}"
+        );
+        assert!(!text.contains("NaN") && !text.contains("inf"));
+        assert!(!text.contains("(Cut)"), "a stroke with NaN is not drawn");
+        assert_eq!(render(&job(vec![s])), doc);
+        let empty = render(&job(vec![]));
+        assert!(String::from_utf8_lossy(&empty).contains("/Count 0"));
     }
 }
