@@ -6,7 +6,9 @@
 //!   stream starts with a `cm` of that factor, so every coordinate in it is the job's own
 //!   millimetres, x right, y up, origin at the sheet's lower-left corner — the job's frame,
 //!   with no flip. Coordinates are rounded once to 0.001 mm. A sheet whose size is zero,
-//!   negative or not a number gets a 1 mm side so that the page stays valid.
+//!   negative or not a number gets a 1 mm side so that the page stays valid. No `UserUnit`:
+//!   a page over 5080 mm (14 400 pt, a roll longer than 5 m) is read by poppler but beyond
+//!   what Acrobat shows; tiling (issue 25, item 2) is the way to print such a sheet.
 //! - Layers: the stroke roles are grouped into optional content groups (`/OCProperties` in the
 //!   catalog, all on, the viewer's layer panel opened with `/PageMode /UseOC`) that a viewer
 //!   or printer can switch: `Cut` (cuts and notches), `Folds` (mountain and valley), `Marks`,
