@@ -128,6 +128,7 @@
 //!   gpgl.rs                    GP-GL programs for Graphtec cutting plotters (CE6000 / CE7000 / FC series) in their native …
 //!   gcode.rs                   GRBL 1.1 G-code programs (dialect `grbl`) for a drag knife on Z, a servo-lifted pen or a laser,…
 //!   obj.rs                     Wavefront OBJ writer
+//!   pdf.rs                     PDF output: 1:1, a page per sheet, stroke kinds as switchable layers, test squares
 //!   png.rs                     PNG output
 //!   report.rs                  `report.json`
 //!   svg.rs                     SVG output

@@ -400,6 +400,9 @@ pub struct Extras {
     pub uv_obj: Option<PathBuf>,
     /// Print no warnings.
     pub quiet: bool,
+    /// Resolution of the PNG pictures in dots per inch (`--dpi`); `None`: the preview's
+    /// [`crate::output::png::DEFAULT_PX_PER_MM`].
+    pub dpi: Option<f64>,
 }
 
 /// What the operator does before a program of a run is sent (`cli::link` waits for it).
@@ -433,7 +436,7 @@ pub struct CutRun {
 }
 
 /// The whole of `flatcut cut` but the sending: plan the job for the device, write the program
-/// per sheet, the SVG, a PNG and a DXF per sheet, the asked-for extras and report.json, each
+/// per sheet, the SVG, the PDF, a PNG and a DXF per sheet, the asked-for extras and report.json, each
 /// file whole or not at all.
 pub fn cut(
     spec: &Spec,
@@ -494,7 +497,7 @@ pub fn cut(
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    files.extend(write_pictures(&mut run, &spec.name, &job)?);
+    files.extend(write_pictures(&mut run, &spec.name, &job, extras.dpi)?);
     files.extend(write_dxf(&mut run, &spec.name, &layout)?);
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
@@ -527,7 +530,7 @@ pub struct FlattenRun {
 }
 
 /// The whole of `flatcut flatten`: the pieces nested on one strip wide enough for the widest
-/// piece (the pieces, not the sheets, are the result), written as SVG, PNG and report.json.
+/// piece (the pieces, not the sheets, are the result), written as SVG, PDF, PNG and report.json.
 pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenRun, Error> {
     let (flats, pieces) = pieces(spec, extras.quiet)?;
     write_extras(&flats, extras)?;
@@ -558,7 +561,7 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
     let mut run = RunFiles::begin(&dir)?;
-    let mut files = write_pictures(&mut run, &spec.name, &job)?;
+    let mut files = write_pictures(&mut run, &spec.name, &job, extras.dpi)?;
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
@@ -796,16 +799,25 @@ fn write_alternatives(
     Ok(files)
 }
 
-/// Write `<name>.svg` and `<name>-<k>.png` per sheet; returns the file names.
-fn write_pictures(run: &mut RunFiles, name: &str, job: &Job) -> Result<Vec<String>, Error> {
+/// Write `<name>.svg`, `<name>.pdf` and `<name>-<k>.png` per sheet (at `dpi`, else the
+/// preview resolution); returns the file names.
+fn write_pictures(
+    run: &mut RunFiles,
+    name: &str,
+    job: &Job,
+    dpi: Option<f64>,
+) -> Result<Vec<String>, Error> {
     let mut files = Vec::new();
     let svg = format!("{name}.svg");
     run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);
+    let pdf = format!("{name}.pdf");
+    run.write(&pdf, &crate::output::pdf::render(job))?;
+    files.push(pdf);
+    let px_per_mm = dpi.map_or(crate::output::png::DEFAULT_PX_PER_MM, |d| d / 25.4);
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
-        let bytes =
-            crate::output::png::render(sheet, i + 1, crate::output::png::DEFAULT_PX_PER_MM)?;
+        let bytes = crate::output::png::render(sheet, i + 1, px_per_mm)?;
         run.write(&png, &bytes)?;
         files.push(png);
     }

@@ -376,3 +376,26 @@ impl SheetArgs {
         Ok(())
     }
 }
+
+/// The largest `--dpi`: 1200 dpi, a photo printer's; more only makes huge pictures.
+pub const MAX_DPI: f64 = 1200.0;
+
+/// Picture flags (`cut`, `flatten`).
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct PictureArgs {
+    /// Resolution of the PNG pictures in dots per inch, more than 0 and at most 1200, written
+    /// into each PNG (`pHYs`); default: the preview's 4 px/mm (101.6 dpi). A picture whose
+    /// longer side would pass 6000 px is drawn coarser and says so in its `pHYs`.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_dpi)]
+    pub dpi: Option<f64>,
+}
+
+/// A resolution in dots per inch: more than 0, at most [`MAX_DPI`] (`--dpi`).
+pub fn parse_dpi(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_DPI => Ok(v),
+        _ => Err(format!(
+            "must be a number of dots per inch more than 0 and at most {MAX_DPI}, got {s:?}"
+        )),
+    }
+}

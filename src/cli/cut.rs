@@ -1,7 +1,8 @@
 //! `flatcut cut SPEC|OBJ`: the whole pipeline. Reads the spec (or a bare OBJ with defaults),
 //! applies the device profile and the flags (flags win), and runs [`crate::pipeline::cut`],
 //! which writes into `-o DIR`: the program for the device (`<name>.plt`, or `<name>-<k>.plt`
-//! per sheet when there are several), `<name>.svg`, `<name>-<k>.png` per sheet, `<name>.dxf`
+//! per sheet when there are several), `<name>.svg`, `<name>.pdf` (1:1, a page per sheet),
+//! `<name>-<k>.png` per sheet (at `--dpi`), `<name>.dxf`
 //! (or `<name>-<k>.dxf`) per sheet and `report.json`, each written whole or not at all. Then,
 //! unless `--dry-run`, the program is streamed to the device: the simulated cutter for `sim`
 //! (the default) or with `--simulate`, else the serial port given by `--port` (see
@@ -10,7 +11,8 @@
 //! a pen pass before the knife pass (see [`super::link`] for the pause between them).
 
 use super::args::{
-    ask_alternatives, PatternArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs, ToolpathArgs,
+    ask_alternatives, PatternArgs, PictureArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs,
+    ToolpathArgs,
 };
 use super::link::LinkArgs;
 use crate::pipeline::Extras;
@@ -59,6 +61,8 @@ pub struct CutArgs {
     pub alternatives: Option<usize>,
     #[command(flatten)]
     pub smooth: SmoothArgs,
+    #[command(flatten)]
+    pub pictures: PictureArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -91,6 +95,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         surface_obj: a.surface_obj.clone(),
         uv_obj: a.smooth.uv_obj.clone(),
         quiet: a.quiet,
+        dpi: a.pictures.dpi,
     };
     let search = a.search.search()?;
     let choices = crate::pipeline::Toolpath {

@@ -1,8 +1,10 @@
-//! `flatcut flatten SPEC|OBJ`: stops after the pattern stage and writes the pieces as SVG and
-//! PNG (laid side by side on one long strip, no sheet limits) plus `report.json`
+//! `flatcut flatten SPEC|OBJ`: stops after the pattern stage and writes the pieces as SVG, PDF
+//! and PNG (at `--dpi`; laid side by side on one long strip, no sheet limits) plus `report.json`
 //! ([`crate::pipeline::flatten`]).
 
-use super::args::{ask_alternatives, PatternArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs};
+use super::args::{
+    ask_alternatives, PatternArgs, PictureArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs,
+};
 use crate::pipeline::Extras;
 use crate::Error;
 use clap::Args;
@@ -32,6 +34,8 @@ pub struct FlattenArgs {
     pub alternatives: Option<usize>,
     #[command(flatten)]
     pub smooth: SmoothArgs,
+    #[command(flatten)]
+    pub pictures: PictureArgs,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -57,6 +61,7 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         surface_obj: a.surface_obj.clone(),
         uv_obj: a.smooth.uv_obj.clone(),
         quiet: a.quiet,
+        dpi: a.pictures.dpi,
     };
     let run = crate::pipeline::flatten(&spec, &search, &extras)?;
     if !a.quiet {

@@ -1,7 +1,8 @@
 //! Output stage: turns a [`Job`](crate::toolpath::Job) into bytes — the program for the cutter
 //! ([`program`]: HP-GL / Roland CAMM-GL mode 2 in [`hpgl`], GRBL G-code in `gcode`, Graphtec
 //! GP-GL in [`gpgl`]), an SVG
-//! document of all sheets ([`svg`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
+//! document of all sheets ([`svg`]), a 1:1 PDF with a page per sheet and switchable layers
+//! ([`pdf`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
 //! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
 //! run's files ([`files`]).
@@ -9,7 +10,7 @@
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
 //! Choices shared by the encoders and kept in this module so that they agree:
-//! - SVG and PNG: the colour and dash pattern of each [`StrokeRole`], and the drawing order
+//! - SVG, PDF and PNG: the colour and dash pattern of each [`StrokeRole`], and the drawing order
 //!   (`DRAW_ORDER`: labels, marks, valley folds, mountain folds, cuts — cuts end up on top).
 //! - HP-GL and G-code: the sheet-to-machine transform [`to_device`] (DESIGN.md "Devices": the
 //!   profile's axes and units), applied to every absolute position, which each encoder then
@@ -29,6 +30,7 @@ pub use gcode::reach as gcode_reach;
 pub mod gpgl;
 pub mod hpgl;
 pub mod obj;
+pub mod pdf;
 pub mod png;
 pub mod report;
 pub mod svg;

@@ -16,6 +16,9 @@
 //! - Geometry is converted to pixels here (x' = (x + border)·s, y' = (height − y + border)·s),
 //!   so widths and dashes are plain pixel values. Strokes with fewer than two points or
 //!   non-finite coordinates are skipped.
+//! - The PNG says its resolution: a `pHYs` chunk (inserted after `IHDR`, as tiny-skia writes
+//!   none) with the scale actually drawn at, in px per metre (px/mm × 1000, rounded), so a
+//!   picture drawn coarser to fit `MAX_SIDE_PX` does not claim the asked-for resolution.
 //! - The bytes depend only on the input: tiny-skia draws deterministically and the PNG carries
 //!   no time stamp.
 
@@ -154,10 +157,43 @@ pub fn render(sheet: &SheetJob, index: usize, px_per_mm: f64) -> Result<Vec<u8>,
         );
     }
 
-    pixmap.encode_png().map_err(|e| OutputError::Encode {
+    let png = pixmap.encode_png().map_err(|e| OutputError::Encode {
         sheet: index,
         message: e.to_string(),
-    })
+    })?;
+    Ok(with_phys(png, px_per_metre(scale)))
+}
+
+/// Pixels per metre of a scale in px/mm, rounded, for `pHYs`.
+pub fn px_per_metre(px_per_mm: f64) -> u32 {
+    let v = (px_per_mm * 1000.0).round();
+    if v.is_finite() && v >= 1.0 {
+        v.min(f64::from(u32::MAX >> 1)) as u32
+    } else {
+        1
+    }
+}
+
+/// `png` with a `pHYs` chunk (`px_per_m` in x and in y, unit: metre) right after its `IHDR`
+/// (tiny-skia writes none); unchanged if it does not start with a PNG signature and `IHDR`.
+fn with_phys(png: Vec<u8>, px_per_m: u32) -> Vec<u8> {
+    // Signature (8), then IHDR: length (4), type (4), 13 bytes of data, CRC (4).
+    const IHDR_END: usize = 8 + 4 + 4 + 13 + 4;
+    if png.len() < IHDR_END || &png[1..4] != b"PNG" || &png[12..16] != b"IHDR" {
+        return png;
+    }
+    let mut body = Vec::with_capacity(13);
+    body.extend_from_slice(b"pHYs");
+    body.extend_from_slice(&px_per_m.to_be_bytes());
+    body.extend_from_slice(&px_per_m.to_be_bytes());
+    body.push(1);
+    let mut out = Vec::with_capacity(png.len() + 21);
+    out.extend_from_slice(&png[..IHDR_END]);
+    out.extend_from_slice(&9u32.to_be_bytes());
+    out.extend_from_slice(&body);
+    out.extend_from_slice(&crc32fast::hash(&body).to_be_bytes());
+    out.extend_from_slice(&png[IHDR_END..]);
+    out
 }
 
 /// Width in px of a `mm` wide line at `scale`, at least 1 px.
@@ -343,6 +379,49 @@ mod tests {
         assert!(c.is_some_and(|c| c.red() < 100 && c.green() > 50), "{c:?}");
         // Tiny scale: lines widened to 1 px, still draws.
         assert!(render(&s, 0, 0.05).is_ok());
+    }
+
+    /// The `pHYs` chunk of a PNG: (x px/m, y px/m, unit), after checking its CRC.
+    fn phys(png: &[u8]) -> Option<(u32, u32, u8)> {
+        let mut at = 8;
+        while at + 12 <= png.len() {
+            let len = u32::from_be_bytes(png[at..at + 4].try_into().ok()?) as usize;
+            let kind = &png[at + 4..at + 8];
+            let data = png.get(at + 8..at + 8 + len)?;
+            let crc = u32::from_be_bytes(png.get(at + 8 + len..at + 12 + len)?.try_into().ok()?);
+            assert_eq!(
+                crc,
+                crc32fast::hash(&png[at + 4..at + 8 + len]),
+                "CRC of {kind:?}"
+            );
+            if kind == b"pHYs" {
+                let x = u32::from_be_bytes(data[0..4].try_into().ok()?);
+                let y = u32::from_be_bytes(data[4..8].try_into().ok()?);
+                return Some((x, y, data[8]));
+            }
+            at += 12 + len;
+        }
+        None
+    }
+
+    #[test]
+    fn phys_says_the_resolution() {
+        let bytes = render(&sheet(), 0, 300.0 / 25.4).expect("renders");
+        assert_eq!(phys(&bytes), Some((11811, 11811, 1)));
+        let p = Pixmap::decode_png(&bytes).expect("decodes with the extra chunk");
+        assert_eq!(p.width(), (104.0 * 300.0 / 25.4_f64).ceil() as u32);
+        assert_eq!(
+            phys(&render(&sheet(), 0, 4.0).expect("renders")),
+            Some((4000, 4000, 1))
+        );
+        // Drawn coarser to fit: the real scale, 6000 px over 10004 mm.
+        let mut big = sheet();
+        big.width = 10_000.0;
+        let bytes = render(&big, 0, 4.0).expect("renders");
+        let expect = (6000.0 / 10_004.0 * 1000.0_f64).round() as u32;
+        assert_eq!(phys(&bytes), Some((expect, expect, 1)));
+        assert_eq!(px_per_metre(f64::NAN), 1);
+        assert_eq!(with_phys(b"not a png".to_vec(), 1), b"not a png");
     }
 
     #[test]

@@ -26,7 +26,7 @@ pub(crate) const SHEET_GAP_MM: f64 = 20.0;
 const SHEET_OUTLINE_MM: f64 = 0.1;
 
 /// Stroke width per role, mm.
-fn stroke_width_mm(role: StrokeRole) -> f64 {
+pub(crate) fn stroke_width_mm(role: StrokeRole) -> f64 {
     match role {
         StrokeRole::Cut | StrokeRole::Notch | StrokeRole::Weed => 0.25,
         StrokeRole::FoldMountain | StrokeRole::FoldValley => 0.2,

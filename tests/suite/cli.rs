@@ -47,6 +47,7 @@ fn every_pattern_cuts_with_hpgl_pens_dry_run() {
         for f in [
             format!("{name}.plt"),
             format!("{name}.svg"),
+            format!("{name}.pdf"),
             format!("{name}-1.png"),
             "report.json".into(),
         ] {

@@ -20,6 +20,7 @@ mod knife;
 mod nest;
 mod param;
 mod pattern;
+mod pdf;
 mod robust;
 mod simplify;
 mod sizing;

@@ -587,6 +587,7 @@ fn a_run_replaces_the_previous_run_in_its_folder() {
             ".flatcut-files",
             "job-1.png",
             "job.dxf",
+            "job.pdf",
             "job.plt",
             "job.svg",
             "notes.txt",
