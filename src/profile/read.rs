@@ -48,6 +48,30 @@ pub(super) fn positive(v: f64) -> bool {
     v.is_finite() && v > 0.0
 }
 
+/// The media sizes and the serial line's status query.
+fn check_media_and_line(p: &Profile) -> Result<(), Problem> {
+    for (key, v) in [
+        ("media_width", p.media_width),
+        ("media_length", p.media_length),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(problem(
+                "",
+                key,
+                format!("must be 0 (unknown) or a size in mm, got {v}"),
+            ));
+        }
+    }
+    if p.serial.status_query != super::StatusQuery::None && p.language != Language::Hpgl {
+        return Err(problem(
+            "serial",
+            "status_query",
+            "`esc-b` is HP's RS-232 device control, for HP-GL devices only",
+        ));
+    }
+    Ok(())
+}
+
 /// The checks of [`parse`] on a profile that deserialised.
 fn check(p: &Profile) -> Result<(), Problem> {
     super::grbl::check(&p.grbl).map_err(|(key, m)| problem("grbl", key, m))?;
@@ -113,25 +137,7 @@ fn check(p: &Profile) -> Result<(), Problem> {
             ),
         ));
     }
-    for (key, v) in [
-        ("media_width", p.media_width),
-        ("media_length", p.media_length),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(problem(
-                "",
-                key,
-                format!("must be 0 (unknown) or a size in mm, got {v}"),
-            ));
-        }
-    }
-    if p.serial.status_query != super::StatusQuery::None && p.language != Language::Hpgl {
-        return Err(problem(
-            "serial",
-            "status_query",
-            "`esc-b` is HP's RS-232 device control, for HP-GL devices only",
-        ));
-    }
+    check_media_and_line(p)?;
     if p.buffer == 0 {
         return Err(problem("", "buffer", "must be at least 1 byte"));
     }

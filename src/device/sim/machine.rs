@@ -95,6 +95,8 @@ pub(super) struct Device {
     /// With `esc_b`: data bytes read past the skid while the host is held off, which a
     /// stopped transmitter would still hold (taken into the buffer when the stop ends).
     held_back: VecDeque<u8>,
+    /// With `esc_b`, in a stop: the grace is over and the line ran dry once.
+    drained: bool,
     stalled: bool,
     rep: SimReport,
     /// Answers produced, then queued for the line.
@@ -169,6 +171,7 @@ impl Device {
             esc_b: !grbl && p.serial.status_query == crate::profile::StatusQuery::EscB,
             esc: 0,
             held_back: VecDeque::new(),
+            drained: false,
             stalled: false,
             rep,
             out: Vec::new(),
@@ -208,10 +211,20 @@ impl Device {
             let on_line = rx_line.ready(now, waiting);
             let mut allowance = on_line;
             // A device with an output channel reads on while it holds the host off, to answer
-            // device-control queries; it counts any other byte past the skid as a violation.
-            if self.stopped && !self.esc_b {
+            // device-control queries (a stalled one reads no more than any other).
+            if self.stopped && (!self.esc_b || self.stalled) {
                 allowance = allowance.min(SKID.saturating_sub(self.taken_since_stop));
                 self.watch_backlog(waiting);
+            }
+            // What the host had written before it stopped is its due, however much of it the
+            // kernel still holds: once the grace is over and the line has run dry, any more
+            // data is a host that did not stop.
+            if self.stopped
+                && self.esc_b
+                && waiting == 0
+                && self.stopped_at.is_some_and(|t| t.elapsed() >= STOP_GRACE)
+            {
+                self.drained = true;
             }
             // With flow control the device asks to stop the moment the high-water mark is
             // reached: take no more than that in one read, so the request goes out in time.
@@ -235,7 +248,7 @@ impl Device {
                         for &b in &buf[..k] {
                             self.receive(b);
                         }
-                        if self.stopped && !self.esc_b {
+                        if self.stopped && (!self.esc_b || self.stalled) {
                             self.taken_since_stop += k;
                         }
                     }
@@ -398,8 +411,8 @@ impl Device {
     /// answered with the free buffer space and CR; other `ESC . X` sequences are taken and
     /// ignored. True when `b` was part of one, or was held back: while the host is held off the
     /// device reads on (to see the queries), takes a skid's worth of data and holds the rest
-    /// back as a stopped transmitter would; data written later than [`STOP_GRACE`] after the
-    /// stop is a flow-control violation.
+    /// back as a stopped transmitter would; data that still arrives once the grace
+    /// ([`STOP_GRACE`]) is over and the line has run dry is a flow-control violation.
     fn device_control(&mut self, b: u8) -> bool {
         match (self.esc, b) {
             (0, 0x1b) => {
@@ -425,13 +438,13 @@ impl Device {
                 self.taken_since_stop += 1;
                 return false;
             }
-            // What the host had written before it could act on the stop is not held against
-            // it; what it writes later is.
-            if self.stopped_at.is_some_and(|t| t.elapsed() > STOP_GRACE) {
-                self.rep.flow_violations += 1;
-            }
             self.rep.bytes_received += 1;
             self.held_back.push_back(b);
+            // What the host had written before it stopped is not held against it; what comes
+            // once the line has run dry is.
+            if self.drained {
+                self.rep.flow_violations += 1;
+            }
             return true;
         }
         false
@@ -626,6 +639,7 @@ impl Device {
                     self.stopped_at = Some(Instant::now());
                     self.taken_since_stop = 0;
                     self.backlog_at_grace = None;
+                    self.drained = false;
                     if self.flow == FlowControl::XonXoff {
                         self.urgent.push(XOFF);
                         self.rep.xoff_sent += 1;

@@ -22,7 +22,7 @@
 //!   stream into the simulator. A profile with `status_query = "esc-b"` answers HP's
 //!   `ESC . B` with its free buffer space as the bytes arrive, also while it holds the host
 //!   off: it then reads on, takes the skid, holds the rest back as the stopped transmitter
-//!   would and counts data that comes later than the grace as violations.
+//!   would and counts data that still arrives once the grace is over and the line has run dry as violations.
 //! - **Execution.** HP-GL and GP-GL (`gpgl`) instructions are executed one at a time, each when the previous
 //!   motion has finished; GRBL lines move from the receive buffer into a 15-block planner and
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the

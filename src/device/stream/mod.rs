@@ -444,43 +444,17 @@ fn buffered(
                 };
                 return Err(fail(link, Failure::Timeout(op), sent, stopped));
             }
-            // A device with an output channel is asked how much room it has: room that grows
-            // is a device at work, however long it holds us off.
-            if let Some(q) = query.as_mut() {
-                if q.asked.is_none_or(|t| t.elapsed() > QUERY_EVERY) {
-                    if link.write_some(ESC_B).is_err() {
-                        return Err(fail(
-                            link,
-                            Failure::HungUp("while asking the device for its buffer space"),
-                            sent,
-                            stopped,
-                        ));
-                    }
-                    q.asked = Some(Instant::now());
-                }
-            }
-            // Wait for the next byte (XON) or the CTS line.
-            if flow == FlowControl::XonXoff || query.is_some() {
-                match link.read_some(&mut input[..]) {
-                    Ok(n) => take_in(
-                        &input[..n],
-                        flow,
-                        &mut rep,
-                        &mut stopped,
-                        &mut last_progress,
-                        query.as_mut(),
-                    ),
-                    Err(_) => {
-                        return Err(fail(
-                            link,
-                            Failure::HungUp("while waiting for XON"),
-                            sent,
-                            stopped,
-                        ))
-                    }
-                }
-            } else {
-                std::thread::sleep(Duration::from_micros(500));
+            let heard = wait_held(
+                link,
+                flow,
+                &mut rep,
+                &mut stopped,
+                &mut last_progress,
+                query.as_mut(),
+                &mut input,
+            );
+            if let Err(op) = heard {
+                return Err(fail(link, Failure::HungUp(op), sent, stopped));
             }
             continue;
         }
@@ -533,6 +507,34 @@ fn buffered(
     bar.set(sent, "");
     rep.bytes = sent;
     Ok(rep)
+}
+
+/// While the device holds the host off: ask a device with an output channel how much room it
+/// has (room that changes is a device at work, however long it holds us off), then wait for
+/// the next byte (XON, an answer) or for the CTS line. The error says what hung up.
+fn wait_held(
+    link: &mut Link,
+    flow: FlowControl,
+    rep: &mut StreamReport,
+    stopped: &mut bool,
+    last_progress: &mut Instant,
+    mut query: Option<&mut Query>,
+    input: &mut [u8],
+) -> Result<(), &'static str> {
+    if let Some(q) = query.as_deref_mut() {
+        if q.asked.is_none_or(|t| t.elapsed() > QUERY_EVERY) {
+            link.write_some(ESC_B)
+                .map_err(|_| "while asking the device for its buffer space")?;
+            q.asked = Some(Instant::now());
+        }
+    }
+    if flow == FlowControl::XonXoff || query.is_some() {
+        let n = link.read_some(input).map_err(|_| "while waiting for XON")?;
+        take_in(&input[..n], flow, rep, stopped, last_progress, query);
+    } else {
+        std::thread::sleep(Duration::from_micros(500));
+    }
+    Ok(())
 }
 
 /// HP's device-control query for the free buffer space (`ESC . B`).
