@@ -27,9 +27,10 @@
 //! the hold, soft reset, then the cut tool's "up" command) and reports how far it got: the
 //! stroke (counted from the program's pen-up moves) and the byte or line.
 //!
-//! Progress: a bar on stderr (bytes, strokes, ETA) when stderr is a terminal and not quiet;
-//! GRBL's bar counts machine time and its status is polled with `?` five times a second while a
-//! job runs (`grbl`).
+//! Progress: a bar on stderr (strokes, ETA) when stderr is a terminal and not quiet. It counts
+//! machine time, not bytes: HP-GL and GP-GL by the simulator's reading of the program's speeds
+//! (the bar stands at the instructions more than a buffer behind what was sent), GRBL by its
+//! planner's (`grbl`), whose status is polled with `?` five times a second while a job runs.
 
 // A stream error carries the job position for the user; it happens at most once per job, so
 // its size on the error path does not matter.
@@ -281,6 +282,11 @@ pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
 pub(crate) struct Bar {
     pub(crate) bar: Option<indicatif::ProgressBar>,
     pub(crate) starts: Vec<usize>,
+    /// HP-GL, GP-GL with a bar shown: where each instruction ends and the machine's seconds
+    /// up to its end; the bar then counts machine milliseconds, not bytes.
+    machine: Vec<(usize, f64)>,
+    /// The device's buffer: bytes sent but perhaps not yet executed.
+    buffer: usize,
 }
 
 impl Bar {
@@ -297,7 +303,33 @@ impl Bar {
             );
             b
         });
-        Bar { bar, starts }
+        Bar {
+            bar,
+            starts,
+            machine: Vec::new(),
+            buffer: 0,
+        }
+    }
+
+    /// Count a buffered program's progress in the machine's time (the simulator's reading of
+    /// its speeds, the line time of every byte), so that the ETA follows the machine's motion:
+    /// the bar stands at the end of the instructions the device has surely executed, those
+    /// more than its buffer behind what was sent.
+    fn in_machine_time(mut self, profile: &Profile, program: &[u8]) -> Bar {
+        let Some(b) = &self.bar else { return self };
+        self.machine = execution_timeline(profile, program)
+            .into_iter()
+            .map(|(at, t)| (at, t / 1.1))
+            .collect();
+        self.buffer = profile.buffer;
+        let total = self.machine.last().map_or(0.0, |&(_, t)| t);
+        b.set_length(((total * 1000.0) as u64).max(1));
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} [{bar:32}] {msg} machine ETA {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        self
     }
 
     fn stroke_at(&self, byte: usize) -> usize {
@@ -306,7 +338,14 @@ impl Bar {
 
     pub(crate) fn set(&self, byte: usize, extra: &str) {
         if let Some(b) = &self.bar {
-            b.set_position(byte as u64);
+            if self.machine.is_empty() {
+                b.set_position(byte as u64);
+            } else {
+                let done = byte.saturating_sub(self.buffer);
+                let k = self.machine.partition_point(|&(end, _)| end <= done);
+                let t = k.checked_sub(1).map_or(0.0, |i| self.machine[i].1);
+                b.set_position((t * 1000.0) as u64);
+            }
             b.set_message(format!(
                 "stroke {}/{}{extra}",
                 self.stroke_at(byte),
@@ -331,7 +370,10 @@ pub fn send(
 ) -> Result<StreamReport, StreamError> {
     let start = Instant::now();
     let starts = stroke_starts(program, profile.language);
-    let bar = Bar::new(program.len(), starts, opts.progress);
+    let mut bar = Bar::new(program.len(), starts, opts.progress);
+    if profile.language != Language::Gcode {
+        bar = bar.in_machine_time(profile, program);
+    }
     // Profile validation ties the GRBL protocols to G-code, so the language decides.
     let result = if profile.language == Language::Gcode {
         Grbl::new(link, profile, program, opts, &bar).run()
@@ -815,5 +857,45 @@ fn set_confirmed(e: &mut StreamError, executed: usize, stroke: usize, state: Too
             }
         }
         _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A buffered program's bar counts machine time: a long move is most of the job, however
+    /// few bytes it is, and the bar stands behind what was sent by the device's buffer.
+    #[test]
+    fn the_hpgl_bar_counts_machine_time() {
+        let profile = crate::profile::find("sim").unwrap();
+        // 1 mm moves, then one 500 mm move, then 1 mm moves again.
+        let mut p = String::from("IN;SP1;PU0,0;");
+        for k in 1..=20 {
+            p.push_str(&format!("PD{},0;", k * 40));
+        }
+        let long_at = p.len();
+        p.push_str("PD20800,0;");
+        let long_end = p.len();
+        for k in 1..=20 {
+            p.push_str(&format!("PD{},0;", 20800 + k * 40));
+        }
+        p.push_str("PU;SP0;");
+        let mut bar = Bar::new(p.len(), Vec::new(), false);
+        bar.bar = Some(indicatif::ProgressBar::hidden());
+        let bar = bar.in_machine_time(&profile, p.as_bytes());
+        let b = bar.bar.clone().unwrap();
+        let total = b.length().unwrap() as f64;
+        let at = |byte: usize| {
+            bar.set(byte + profile.buffer, "");
+            b.position() as f64 / total
+        };
+        let (before, after) = (at(long_at), at(long_end));
+        assert!(before < 0.1, "{before}");
+        assert!(after > 0.85, "{after}: the long move is most of the machine's time");
+        assert_eq!(at(0), 0.0);
+        assert!((at(p.len()) - 1.0).abs() < 1e-3);
+        bar.set(long_end, "");
+        assert!((b.position() as f64 / total) < 0.1, "the buffer is not yet executed");
     }
 }
