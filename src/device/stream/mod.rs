@@ -892,10 +892,16 @@ mod tests {
         };
         let (before, after) = (at(long_at), at(long_end));
         assert!(before < 0.1, "{before}");
-        assert!(after > 0.85, "{after}: the long move is most of the machine's time");
+        assert!(
+            after > 0.85,
+            "{after}: the long move is most of the machine's time"
+        );
         assert_eq!(at(0), 0.0);
         assert!((at(p.len()) - 1.0).abs() < 1e-3);
         bar.set(long_end, "");
-        assert!((b.position() as f64 / total) < 0.1, "the buffer is not yet executed");
+        assert!(
+            (b.position() as f64 / total) < 0.1,
+            "the buffer is not yet executed"
+        );
     }
 }
