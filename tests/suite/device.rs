@@ -8,7 +8,7 @@ use crate::common::*;
 use flatcut::device::serial;
 use flatcut::device::sim::{self, Faults, SimConfig, SimReport};
 use flatcut::device::stream::{self, StreamError, StreamOptions};
-use flatcut::profile::{self, Profile};
+use flatcut::profile::{self, Profile, StatusQuery};
 use std::time::Duration;
 
 fn hpgl_profile(baud: u32, flow: &str, buffer: usize) -> Profile {
@@ -100,28 +100,32 @@ fn one_megabyte_over_rts_cts_into_256_bytes() {
 
 #[test]
 fn a_host_that_ignores_xoff_is_caught() {
-    // Write straight into the pty, ignoring XOFF: the simulator must see the violation.
+    // Write straight into the pty, ignoring XOFF: the simulator must see the violation, also
+    // when it reads on to answer `ESC . B` (status_query = "esc-b").
     // A slow device (×0.2): each stop lasts longer than the grace the simulator allows a host
     // to react, which is what makes a violation measurable.
-    let p = hpgl_profile(115_200, "xon-xoff", 256);
-    let mut cfg = SimConfig::new(p.clone());
-    cfg.time_factor = Some(0.2);
-    let h = sim::spawn(cfg).unwrap();
-    let mut port = serial::open(&p, &h.path, None).unwrap();
-    // Steadily, as a host pacing at a line rate but deaf to XOFF would (the pty shows at most
-    // 4 kB waiting, so a flood all at once would hide the growth).
-    let (prog, _) = big_hpgl(6_400);
-    for c in prog.chunks(64) {
-        let _ = port.write_some(c);
-        std::thread::sleep(Duration::from_millis(10));
+    for query in [StatusQuery::None, StatusQuery::EscB] {
+        let mut p = hpgl_profile(115_200, "xon-xoff", 256);
+        p.serial.status_query = query;
+        let mut cfg = SimConfig::new(p.clone());
+        cfg.time_factor = Some(0.2);
+        let h = sim::spawn(cfg).unwrap();
+        let mut port = serial::open(&p, &h.path, None).unwrap();
+        // Steadily, as a host pacing at a line rate but deaf to XOFF would (the pty shows at
+        // most 4 kB waiting, so a flood all at once would hide the growth).
+        let (prog, _) = big_hpgl(6_400);
+        for c in prog.chunks(64) {
+            let _ = port.write_some(c);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        // The simulator counts the bytes that keep coming once its grace for reacting to XOFF
+        // is over: wait for that count rather than a fixed time.
+        assert!(h.wait_for_violation(Duration::from_secs(10)), "{query:?}");
+        let rep = h.stop().unwrap();
+        assert!(rep.xoff_sent >= 1);
+        assert!(rep.violations() > 0, "{query:?}: {rep:?}");
+        let _ = port.flush();
     }
-    // The simulator counts the bytes that keep coming once its grace for reacting to XOFF is
-    // over: wait for that count rather than a fixed time.
-    assert!(h.wait_for_violation(Duration::from_secs(10)));
-    let rep = h.stop().unwrap();
-    assert!(rep.xoff_sent >= 1);
-    assert!(rep.violations() > 0, "{rep:?}");
-    let _ = port.flush();
 }
 
 fn grbl_profile(protocol: &str) -> Profile {
@@ -779,7 +783,7 @@ fn a_busy_hpgl_device_that_answers_esc_b_outlasts_the_timeout() {
     assert_eq!(rep.flow_violations, 0);
 
     let mut asking = plain.clone();
-    asking.serial.status_query = flatcut::profile::StatusQuery::EscB;
+    asking.serial.status_query = StatusQuery::EscB;
     let t = std::time::Instant::now();
     let (r, rep) = run(
         &asking,
