@@ -255,6 +255,14 @@ impl Firmware {
         seen[0].is_some() && seen.iter().all(|a| *a == seen[0])
     }
 
+    /// End this attempt (see [`on_firmware`]) when the firmware has frozen; `what` is the
+    /// failure it caused.
+    pub fn give_up_if_frozen(&mut self, what: &dyn std::fmt::Display) {
+        if self.frozen() {
+            panic!("{FROZEN} {}: {what}", self.path);
+        }
+    }
+
     /// Bytes GRBL's receive buffer dropped.
     pub fn overflows(&self) -> usize {
         std::fs::read_to_string(self.dir.join("stderr.log"))
@@ -309,9 +317,7 @@ fn send(
     let r = stream::send(&mut link, p, program, o);
     drop(link);
     if let Err(e @ StreamError::Timeout { .. }) = &r {
-        if fw.frozen() {
-            panic!("{FROZEN} {}: {e}", fw.path);
-        }
+        fw.give_up_if_frozen(e);
     }
     r
 }
@@ -641,8 +647,8 @@ fn compare_with_the_simulator(mut fw: Firmware) {
         }
     }
     // A frozen firmware answers the lines that wait for motion late or never.
-    if !differ.is_empty() && fw.frozen() {
-        panic!("{FROZEN} {}: {}", fw.path, differ.join("; "));
+    if !differ.is_empty() {
+        fw.give_up_if_frozen(&differ.join("; "));
     }
     // M0 pauses: Hold:0 and no `ok` until cycle start (`~`), then `ok`.
     fw.slave.write_all(b"M0\n").unwrap();
@@ -747,8 +753,8 @@ fn a_reset_during_motion_stops_the_job_and_the_next_one_runs() {
         std::thread::sleep(Duration::from_millis(1500));
         fw.slave.write_all(&[0x18]).unwrap();
         let e = t.join().unwrap().unwrap_err();
-        if matches!(e, StreamError::Timeout { .. }) && fw.frozen() {
-            panic!("{FROZEN} {}: {e}", fw.path);
+        if matches!(e, StreamError::Timeout { .. }) {
+            fw.give_up_if_frozen(&e);
         }
         assert!(
             matches!(

@@ -501,7 +501,8 @@ impl Device {
                     let t = m.execute(&instr);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
-                        self.motion.push_back(Queued::still(s, DVec3::ZERO));
+                        self.motion
+                            .push_back(Queued::new(s, DVec3::ZERO, DVec3::ZERO));
                     }
                 }
                 Interp::Gpgl(m) => {
@@ -515,7 +516,8 @@ impl Device {
                     let t = m.execute(&instr);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
-                        self.motion.push_back(Queued::still(s, DVec3::ZERO));
+                        self.motion
+                            .push_back(Queued::new(s, DVec3::ZERO, DVec3::ZERO));
                     }
                 }
                 Interp::Grbl(_) => {
@@ -585,12 +587,7 @@ impl Device {
                     }
                 }
                 if let Some(s) = scale_time(tf, e.seconds) {
-                    self.motion.push_back(Queued {
-                        left: s,
-                        total: s,
-                        from,
-                        to: g.pos,
-                    });
+                    self.motion.push_back(Queued::new(s, from, g.pos));
                 }
                 for l in &e.text {
                     self.out.extend_from_slice(l.as_bytes());
@@ -598,7 +595,7 @@ impl Device {
                 }
                 if let Some(d) = e.dwell {
                     if let Some(s) = scale_time(tf, d) {
-                        self.motion.push_back(Queued::still(s, g.pos));
+                        self.motion.push_back(Queued::new(s, g.pos, g.pos));
                     }
                     self.owed_ok = Some(e.pause);
                     return true;
@@ -734,13 +731,14 @@ struct Queued {
 }
 
 impl Queued {
-    /// A wait in one place (a dwell, or an HP-GL/GP-GL instruction, whose status is not asked).
-    fn still(seconds: f64, at: DVec3) -> Self {
+    /// `seconds` from `from` to `to` (the same point for a dwell, and for an HP-GL or GP-GL
+    /// instruction, whose position is never asked).
+    fn new(seconds: f64, from: DVec3, to: DVec3) -> Self {
         Queued {
             left: seconds,
             total: seconds,
-            from: at,
-            to: at,
+            from,
+            to,
         }
     }
 

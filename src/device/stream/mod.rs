@@ -317,10 +317,7 @@ impl Bar {
     /// more than its buffer behind what was sent.
     fn in_machine_time(mut self, profile: &Profile, program: &[u8]) -> Bar {
         let Some(b) = &self.bar else { return self };
-        self.machine = execution_timeline(profile, program)
-            .into_iter()
-            .map(|(at, t)| (at, t / 1.1))
-            .collect();
+        self.machine = execution_timeline(profile, program);
         self.buffer = profile.buffer;
         let total = self.machine.last().map_or(0.0, |&(_, t)| t);
         b.set_length(((total * 1000.0) as u64).max(1));
@@ -513,7 +510,7 @@ fn buffered(
         if !timeline.is_empty() && sent + n > profile.buffer {
             let need = sent + n - profile.buffer;
             let k = timeline.partition_point(|&(end, _)| end < need);
-            let t_ready = timeline.get(k).map_or(0.0, |&(_, t)| t);
+            let t_ready = timeline.get(k).map_or(0.0, |&(_, t)| t * PACING_MARGIN);
             let wait = t_ready - t0.elapsed().as_secs_f64();
             if wait > 0.0 {
                 // Waiting on our own estimate is not the device failing to make progress.
@@ -578,6 +575,10 @@ fn wait_held(
     }
     Ok(())
 }
+
+/// Without flow control, how much later than the program's own timeline a byte is sent: a safe
+/// upper bound of when the device has made room for it.
+const PACING_MARGIN: f64 = 1.1;
 
 /// HP's device-control query for the free buffer space (`ESC . B`).
 const ESC_B: &[u8] = b"\x1b.B";
@@ -646,10 +647,10 @@ fn take_in(
     }
 }
 
-/// For each HP-GL instruction, where it ends in the program and a safe upper bound of when
-/// (seconds after the first byte) the device will have executed it: the line time of every byte
-/// up to it plus the motion time of every instruction up to it (from the speeds the program
-/// and profile set, read by the simulator's interpreter), plus 10 %.
+/// For each HP-GL or GP-GL instruction, where it ends in the program and when (seconds after
+/// the first byte) the device will have executed it: the line time of every byte up to it plus
+/// the motion time of every instruction up to it (from the speeds the program and profile set,
+/// read by the simulator's interpreter). Pacing adds [`PACING_MARGIN`] to it.
 fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
     let rate = profile.serial.baud.max(1) as f64 / 10.0;
     let mut m = super::sim::hpgl::Hpgl::new(profile);
@@ -672,7 +673,7 @@ fn execution_timeline(profile: &Profile, program: &[u8]) -> Vec<(usize, f64)> {
             m.execute(&rest[..n])
         };
         at += n;
-        out.push((at, 1.1 * (motion + at as f64 / rate)));
+        out.push((at, motion + at as f64 / rate));
         rest = &rest[n..];
     }
     out
