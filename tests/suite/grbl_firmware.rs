@@ -192,10 +192,17 @@ impl Firmware {
         )
     }
 
-    /// Send `$` settings one at a time, each answered `ok`.
+    /// Send `$` settings one at a time, each answered `ok`. No answer is grbl-sim
+    /// frozen (its serial interrupt is gated by the same flag as its stepper): the attempt ends.
     pub fn settings(&mut self, lines: &[&str]) {
         for l in lines {
             let a = self.ask(l);
+            let answered = a
+                .last()
+                .is_some_and(|x| x == "ok" || x.starts_with("error") || x.starts_with("ALARM"));
+            if !answered {
+                self.give_up(&format!("no answer to {l} in 10 s: {a:?}"));
+            }
             assert_eq!(a.last().map(String::as_str), Some("ok"), "{l}: {a:?}");
         }
     }

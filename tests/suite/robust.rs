@@ -482,6 +482,34 @@ fn a_stalled_device_is_reported_with_the_bytes_it_executed() {
 }
 
 #[test]
+fn a_device_that_stalls_after_taking_the_whole_program_is_not_a_finished_job() {
+    // A buffer larger than the program: the host writes it all before the device stalls, so
+    // only the device's end can tell that the job did not run.
+    let mut profile = flatcut::profile::find("sim").unwrap();
+    profile.buffer = 4096;
+    let mut cfg = SimConfig::new(profile);
+    cfg.faults = Faults {
+        stall_after: Some(100),
+        ..Faults::default()
+    };
+    let prog = slow_job();
+    let (r, rep) = stream::stream_job(
+        cfg,
+        &prog,
+        &sim_opts(1.0, Arc::new(AtomicBool::new(false))),
+        Duration::from_secs(3600),
+    )
+    .unwrap();
+    assert_eq!(rep.ended, "stalled (fault)");
+    let e = r.unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("timed out"), "{text}");
+    assert!(text.contains("known executed by the device"), "{text}");
+    let at = e.position().unwrap();
+    assert!(at.confirmed.unwrap() <= 100, "{text}");
+}
+
+#[test]
 fn cts_that_cannot_be_read_is_an_error() {
     // A pseudo-terminal has no modem lines: read for real (no virtual CTS), CTS fails.
     let profile = flatcut::profile::find("graphtec-ce6000").unwrap();

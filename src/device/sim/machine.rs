@@ -299,7 +299,11 @@ impl Device {
                 && now.duration_since(quiet_since) > Duration::from_millis(30)
             {
                 self.rep.unexecuted_bytes = self.rx.len();
-                self.rep.ended = "finished".into();
+                self.rep.ended = if self.stalled {
+                    "stalled (fault)".into()
+                } else {
+                    "finished".into()
+                };
                 break;
             }
             self.violations

@@ -820,13 +820,22 @@ pub fn stream_job(
         let port = handle_port_name(&report);
         sent = match (sent, end) {
             (Ok(_), Finish::Cancelled) => Err(StreamError::Cancelled { port, at, tool }),
-            (Ok(_), Finish::Idle) if executed < program.len() => Err(StreamError::Timeout {
-                port,
-                op: "waiting for the device to work off its buffer (it stopped making progress)",
-                secs: opts.timeout.as_secs_f64(),
-                at,
-                tool,
-            }),
+            // Done with a whole instruction left unexecuted is a device that stopped working
+            // (the host may have written everything before the device stalled).
+            (Ok(_), end)
+                if (end == Finish::Idle && executed < program.len())
+                    || crate::output::hpgl::read::next_instruction(&program[executed..])
+                        .is_some() =>
+            {
+                Err(StreamError::Timeout {
+                    port,
+                    op:
+                        "waiting for the device to work off its buffer (it stopped making progress)",
+                    secs: opts.timeout.as_secs_f64(),
+                    at,
+                    tool,
+                })
+            }
             (Err(mut e), _) => {
                 set_confirmed(&mut e, executed, at.stroke, tool);
                 Err(e)
