@@ -21,13 +21,14 @@
 //! x of its strokes, across the media) or longer than its `media_length` (the largest y, along
 //! the media) is refused, naming both sizes; `send` checks a program file alike.
 
+use crate::device::journal::{self, Journal};
 use crate::device::sim::{self, SimConfig};
 use crate::device::stream::{self, StreamOptions};
 use crate::pipeline::{Before, CutRun};
 use crate::profile::Profile;
 use crate::Error;
 use clap::Args;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::Duration;
@@ -101,7 +102,16 @@ pub fn deliver_run(
     quiet: bool,
 ) -> Result<(), Error> {
     check_media(profile, &run.job)?;
-    deliver_and_print(&run.programs, &run.before, profile, link, &run.dir, quiet)
+    let sources: Vec<PathBuf> = run.programs.iter().map(|(n, _)| run.dir.join(n)).collect();
+    deliver_and_print(
+        &run.programs,
+        &sources,
+        &run.before,
+        profile,
+        link,
+        &run.dir,
+        quiet,
+    )
 }
 
 /// A job whose strokes reach further across the media (sheet x) than the profile's
@@ -211,13 +221,14 @@ pub fn check_program_media(profile: &Profile, name: &str, bytes: &[u8]) -> Resul
 /// [`deliver`], printing what it says unless `quiet`.
 pub fn deliver_and_print(
     programs: &[(String, Vec<u8>)],
+    sources: &[PathBuf],
     before: &[Before],
     profile: &Profile,
     link: &LinkArgs,
     dir: &Path,
     quiet: bool,
 ) -> Result<(), Error> {
-    for line in deliver(programs, before, profile, link, dir, quiet)? {
+    for line in deliver(programs, sources, before, profile, link, dir, quiet)? {
         if !quiet {
             println!("{line}");
         }
@@ -272,15 +283,69 @@ pub fn chosen_sheets(list: Option<&str>, n: usize) -> Result<Vec<usize>, Error> 
 }
 
 /// Send each program (name, bytes) in turn, pausing as `before` says (see the module
-/// documentation); returns the lines to print.
+/// documentation); returns the lines to print. `sources` are the programs' files (the journal
+/// names them so that `flatcut resume` can read them again).
 pub fn deliver(
     programs: &[(String, Vec<u8>)],
+    sources: &[PathBuf],
     before: &[Before],
     profile: &Profile,
     link: &LinkArgs,
     dir: &Path,
     quiet: bool,
 ) -> Result<Vec<String>, Error> {
+    let opts = stream_options(link, quiet)?;
+    let sheets = sheet_of(before, programs.len());
+    let n = sheets.last().copied().unwrap_or(1);
+    let chosen = chosen_sheets(link.sheets.as_deref(), n)?;
+    // Every program is checked before the first byte of the first one goes out.
+    let programs = &checked(programs, profile, quiet)?;
+    // What is sent, in order, as streams: one per program to a real machine; to the
+    // simulator, one per sheet (the passes of a tool change go into one simulated machine,
+    // which changes tools itself).
+    let sim = simulated(profile, link);
+    let mut streams: Vec<Stream> = Vec::new();
+    for (i, &k) in sheets.iter().enumerate() {
+        if !chosen.contains(&k) {
+            continue;
+        }
+        let file = sources.get(i).map(|p| absolute(p)).unwrap_or_default();
+        match streams.last_mut() {
+            Some(s) if sim && s.sheet == k => {
+                s.names.push(programs[i].0.clone());
+                s.files.push(file);
+                s.bytes.extend_from_slice(&programs[i].1);
+            }
+            _ => streams.push(Stream {
+                sheet: k,
+                names: vec![programs[i].0.clone()],
+                files: vec![file],
+                bytes: programs[i].1.clone(),
+            }),
+        }
+    }
+    let mut journal = Journal {
+        device: profile.name.clone(),
+        streams: streams
+            .iter()
+            .map(|s| journal::Entry {
+                sheet: s.sheet,
+                files: s.files.clone(),
+                bytes: s.bytes.len(),
+                hash: journal::hash(&s.bytes),
+                strokes: stream::stroke_starts(&s.bytes, profile.language).len(),
+                state: journal::State::Pending,
+                finished: 0,
+                why: String::new(),
+            })
+            .collect(),
+    };
+    let todo: Vec<(usize, usize)> = (0..streams.len()).map(|j| (j, 0)).collect();
+    send_streams(&streams, &todo, &mut journal, n, profile, link, dir, &opts)
+}
+
+/// The stream options from the link flags, checked.
+pub fn stream_options(link: &LinkArgs, quiet: bool) -> Result<StreamOptions, Error> {
     if !(link.timeout.is_finite() && link.timeout > 0.0) {
         return Err(Error::Usage(format!(
             "--timeout must be a positive number of seconds, got {}",
@@ -293,61 +358,150 @@ pub fn deliver(
             link.sim_speed
         )));
     }
-    let opts = StreamOptions {
+    Ok(StreamOptions {
         timeout: Duration::from_secs_f64(link.timeout),
         progress: !quiet,
         cancel: cancel_flag(),
         ..StreamOptions::default()
-    };
-    let sheets = sheet_of(before, programs.len());
-    let n = sheets.last().copied().unwrap_or(1);
-    let chosen = chosen_sheets(link.sheets.as_deref(), n)?;
-    // (sheet, program index) of what is sent, in order.
-    let todo: Vec<(usize, usize)> = sheets
-        .iter()
-        .enumerate()
-        .filter(|(_, k)| chosen.contains(k))
-        .map(|(i, k)| (*k, i))
-        .collect();
-    // Every program is checked before the first byte of the first one goes out.
-    let programs = &checked(programs, profile, quiet)?;
-    if simulated(profile, link) {
-        return deliver_simulated(programs, &todo, n, profile, link, dir, &opts);
+    })
+}
+
+fn absolute(p: &Path) -> String {
+    std::path::absolute(p)
+        .unwrap_or_else(|_| p.to_path_buf())
+        .display()
+        .to_string()
+}
+
+/// One stream of a job: a sheet's program, or (to the simulator) the passes of a sheet.
+#[derive(Debug, Clone)]
+pub struct Stream {
+    pub sheet: usize,
+    pub names: Vec<String>,
+    pub files: Vec<String>,
+    pub bytes: Vec<u8>,
+}
+
+fn journal_error(e: journal::JournalError) -> Error {
+    Error::Usage(e.to_string())
+}
+
+/// Send `streams[j]` for each `(j, from)` of `todo`, in order, and keep `journal` (whose entry
+/// `j` is stream `j`) up to date in `dir`: `sending` before the first byte, then `done` or
+/// `stopped` with the strokes known finished (`from`, the strokes the stream's bytes leave out
+/// at its start, added). Between streams a real machine waits for the operator.
+#[allow(clippy::too_many_arguments)]
+pub fn send_streams(
+    streams: &[Stream],
+    todo: &[(usize, usize)],
+    journal: &mut Journal,
+    n: usize,
+    profile: &Profile,
+    link: &LinkArgs,
+    dir: &Path,
+    opts: &StreamOptions,
+) -> Result<Vec<String>, Error> {
+    journal.save(dir).map_err(journal_error)?;
+    let mut said = Vec::new();
+    for (t, &(j, from)) in todo.iter().enumerate() {
+        let s = &streams[j];
+        if t > 0 && !simulated(profile, link) {
+            let left: Vec<String> = todo[t..]
+                .iter()
+                .flat_map(|(j, _)| streams[*j].names.clone())
+                .collect();
+            let what = if streams[todo[t - 1].0].sheet != s.sheet {
+                format!("load sheet {} of {n}", s.sheet)
+            } else {
+                format!(
+                    "sheet {}: take the pen out of the holder and put the knife in",
+                    s.sheet
+                )
+            };
+            wait_for_operator(&what, &left, opts)?;
+        }
+        journal.streams[j].state = journal::State::Sending;
+        journal.save(dir).map_err(journal_error)?;
+        let (result, lines) = if simulated(profile, link) {
+            send_simulated(s, n, profile, link, dir, opts)?
+        } else {
+            send_real(s, profile, link, opts)?
+        };
+        let entry = &mut journal.streams[j];
+        match &result {
+            Ok(()) => {
+                entry.state = journal::State::Done;
+                entry.finished = entry.strokes;
+                entry.why.clear();
+            }
+            Err(e) => {
+                entry.state = journal::State::Stopped;
+                let at = match e {
+                    Error::Stream(e) => e.position(),
+                    _ => None,
+                };
+                entry.finished = from
+                    + at.map_or(0, |p| {
+                        journal::finished_strokes(&s.bytes, profile.language, p)
+                    });
+                entry.why = e.to_string();
+            }
+        }
+        let saved = journal.save(dir);
+        said.extend(lines);
+        if let Err(e) = result {
+            // The error is the job's end; how to go on is said beside it.
+            match saved {
+                Ok(()) => eprintln!(
+                    "flatcut: `flatcut resume {}` goes on from stroke {} of {} of {}",
+                    dir.display(),
+                    journal.streams[j].finished + 1,
+                    journal.streams[j].strokes,
+                    s.names.join(" + ")
+                ),
+                Err(w) => eprintln!("flatcut: warning: {w}"),
+            }
+            return Err(e);
+        }
+        saved.map_err(journal_error)?;
     }
+    Ok(said)
+}
+
+/// One stream to the real machine on `--port`.
+fn send_real(
+    s: &Stream,
+    profile: &Profile,
+    link: &LinkArgs,
+    opts: &StreamOptions,
+) -> Result<(Result<(), Error>, Vec<String>), Error> {
     let Some(path) = link.port.as_deref() else {
         return Err(Error::Usage(format!(
             "device `{}` is a real machine: give its serial port with --port (see `flatcut ports`), or use --simulate or --dry-run",
             profile.name
         )));
     };
-    let mut said = Vec::new();
-    for (j, &(k, i)) in todo.iter().enumerate() {
-        let name = &programs[i].0;
-        if j > 0 {
-            let left: Vec<String> = todo[j..]
-                .iter()
-                .map(|(_, i)| programs[*i].0.clone())
-                .collect();
-            let what = if todo[j - 1].0 != k {
-                format!("load sheet {k} of {n}")
-            } else {
-                format!("sheet {k}: take the pen out of the holder and put the knife in")
-            };
-            wait_for_operator(&what, &left, &opts)?;
-        }
-        let mut port = crate::device::serial::open(profile, path, link.baud)?;
-        let rep = stream::send(&mut port, profile, &programs[i].1, &opts)?;
-        said.push(format!(
-            "sent {name} to {} on {path}: {} bytes, {} strokes in {:.1} s ({:.0} bytes/s)",
-            profile.name, rep.bytes, rep.strokes, rep.seconds, rep.rate
-        ));
+    let mut port = crate::device::serial::open(profile, path, link.baud)?;
+    match stream::send(&mut port, profile, &s.bytes, opts) {
+        Ok(rep) => Ok((
+            Ok(()),
+            vec![format!(
+                "sent {} to {} on {path}: {} bytes, {} strokes in {:.1} s ({:.0} bytes/s)",
+                s.names.join(" + "),
+                profile.name,
+                rep.bytes,
+                rep.strokes,
+                rep.seconds,
+                rep.rate
+            )],
+        )),
+        Err(e) => Ok((Err(e.into()), Vec::new())),
     }
-    Ok(said)
 }
 
 /// The programs as they are sent: HP-GL ones checked (`device::check`), with the warnings
 /// printed unless `quiet`; a program that cannot be sent is an error naming it.
-fn checked(
+pub fn checked(
     programs: &[(String, Vec<u8>)],
     profile: &Profile,
     quiet: bool,
@@ -370,90 +524,82 @@ fn checked(
     Ok(out)
 }
 
-/// The simulated path of [`deliver`]: one simulated machine per sheet, the passes of a tool
-/// change streamed into the same one; no operator is waited for.
-fn deliver_simulated(
-    programs: &[(String, Vec<u8>)],
-    todo: &[(usize, usize)],
+/// One stream to a simulated machine of its own (see [`deliver`]); no operator is waited for.
+fn send_simulated(
+    s: &Stream,
     n: usize,
     profile: &Profile,
     link: &LinkArgs,
     dir: &Path,
     opts: &StreamOptions,
-) -> Result<Vec<String>, Error> {
+) -> Result<(Result<(), Error>, Vec<String>), Error> {
+    let k = s.sheet;
     let mut said = Vec::new();
-    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
-    for &(k, i) in todo {
-        match groups.last_mut() {
-            Some((g, v)) if *g == k => v.push(i),
-            _ => groups.push((k, vec![i])),
-        }
+    let mut cfg = SimConfig::new(profile.clone());
+    // The simulated line runs at the rate the host uses.
+    if let Some(b) = link.baud {
+        cfg.profile.serial.baud = b;
     }
-    for (k, group) in &groups {
-        let mut cfg = SimConfig::new(profile.clone());
-        // The simulated line runs at the rate the host uses.
-        if let Some(b) = link.baud {
-            cfg.profile.serial.baud = b;
-        }
-        cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
-        // The passes of a sheet go into one simulated machine, one after the other, as one
-        // stream (the simulated machine changes tools itself).
-        let bytes: Vec<u8> = group.iter().flat_map(|&i| programs[i].1.clone()).collect();
-        let names: Vec<&str> = group.iter().map(|&i| programs[i].0.as_str()).collect();
-        if group.len() > 1 {
-            said.push(format!(
-                "sheet {k}: tool change (the simulated machine changes tools itself)"
-            ));
-        }
-        // The simulated machine works off what it has buffered, as a real one would (after
-        // Ctrl-C that includes the tool-up command, queued behind the buffer), for as long
-        // as it makes progress: `--timeout` without progress, or Ctrl-C, ends the wait.
-        let (sent, report) = stream::stream_job(cfg, &bytes, opts, SIM_FINISH_CAP)?;
-        let stem = if n > 1 {
-            format!("sim-{k}")
-        } else {
-            "sim".into()
-        };
-        let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
-        let rep = sent?;
+    cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
+    if s.names.len() > 1 {
         said.push(format!(
-            "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud)",
-            names.join(" + "),
-            profile.name,
-            rep.bytes,
-            rep.strokes,
-            rep.seconds,
-            report.baud,
+            "sheet {k}: tool change (the simulated machine changes tools itself)"
         ));
-        if report.violations() > 0 {
-            return Err(Error::Usage(format!(
+    }
+    // The simulated machine works off what it has buffered, as a real one would (after
+    // Ctrl-C that includes the tool-up command, queued behind the buffer), for as long
+    // as it makes progress: `--timeout` without progress, or Ctrl-C, ends the wait.
+    let (sent, report) = stream::stream_job(cfg, &s.bytes, opts, SIM_FINISH_CAP)?;
+    let stem = if n > 1 {
+        format!("sim-{k}")
+    } else {
+        "sim".into()
+    };
+    let (png, json) = sim::write_outputs(&report, profile, dir, &stem)?;
+    let rep = match sent {
+        Ok(rep) => rep,
+        Err(e) => return Ok((Err(e.into()), said)),
+    };
+    said.push(format!(
+        "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s at {} baud)",
+        s.names.join(" + "),
+        profile.name,
+        rep.bytes,
+        rep.strokes,
+        rep.seconds,
+        report.baud,
+    ));
+    if report.violations() > 0 {
+        return Ok((
+            Err(Error::Usage(format!(
                 "the simulated {} lost data: {} bytes overran its {}-byte buffer and {} were sent while it asked to stop (see {}); a real machine would have cut this job wrong",
                 profile.name,
                 report.overruns,
                 report.buffer,
                 report.flow_violations,
                 json.display()
-            )));
-        }
-        said.push(format!(
-            "the simulated {} cut {} paths, {:.0} mm, {} overruns",
-            profile.name,
-            report.paths.len(),
-            report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
-            report.violations(),
-        ));
-        said.push(format!(
-            "picture of the cut: {} (report {})",
-            png.display(),
-            json.display()
+            ))),
+            said,
         ));
     }
-    Ok(said)
+    said.push(format!(
+        "the simulated {} cut {} paths, {:.0} mm, {} overruns",
+        profile.name,
+        report.paths.len(),
+        report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
+        report.violations(),
+    ));
+    said.push(format!(
+        "picture of the cut: {} (report {})",
+        png.display(),
+        json.display()
+    ));
+    Ok((Ok(()), said))
 }
 
 /// Stop for the operator (`what` to do) before the programs `left` are sent: on a terminal
 /// Enter, otherwise a line on standard input; closed input or Ctrl-C stops the job.
-fn wait_for_operator(what: &str, left: &[String], opts: &StreamOptions) -> Result<(), Error> {
+pub fn wait_for_operator(what: &str, left: &[String], opts: &StreamOptions) -> Result<(), Error> {
     use std::io::IsTerminal;
     let how = if std::io::stdin().is_terminal() {
         "press Enter"

@@ -12,6 +12,7 @@ pub mod flatten;
 pub mod link;
 pub mod nest;
 pub mod ports;
+pub mod resume;
 pub mod send;
 pub mod sim;
 
@@ -33,6 +34,7 @@ Examples:
   flatcut cut lamp.toml --device roland-gx24 --port /dev/ttyUSB0   cut on a real machine
   flatcut cut lamp.toml --device grbl-dragknife --simulate          try a device on the simulator
   flatcut send out/cube/cube.plt --device hpgl-pens --port /dev/ttyUSB0
+  flatcut resume out/cube                             go on with a job that stopped (hang-up, Ctrl-C)
   flatcut sim --device grbl-pen -o out/sim            a simulated cutter for other software
   flatcut ports                                       serial ports on this machine
   flatcut devices                                     device profiles";
@@ -66,6 +68,9 @@ pub enum Command {
     /// Stream an existing .plt or .gcode program to a machine (or the simulated cutter).
     #[command(after_help = EXAMPLES)]
     Send(send::SendArgs),
+    /// Go on with a job that stopped, from the last stroke the machine is known to have cut.
+    #[command(after_help = EXAMPLES)]
+    Resume(resume::ResumeArgs),
     /// Run the simulated cutter on a pseudo-terminal for other software to talk to.
     #[command(after_help = EXAMPLES)]
     Sim(sim::SimArgs),
@@ -84,6 +89,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Nest(a) => nest::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Send(a) => send::run(&a),
+        Command::Resume(a) => resume::run(&a),
         Command::Sim(a) => sim::run(&a),
         Command::Ports => ports::ports(),
         Command::Devices => ports::devices(),

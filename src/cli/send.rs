@@ -33,9 +33,8 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/send"));
-    if super::link::simulated(&profile, &a.link) {
-        crate::pipeline::create_dir(&dir)?;
-    }
+    // The simulator's picture and report, and the job's journal, go there.
+    crate::pipeline::create_dir(&dir)?;
     let name = a
         .file
         .file_name()
@@ -44,6 +43,7 @@ pub fn run(a: &SendArgs) -> Result<(), Error> {
     super::link::check_program_media(&profile, &name, &bytes)?;
     deliver_and_print(
         &[(name, bytes)],
+        std::slice::from_ref(&a.file),
         &[crate::pipeline::Before::Start],
         &profile,
         &a.link,

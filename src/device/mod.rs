@@ -7,6 +7,7 @@
 
 pub mod check;
 pub mod grbl;
+pub mod journal;
 pub(crate) mod motion;
 pub mod serial;
 pub mod sim;

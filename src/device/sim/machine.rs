@@ -691,6 +691,8 @@ impl Device {
     }
 
     fn close(mut self) -> SimReport {
+        // However it ended (finished, hung up, stopped), what is still buffered was not run.
+        self.rep.unexecuted_bytes = self.rx.len();
         let (rec, upm) = match &self.interp {
             Interp::Hpgl(m) => {
                 self.rep.executed = m.instructions;

@@ -130,7 +130,8 @@ pub struct SimReport {
     pub flow_violations: usize,
     /// The tool that was down when the simulator stopped (`None`: all tools up).
     pub tool_down_at_end: Option<String>,
-    /// Bytes left in the buffer at the end that never made a whole instruction or line.
+    /// Bytes left in the buffer at the end, never run: a fragment that no further byte
+    /// completed, or what a stall, a hang-up or a stop left.
     pub unexecuted_bytes: usize,
     /// Fullest the input buffer ever was.
     pub max_buffer_fill: usize,

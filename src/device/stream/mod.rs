@@ -238,7 +238,7 @@ pub struct StreamReport {
 }
 
 /// Byte offsets where strokes start: HP-GL `PU` with coordinates, G-code `G0` with X or Y.
-pub(crate) fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
+pub fn stroke_starts(program: &[u8], language: Language) -> Vec<usize> {
     let mut out = Vec::new();
     match language {
         Language::Hpgl => {
