@@ -140,7 +140,9 @@ pub fn finished_strokes(program: &[u8], language: Language, at: &Position) -> us
     };
     // Stroke j ends where stroke j + 1 starts; the last one at the end of the program.
     let ends = starts.iter().skip(1).copied().chain([program.len()]);
-    ends.take_while(|&e| e <= executed).count().min(starts.len())
+    ends.take_while(|&e| e <= executed)
+        .count()
+        .min(starts.len())
 }
 
 /// Bytes of a G-code program known run when line `ok_line` (1-based) was the last answered:
@@ -198,14 +200,19 @@ pub fn resume_program(program: &[u8], language: Language, from: usize) -> Option
                 before
                     .lines()
                     .flat_map(|l| l.split_whitespace())
-                    .filter(|t| t.starts_with(w) && t.len() > 1)
-                    .last()
+                    .rfind(|t| t.starts_with(w) && t.len() > 1)
                     .map(str::to_string)
             };
             if let Some(f) = word('F') {
                 out.extend_from_slice(format!("{f}\n").as_bytes());
             }
-            let laser_on = before.lines().any(|l| l.trim_start().starts_with("M4"));
+            // The last M4/M5 before the resume point says whether the laser was on (M3 S is
+            // a servo pen's position, which each stroke sets itself).
+            let laser_on = before
+                .lines()
+                .map(str::trim_start)
+                .rfind(|l| l.starts_with("M4") || l.starts_with("M5"))
+                .is_some_and(|l| l.starts_with("M4"));
             if let (true, Some(s)) = (laser_on, word('S')) {
                 out.extend_from_slice(format!("M4 {s}\n").as_bytes());
             }
@@ -233,7 +240,8 @@ fn moves(ins: &[u8], language: Language) -> bool {
 mod tests {
     use super::*;
 
-    const HPGL: &[u8] = b"IN;SP1;VS10;PU0,0;PD100,0;PU100,100;SP2;PD200,100;PU300,0;PD300,50;PU;SP0;";
+    const HPGL: &[u8] =
+        b"IN;SP1;VS10;PU0,0;PD100,0;PU100,100;SP2;PD200,100;PU300,0;PD300,50;PU;SP0;";
 
     #[test]
     fn an_hpgl_resume_keeps_the_tool_and_speed_in_effect() {
