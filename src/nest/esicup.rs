@@ -12,6 +12,10 @@ use serde::Deserialize;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
+/// Most items an instance may have, counting each unit of demand (the largest ESICUP instances
+/// have a few hundred): a bound on memory and time that a typo in `demand` cannot lift.
+pub const MAX_ITEMS: usize = 10_000;
+
 /// Errors reading or solving an instance; each names the file and, where it applies, the item.
 #[derive(Debug, thiserror::Error)]
 pub enum EsicupError {
@@ -164,6 +168,13 @@ pub fn parse(text: &str, path: &Path) -> Result<Instance, EsicupError> {
                 .fold(f64::INFINITY, f64::min);
             return Err(bad(format!(
                 "it is {h} high in every allowed orientation, wider than the strip ({height})"
+            )));
+        }
+        if it.demand > MAX_ITEMS - items.len() {
+            return Err(bad(format!(
+                "its demand of {} makes more than {MAX_ITEMS} items in all; the nest is not \
+                 made for more",
+                it.demand
             )));
         }
         for _ in 0..it.demand {

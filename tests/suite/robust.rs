@@ -664,3 +664,27 @@ fn messages_name_file_line_and_key_and_never_echo_content() {
     assert!(!e.contains("root:x"), "{e}");
     assert!(!e.contains("daemon"), "{e}");
 }
+
+/// The fuzz harness's find: `jakobs1.json` with one item's demand mutated to 2^32 expanded it
+/// into four billion items (out of memory). The reader refuses more than `MAX_ITEMS` in all,
+/// naming the item.
+#[test]
+fn an_esicup_demand_beyond_the_item_bound_is_refused() {
+    require_shared!();
+    let dir = scratch("robust-esicup-demand");
+    let text = std::fs::read_to_string(shared_data("nesting/jakobs1.json")).unwrap();
+    let at = text.find("\"demand\": 1").expect("a demand of 1");
+    let huge = format!("{}\"demand\": 4294967296{}", &text[..at], &text[at + 11..]);
+    let file = dir.join("huge-demand.json");
+    std::fs::write(&file, huge).unwrap();
+    let o = bounded(&[
+        "nest",
+        &s(&file),
+        "-o",
+        &s(&dir.join("out")),
+        "--nest-time",
+        "1",
+    ]);
+    refused(&o, &["huge-demand.json", "item 0", "4294967296", "10000"]);
+    assert!(!dir.join("out").join("solution.json").exists());
+}

@@ -257,8 +257,9 @@ impl Grbl {
             || matches!(k.flow, Some(0 | 2 | 30))
     }
 
-    /// Execute one line (without its line ending); `busy`: the machine is moving.
-    pub(crate) fn execute(&mut self, line: &str, busy: bool) -> Result<Effect, u32> {
+    /// Execute one line (without its line ending); `busy`: the machine is moving. An `Err` is
+    /// GRBL's error code for the line.
+    pub fn execute(&mut self, line: &str, busy: bool) -> Result<Effect, u32> {
         if crate::device::grbl::significant_len(line) > crate::device::grbl::LINE_MAX {
             return Err(11);
         }
