@@ -106,8 +106,6 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     if !a.quiet {
         super::print_cut(&spec, &run, &profile.name, a.dry_run);
     }
-    if !a.dry_run {
-        super::link::deliver_run(&run, &profile, &a.link, a.quiet)?;
-    }
+    super::link::deliver_run(&run, &profile, &a.link, a.quiet, a.dry_run)?;
     Ok(())
 }

@@ -94,13 +94,23 @@ pub fn need_port(profile: &Profile, link: &LinkArgs, dry_run: bool) -> Result<()
 }
 
 /// `cut` and `fitting`: refuse a job wider than the device's media before the first byte, then
-/// [`deliver_and_print`] the run's programs with their pauses.
+/// [`deliver_and_print`] the run's programs with their pauses. A dry run sends nothing and
+/// only warns of a job the device would refuse.
 pub fn deliver_run(
     run: &CutRun,
     profile: &Profile,
     link: &LinkArgs,
     quiet: bool,
+    dry_run: bool,
 ) -> Result<(), Error> {
+    if dry_run {
+        // The files are written and nothing is sent; a job the device would refuse is said
+        // now, not when the user sends the files.
+        if let Err(e) = check_media(profile, &run.job) {
+            eprintln!("flatcut: warning: {e}");
+        }
+        return Ok(());
+    }
     check_media(profile, &run.job)?;
     let sources: Vec<PathBuf> = run.programs.iter().map(|(n, _)| run.dir.join(n)).collect();
     deliver_and_print(
@@ -428,6 +438,13 @@ pub fn send_streams(
             send_real(s, profile, link, opts)?
         };
         let entry = &mut journal.streams[j];
+        // Whether the program started: an error with no position (a line too long, a setting
+        // that does not suit, no answer to the reset) came before its first byte, so there is
+        // nothing to resume; the program or the machine needs fixing first.
+        let started = match &result {
+            Err(Error::Stream(e)) => e.position().is_some(),
+            _ => false,
+        };
         match &result {
             Ok(()) => {
                 entry.state = journal::State::Done;
@@ -452,6 +469,7 @@ pub fn send_streams(
         if let Err(e) = result {
             // The error is the job's end; how to go on is said beside it.
             match saved {
+                Ok(()) if !started || journal.streams[j].strokes == 0 => {}
                 Ok(()) => eprintln!(
                     "flatcut: `flatcut resume {}` goes on from stroke {} of {} of {}",
                     dir.display(),

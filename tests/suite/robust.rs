@@ -404,6 +404,54 @@ fn a_program_ending_tool_down_gets_a_tool_up() {
     assert!(json.contains("\"tool_down_at_end\": null"), "{json}");
 }
 
+/// A G-code line over GRBL's 80 characters in the middle of a program once stopped the job
+/// after 58 lines with the tool down: the streamer checks every line before the first byte.
+#[test]
+fn a_gcode_line_over_grbls_80_characters_is_refused_before_the_first_byte() {
+    let dir = scratch("robust-long-line");
+    let mut prog = String::from("G21\nG90\nG0 Z5\n");
+    for i in 0..60 {
+        if i == 30 {
+            prog.push_str(&format!(
+                "G1 X{:.6} Y{:.6} Z0.000000 F1500.000000 ; {}\n",
+                10.0,
+                10.0,
+                "x".repeat(5)
+            ));
+            prog.push_str("G1 X10.0000000000001 Y20.0000000000001 Z-0.0000000000001 F1500.0000000000001 S1000.000\n");
+        }
+        prog.push_str(&format!("G1 X{} Y{} Z0 F1500\n", i % 7, i % 5));
+    }
+    prog.push_str("G0 Z5\n");
+    let file = dir.join("long.gcode");
+    std::fs::write(&file, &prog).unwrap();
+    let line = prog
+        .lines()
+        .position(|l| l.starts_with("G1 X10.0000000000001"))
+        .unwrap()
+        + 1;
+    let o = bounded(&[
+        "send",
+        &s(&file),
+        "--device",
+        "grbl-pen",
+        "--simulate",
+        "--sim-speed",
+        "0",
+        "-o",
+        &s(&dir.join("out")),
+    ]);
+    refused(
+        &o,
+        &[&format!("line {line}"), "79 GRBL keeps", "nothing was sent"],
+    );
+    assert!(!stderr(&o).contains("resume"), "{}", stderr(&o));
+    if let Ok(json) = std::fs::read_to_string(dir.join("out/sim.json")) {
+        assert!(json.contains("\"tool_down_at_end\": null"), "{json}");
+        assert!(json.contains("\"paths\": []"), "{json}");
+    }
+}
+
 fn sim_opts(timeout: f64, cancel: Arc<AtomicBool>) -> StreamOptions {
     StreamOptions {
         timeout: Duration::from_secs_f64(timeout),

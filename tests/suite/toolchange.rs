@@ -314,6 +314,40 @@ fn fabric_folds_never_reach_the_knife_unless_asked() {
     assert!(drawn.iter().filter(|s| s.pen == 3).count() as u64 >= folds);
 }
 
+/// A dry run writes the files but says at once that the device would refuse them: the cube's
+/// spec nests on a 610 mm roll, twice grbl-pen's 300 mm bed.
+#[test]
+fn a_dry_run_warns_of_a_job_wider_than_the_media() {
+    let out = scratch("media-wide-dry");
+    let args = |device: &'static str| {
+        [
+            "cut",
+            "patterns/cube.toml",
+            "--device",
+            device,
+            "--dry-run",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+    };
+    let a = args("grbl-pen");
+    let o = flatcut(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning") && e.contains("wider than the 300 mm media"),
+        "{e}"
+    );
+    assert!(out.join("cube.gcode").exists());
+    // On the 610 mm roll's own cutter there is nothing to say.
+    let a = args("sim-dragknife");
+    let o = flatcut(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}
+
 #[test]
 fn a_blank_wider_than_the_media_is_refused_before_the_first_byte() {
     let out = scratch("media-wide");
