@@ -12,7 +12,8 @@ use crate::geom::obj;
 use glam::DVec2;
 
 /// The OBJ text of `mesh`, headed by `# comment` lines (one per line of `comment`). With `uv`
-/// (one 2D point per corner of each face, in mm) every face is written `f v/vt …`.
+/// (one 2D point per corner of each face, in mm) every face is written `f v/vt …`, the corners
+/// of a vertex at one flat point sharing one `vt` (one UV island per piece).
 ///
 /// Returns `None` when `uv` does not have one point per corner of every face.
 pub fn write(mesh: &Mesh, uv: Option<&[Vec<DVec2>]>, comment: &str) -> Option<String> {
@@ -47,7 +48,7 @@ mod tests {
     }
 
     #[test]
-    fn obj_lists_vertices_faces_and_per_corner_uv() {
+    fn obj_lists_vertices_faces_and_shared_uv() {
         let m = quad();
         let plain = write(&m, None, "flatcut").unwrap();
         assert_eq!(
@@ -60,7 +61,17 @@ mod tests {
         ];
         let with = write(&m, Some(&uv), "").unwrap();
         assert!(with.contains("vt 0 5.64\n"), "{with}");
-        assert!(with.ends_with("f 1/1 2/2 3/3\nf 1/4 3/5 4/6\n"), "{with}");
+        // The two faces are one piece: vertices 1 and 3 have one `vt` each.
+        assert_eq!(with.matches("vt ").count(), 4, "{with}");
+        assert!(with.ends_with("f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n"), "{with}");
+        // Cut apart along the diagonal (the second face moved 30 mm): one `vt` per side.
+        let apart: Vec<Vec<DVec2>> = vec![
+            uv[0].clone(),
+            uv[1].iter().map(|p| *p + DVec2::X * 30.0).collect(),
+        ];
+        let two = write(&m, Some(&apart), "").unwrap();
+        assert_eq!(two.matches("vt ").count(), 6, "{two}");
+        assert!(two.ends_with("f 1/1 2/2 3/3\nf 1/4 3/5 4/6\n"), "{two}");
         // One point short for a face: refused.
         let short = vec![uv[0].clone(), uv[1][..2].to_vec()];
         assert!(write(&m, Some(&short), "").is_none());

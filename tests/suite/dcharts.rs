@@ -614,14 +614,61 @@ fn cli_flatten_writes_uv_obj_and_stretch() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(&uv).unwrap();
     assert!(!text.to_lowercase().contains("nan"));
-    let faces = text.lines().filter(|l| l.starts_with("f ")).count();
+    let faces: Vec<Vec<(usize, usize)>> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("f "))
+        .map(|l| {
+            l.split_whitespace()
+                .map(|c| {
+                    let (v, t) = c.split_once('/').expect("f v/vt");
+                    (v.parse().unwrap(), t.parse().unwrap())
+                })
+                .collect()
+        })
+        .collect();
     let t = vts(&text);
-    assert_eq!(t.len(), 3 * faces);
+    // Shared as exporters share them: each `vt` belongs to one vertex, and the faces joined
+    // by shared `vt` make one island per piece.
+    let mut owner = std::collections::HashMap::new();
+    for &(v, vt) in faces.iter().flatten() {
+        assert!(vt >= 1 && vt <= t.len());
+        assert_eq!(
+            *owner.entry(vt).or_insert(v),
+            v,
+            "vt {vt} is on two vertices"
+        );
+    }
+    assert!(
+        t.len() < 3 * faces.len() / 2,
+        "{} vt for {} faces",
+        t.len(),
+        faces.len()
+    );
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    let mut first_face = std::collections::HashMap::new();
+    for (f, corners) in faces.iter().enumerate() {
+        for &(_, vt) in corners {
+            let g = *first_face.entry(vt).or_insert(f);
+            let (a, b) = (root(&mut parent, f), root(&mut parent, g));
+            parent[a] = b;
+        }
+    }
+    let islands = (0..faces.len())
+        .filter(|&f| root(&mut parent, f) == f)
+        .count();
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("out/report.json")).unwrap())
             .unwrap();
     let pieces = report["pieces"].as_array().unwrap();
     assert!(!pieces.is_empty() && pieces.len() <= 3);
+    assert_eq!(islands, pieces.len(), "UV islands vs pieces");
     for p in pieces {
         let l2 = p["stretch"]["l2"].as_f64().unwrap();
         assert!((0.999_999..1.0005).contains(&l2), "{l2}");
