@@ -517,7 +517,7 @@ fn send_real(
     }
 }
 
-/// The programs as they are sent: HP-GL ones checked (`device::check`), with the warnings
+/// The programs as they are sent: HP-GL and GP-GL ones checked (`device::check`), with the warnings
 /// printed unless `quiet`; a program that cannot be sent is an error naming it.
 pub fn checked(
     programs: &[(String, Vec<u8>)],
@@ -526,12 +526,15 @@ pub fn checked(
 ) -> Result<Vec<(String, Vec<u8>)>, Error> {
     let mut out = Vec::with_capacity(programs.len());
     for (name, bytes) in programs {
-        if profile.language != crate::profile::Language::Hpgl {
-            out.push((name.clone(), bytes.clone()));
-            continue;
-        }
-        let c = crate::device::check::check_hpgl(bytes, profile)
-            .map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+        let c = match profile.language {
+            crate::profile::Language::Hpgl => crate::device::check::check_hpgl(bytes, profile)
+                .map_err(|e| Error::Usage(format!("{name}: {e}")))?,
+            crate::profile::Language::Gpgl => crate::device::check::check_gpgl(bytes, profile),
+            crate::profile::Language::Gcode => {
+                out.push((name.clone(), bytes.clone()));
+                continue;
+            }
+        };
         if !quiet {
             for w in &c.warnings {
                 eprintln!("flatcut: warning: {name}: {w}");

@@ -1,4 +1,5 @@
-//! Checking an HP-GL program before its first byte goes out: every move within HP-GL's
+//! Checking a program before its first byte goes out. GP-GL gets the same final tool-up and
+//! terminator as HP-GL below ([`check_gpgl`]). HP-GL: every move within HP-GL's
 //! coordinate range (±2^30 plotter units; a device ignores an instruction out of range, so the
 //! job would go on from the wrong place), and a final tool-up: a program that ends with the
 //! tool down (truncated, or made by hand) gets `;PU;` appended, with a warning, so that no job
@@ -31,6 +32,42 @@ pub enum CheckError {
 pub struct Checked {
     pub bytes: Vec<u8>,
     pub warnings: Vec<String>,
+}
+
+/// Check a GP-GL program as [`check_hpgl`] checks HP-GL: run through the simulated cutter's
+/// GP-GL interpreter, an unterminated last instruction gets its ETX, and a program that ends
+/// with the tool down gets a tool-up where the tool stands (`M x,y`), each with a warning.
+pub fn check_gpgl(program: &[u8], profile: &Profile) -> Checked {
+    use crate::output::gpgl;
+    let mut m = super::sim::gpgl::Gpgl::new(profile);
+    let mut rest = program;
+    while !rest.is_empty() {
+        let n = gpgl::next_instruction(rest).unwrap_or(rest.len());
+        m.execute(&rest[..n]);
+        rest = &rest[n..];
+    }
+    let mut bytes = program.to_vec();
+    let mut warnings = Vec::new();
+    let body = program
+        .iter()
+        .rposition(|b| !b.is_ascii_whitespace() && *b != 0)
+        .map_or(&program[..0], |i| &program[..=i]);
+    if body.last().is_some_and(|&b| !gpgl::ends_instruction(b)) {
+        bytes.push(0x03);
+        warnings.push(
+            "the last instruction has no terminator: an ETX was appended so that the device executes it"
+                .into(),
+        );
+    }
+    if m.is_down() {
+        let tool = m.tool_down().unwrap_or_else(|| "the tool".into());
+        let at = m.position();
+        bytes.extend_from_slice(format!("M{},{}\x03", at.x.round(), at.y.round()).as_bytes());
+        warnings.push(format!(
+            "the program ends with the tool down ({tool}): a tool-up where it stands (`M`) was appended"
+        ));
+    }
+    Checked { bytes, warnings }
 }
 
 /// Check an HP-GL program (see the module doc); G-code is returned as it is (its checks are
@@ -93,6 +130,26 @@ mod tests {
 
     fn profile() -> Profile {
         crate::profile::find("sim").unwrap()
+    }
+
+    #[test]
+    fn a_gpgl_program_ending_tool_down_gets_a_tool_up() {
+        let p = crate::profile::find("graphtec-ce6000-gpgl").unwrap();
+        let c = check_gpgl(b"J1\x03M100,100\x03D400,400\x03", &p);
+        assert!(
+            c.bytes.ends_with(b"D400,400\x03M400,400\x03"),
+            "{:?}",
+            String::from_utf8_lossy(&c.bytes)
+        );
+        assert_eq!(c.warnings.len(), 1, "{:?}", c.warnings);
+        let c = check_gpgl(b"J1\x03M100,100\x03D400,400", &p);
+        assert!(c.bytes.ends_with(b"D400,400\x03M400,400\x03"));
+        assert_eq!(c.warnings.len(), 2, "{:?}", c.warnings);
+        // Ending tool up: as it is.
+        let ok = b"J1\x03M100,100\x03D400,400\x03M0,0\x03H\x03";
+        let c = check_gpgl(ok, &p);
+        assert_eq!(c.bytes, ok.to_vec());
+        assert!(c.warnings.is_empty());
     }
 
     #[test]

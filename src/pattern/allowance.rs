@@ -67,8 +67,49 @@ pub(super) fn apply(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
                 p.outline = outline;
             }
         }
+        clip_folds(p);
         super::marks::notch_strokes(p, opts);
     }
+}
+
+/// Fold lines end on the border, but cleaning the outline ([`clean`]) trims an acute corner of
+/// the border by more than [`CLEAN_MM`] (an opening by `d` cuts a corner of angle θ back by
+/// about `d / sin(θ/2)`), leaving the end of a fold there outside the cut line (a tab fold
+/// 0.31 mm out on couplingdown at 300 mm, past the sheet's margin). Each fold is cut back to
+/// the longest part of it that lies inside the outline; a fold with nothing inside is dropped.
+fn clip_folds(p: &mut Piece) {
+    let outline = &p.outline;
+    let on_or_inside = |q: DVec2| {
+        polygon::contains_rings(outline, q)
+            || outline.iter().any(|r| {
+                (0..r.len())
+                    .any(|i| polygon::segment_distance(q, r[i], r[(i + 1) % r.len()]) < 1e-6)
+            })
+    };
+    p.folds.retain_mut(|f| {
+        if on_or_inside(f.a) && on_or_inside(f.b) {
+            return true;
+        }
+        let len = f.a.distance(f.b);
+        if len <= 0.0 {
+            return false;
+        }
+        let d = (f.b - f.a) / len;
+        let best = polygon::line_intervals(outline, f.a, d)
+            .into_iter()
+            .map(|(t0, t1)| (t0.max(0.0), t1.min(len)))
+            .filter(|(t0, t1)| t1 > t0)
+            .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)));
+        match best {
+            Some((t0, t1)) if t1 - t0 > CLEAN_MM => {
+                let a = f.a;
+                f.a = a + d * t0;
+                f.b = a + d * t1;
+                true
+            }
+            _ => false,
+        }
+    });
 }
 
 /// Features narrower than twice this (mm) are closed or dropped from cut outlines: no knife
@@ -370,5 +411,46 @@ fn bend_notches(p: &mut Piece) {
     }
     if let Some(outline) = single(boolean::difference(&p.outline, &vs)).and_then(|o| clean(&o)) {
         p.outline = outline;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folds_are_cut_back_to_the_outline() {
+        let sq = vec![
+            DVec2::ZERO,
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
+        let mut p = Piece::from_outline(1, "1".into(), sq);
+        let fold = |a: DVec2, b: DVec2| Fold {
+            a,
+            b,
+            kind: FoldKind::Mountain,
+            angle: 0.5,
+            edge: 0,
+            tab: true,
+        };
+        p.folds = vec![
+            // Inside: kept as it is.
+            fold(DVec2::new(1.0, 1.0), DVec2::new(9.0, 9.0)),
+            // On the cut line: kept.
+            fold(DVec2::new(0.0, 0.0), DVec2::new(10.0, 0.0)),
+            // 0.31 mm past the outline at one end: cut back to it.
+            fold(DVec2::new(5.0, 5.0), DVec2::new(5.0, -0.31)),
+            // Outside: dropped.
+            fold(DVec2::new(20.0, 0.0), DVec2::new(30.0, 5.0)),
+        ];
+        clip_folds(&mut p);
+        assert_eq!(p.folds.len(), 3);
+        assert_eq!(p.folds[0].b, DVec2::new(9.0, 9.0));
+        assert_eq!(p.folds[1].b, DVec2::new(10.0, 0.0));
+        let f = &p.folds[2];
+        assert!(f.a.distance(DVec2::new(5.0, 5.0)) < 1e-12, "{:?}", f.a);
+        assert!(f.b.distance(DVec2::new(5.0, 0.0)) < 1e-12, "{:?}", f.b);
     }
 }

@@ -365,3 +365,26 @@ fn metal_bend_notes_stay_on_the_blank_of_a_boundary_panel() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// Issue 20's exit 2: couplingdown at 300 mm with paper tabs stopped with "piece 13 leaves
+/// the sheet" — a tab fold ended 0.31 mm outside its outline, where cleaning had trimmed an
+/// acute corner, and past the margin. Folds are now cut back to the outline.
+#[test]
+fn couplingdown_at_300_mm_cuts_with_every_fold_inside_its_piece() {
+    require_shared!();
+    let out = scratch("couplingdown-300");
+    let o = flatcut(&[
+        "cut",
+        &shared_data("meshes/couplingdown.obj").to_string_lossy(),
+        "--size",
+        "300",
+        "--dry-run",
+        "-q",
+        "-o",
+        &out.to_string_lossy(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(report["pieces"].as_array().unwrap().len() > 13);
+}

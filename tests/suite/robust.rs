@@ -736,3 +736,97 @@ fn an_esicup_demand_beyond_the_item_bound_is_refused() {
     refused(&o, &["huge-demand.json", "item 0", "4294967296", "10000"]);
     assert!(!dir.join("out").join("solution.json").exists());
 }
+
+/// Fuzz finds (issue 22 item 6): a G-code program holding a character GRBL takes as a
+/// real-time command (`G!` for `G1`: a feed hold) or a program pause written `M-0` held the
+/// simulated GRBL for ever, past `--timeout`. Both are refused before the first byte.
+#[test]
+fn gcode_that_would_hold_grbl_for_ever_is_refused_before_the_first_byte() {
+    let dir = scratch("robust-hold");
+    let cases = [
+        (
+            "G21\nG90\nG0 X10\nG! X20 F1000\nG0 X0\n",
+            "line 4",
+            "`!` (feed hold)",
+        ),
+        ("G21\nG90\nG0 X10 (why?)\nG0 X0\n", "line 3", "`?`"),
+        (
+            "G21\nG90\nG0 X10\nM-0 S100\nG0 X0\n",
+            "line 4",
+            "program pause (M0)",
+        ),
+        ("G21\nG90\nM00\nG0 X0\n", "line 3", "program pause (M0)"),
+    ];
+    for (k, (prog, line, what)) in cases.iter().enumerate() {
+        let file = dir.join(format!("hold{k}.gcode"));
+        std::fs::write(&file, prog).unwrap();
+        let t = Instant::now();
+        let o = bounded(&[
+            "send",
+            &s(&file),
+            "--device",
+            "grbl-pen",
+            "--simulate",
+            "--sim-speed",
+            "0",
+            "--timeout",
+            "5",
+            "-o",
+            &s(&dir.join(format!("out{k}"))),
+        ]);
+        assert!(t.elapsed() < Duration::from_secs(10), "{prog}");
+        refused(&o, &[line, what, "nothing was sent"]);
+        let json = std::fs::read_to_string(dir.join(format!("out{k}/sim.json"))).unwrap();
+        assert!(json.contains("\"tool_down_at_end\": null"), "{json}");
+    }
+}
+
+/// Fuzz find: a GP-GL program cut short after a `D` (tool-down move) exited 0 with the knife
+/// down in sim.json; it now gets a tool-up where the tool stands, with a warning.
+#[test]
+fn a_gpgl_program_ending_tool_down_gets_a_tool_up() {
+    let dir = scratch("robust-gpgl-down");
+    let file = dir.join("down.gpgl");
+    std::fs::write(&file, b"J1\x03M100,100\x03D400,400\x03D400,800").unwrap();
+    let o = bounded(&[
+        "send",
+        &s(&file),
+        "--device",
+        "graphtec-ce6000-gpgl",
+        "--simulate",
+        "--sim-speed",
+        "0",
+        "-o",
+        &s(&dir.join("out")),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("tool down") && e.contains("ETX"), "{e}");
+    let json = std::fs::read_to_string(dir.join("out/sim.json")).unwrap();
+    assert!(json.contains("\"tool_down_at_end\": null"), "{json}");
+}
+
+/// Fuzz find: the elbow segment at spacing 0 on a sheet too narrow for its blank (split into
+/// three parts along rulings) exited 2, "pieces 1a and 1c overlap": parts that touch along a
+/// straight edge overlapped by rounding. The search keeps a hair of a gap (`MIN_GAP_MM`).
+#[test]
+fn split_parts_at_spacing_zero_nest_apart() {
+    let dir = scratch("robust-spacing-zero");
+    let spec = std::fs::read_to_string(manifest("patterns/elbow-segment.toml")).unwrap();
+    let spec = spec
+        .replace("width = 1250\n", "")
+        .replace("spacing = 5", "spacing = 0");
+    assert!(spec.contains("spacing = 0"));
+    std::fs::write(dir.join("elbow.toml"), spec).unwrap();
+    std::fs::copy(
+        manifest("patterns/elbow-cut.csv"),
+        dir.join("elbow-cut.csv"),
+    )
+    .unwrap();
+    let o = bounded_in(&dir, &["cut", "elbow.toml", "--dry-run", "-q", "-o", "out"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/report.json")).unwrap())
+            .unwrap();
+    assert!(report["pieces"].as_array().unwrap().len() >= 2, "{report}");
+}

@@ -91,6 +91,16 @@ impl Gpgl {
         best.map(|(_, n)| n.clone())
     }
 
+    /// Where the tool is, device units.
+    pub(crate) fn position(&self) -> DVec2 {
+        self.pos
+    }
+
+    /// Whether a tool is down now (whichever it is).
+    pub(crate) fn is_down(&self) -> bool {
+        self.down
+    }
+
     /// The tool that is down now, if any.
     pub(crate) fn tool_down(&self) -> Option<String> {
         self.down.then(|| self.tool_name()).flatten()

@@ -37,7 +37,7 @@
 
 pub(crate) mod gpgl;
 pub mod grbl;
-mod grbl_block;
+pub(crate) mod grbl_block;
 pub(crate) mod hpgl;
 mod machine;
 pub(crate) mod record;

@@ -452,9 +452,41 @@ impl<'a> Grbl<'a> {
         }
     }
 
-    /// Refuse a line longer than GRBL keeps, before the first byte.
+    /// Refuse, before the first byte, a line longer than GRBL keeps, and a line holding a
+    /// character GRBL's serial reader takes out of the stream wherever it stands, comments
+    /// included: `?` (status), `!` (feed hold: the job would stop there and wait for ever),
+    /// `~` (cycle start), Ctrl-X (reset), or any byte above 0x7F (GRBL 1.1's overrides and
+    /// jog cancel, the rest dropped); and a program pause (`M0`), which would hold the machine
+    /// with no one to resume it.
     fn check_lines(&self) -> Result<(), StreamError> {
         for (_, text, line) in &self.lines {
+            let what = text.chars().find_map(|c| match c {
+                '?' => Some("`?` (status report)".to_string()),
+                '!' => Some("`!` (feed hold)".to_string()),
+                '~' => Some("`~` (cycle start)".to_string()),
+                '\u{18}' => Some("Ctrl-X (reset)".to_string()),
+                c if !c.is_ascii() => Some(format!(
+                    "a byte that is not ASCII (`{}`)",
+                    c.escape_unicode()
+                )),
+                _ => None,
+            });
+            if let Some(what) = what {
+                return Err(StreamError::RealtimeInLine {
+                    port: self.port.clone(),
+                    line: *line,
+                    what,
+                });
+            }
+            // Read as GRBL reads it (`M0`, `M00`, `M-0`, `M0.0` alike).
+            let block =
+                crate::device::sim::grbl_block::parse(&crate::device::sim::grbl_block::strip(text));
+            if block.is_ok_and(|b| b.flow == Some(0)) {
+                return Err(StreamError::ProgramPause {
+                    port: self.port.clone(),
+                    line: *line,
+                });
+            }
             let len = proto::significant_len(text);
             if len > proto::LINE_MAX {
                 return Err(StreamError::LineTooLong {

@@ -191,6 +191,14 @@ pub enum StreamError {
         len: usize,
         max: usize,
     },
+    #[error("{port}: line {line} contains {what}, which GRBL acts on at once as a real-time command (or drops) instead of reading it as part of the line; nothing was sent")]
+    RealtimeInLine {
+        port: String,
+        line: usize,
+        what: String,
+    },
+    #[error("{port}: line {line} is a program pause (M0): GRBL would hold there until its cycle-start button or `~`, and flatcut does not resume a held machine within one program; split the program at the pause (flatcut's own jobs pause between programs); nothing was sent")]
+    ProgramPause { port: String, line: usize },
     /// A controller setting does not suit the profile (nothing was sent).
     #[error("{port}: {message}")]
     Settings { port: String, message: String },
