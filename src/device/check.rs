@@ -34,6 +34,14 @@ pub struct Checked {
     pub warnings: Vec<String>,
 }
 
+/// The program without its trailing white space and NULs.
+fn body(program: &[u8]) -> &[u8] {
+    program
+        .iter()
+        .rposition(|b| !b.is_ascii_whitespace() && *b != 0)
+        .map_or(&program[..0], |i| &program[..=i])
+}
+
 /// Check a GP-GL program as [`check_hpgl`] checks HP-GL: run through the simulated cutter's
 /// GP-GL interpreter, an unterminated last instruction gets its ETX, and a program that ends
 /// with the tool down gets a tool-up where the tool stands (`M x,y`), each with a warning.
@@ -48,10 +56,7 @@ pub fn check_gpgl(program: &[u8], profile: &Profile) -> Checked {
     }
     let mut bytes = program.to_vec();
     let mut warnings = Vec::new();
-    let body = program
-        .iter()
-        .rposition(|b| !b.is_ascii_whitespace() && *b != 0)
-        .map_or(&program[..0], |i| &program[..=i]);
+    let body = body(program);
     if body.last().is_some_and(|&b| !gpgl::ends_instruction(b)) {
         bytes.push(0x03);
         warnings.push(
@@ -102,10 +107,7 @@ pub fn check_hpgl(program: &[u8], profile: &Profile) -> Result<Checked, CheckErr
     }
     let mut bytes = program.to_vec();
     let mut warnings = Vec::new();
-    let body = program
-        .iter()
-        .rposition(|b| !b.is_ascii_whitespace() && *b != 0)
-        .map_or(&program[..0], |i| &program[..=i]);
+    let body = body(program);
     let open = body.last().is_some_and(|&b| b != b';' && b != b'\n');
     if open {
         bytes.push(b';');
