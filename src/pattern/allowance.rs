@@ -75,15 +75,17 @@ pub(super) fn apply(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
 /// Fold lines end on the border, but cleaning the outline ([`clean`]) trims an acute corner of
 /// the border by more than [`CLEAN_MM`] (an opening by `d` cuts a corner of angle θ back by
 /// about `d / sin(θ/2)`), leaving the end of a fold there outside the cut line (a tab fold
-/// 0.31 mm out on couplingdown at 300 mm, past the sheet's margin). Each fold is cut back to
-/// the longest part of it that lies inside the outline; a fold with nothing inside is dropped.
+/// 0.31 mm out on couplingdown at 300 mm, past the sheet's margin). A fold with an end more
+/// than `CLEAN_MM` outside (what the nest allows a mark: `Piece::OVERHANG_MM`) is cut back to
+/// the longest part of it that lies inside the outline, one with nothing inside is dropped;
+/// ends closer are left as they are, so that fold lengths scale with the model.
 fn clip_folds(p: &mut Piece) {
     let outline = &p.outline;
     let on_or_inside = |q: DVec2| {
         polygon::contains_rings(outline, q)
             || outline.iter().any(|r| {
                 (0..r.len())
-                    .any(|i| polygon::segment_distance(q, r[i], r[(i + 1) % r.len()]) < 1e-6)
+                    .any(|i| polygon::segment_distance(q, r[i], r[(i + 1) % r.len()]) <= CLEAN_MM)
             })
     };
     p.folds.retain_mut(|f| {
