@@ -256,7 +256,7 @@ pub fn contains_rings(rings: &[Vec<DVec2>], p: DVec2) -> bool {
 }
 
 /// Signed distance from `p` to the boundary of a set of rings: positive inside.
-fn rings_distance(rings: &[Vec<DVec2>], p: DVec2) -> f64 {
+pub fn rings_distance(rings: &[Vec<DVec2>], p: DVec2) -> f64 {
     let mut d = f64::INFINITY;
     for r in rings {
         let n = r.len();

@@ -81,13 +81,7 @@ pub(super) fn apply(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
 /// ends closer are left as they are, so that fold lengths scale with the model.
 fn clip_folds(p: &mut Piece) {
     let outline = &p.outline;
-    let on_or_inside = |q: DVec2| {
-        polygon::contains_rings(outline, q)
-            || outline.iter().any(|r| {
-                (0..r.len())
-                    .any(|i| polygon::segment_distance(q, r[i], r[(i + 1) % r.len()]) <= CLEAN_MM)
-            })
-    };
+    let on_or_inside = |q: DVec2| polygon::rings_distance(outline, q) >= -CLEAN_MM;
     p.folds.retain_mut(|f| {
         if on_or_inside(f.a) && on_or_inside(f.b) {
             return true;

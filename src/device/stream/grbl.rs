@@ -460,16 +460,19 @@ impl<'a> Grbl<'a> {
     /// with no one to resume it.
     fn check_lines(&self) -> Result<(), StreamError> {
         for (_, text, line) in &self.lines {
-            let what = text.chars().find_map(|c| match c {
-                '?' => Some("`?` (status report)".to_string()),
-                '!' => Some("`!` (feed hold)".to_string()),
-                '~' => Some("`~` (cycle start)".to_string()),
-                '\u{18}' => Some("Ctrl-X (reset)".to_string()),
-                c if !c.is_ascii() => Some(format!(
-                    "a byte that is not ASCII (`{}`)",
-                    c.escape_unicode()
-                )),
-                _ => None,
+            let what = text.chars().find_map(|c| {
+                let named = |what: &str| Some(what.to_string());
+                match c {
+                    c if c == proto::STATUS_QUERY as char => named("`?` (status report)"),
+                    c if c == proto::FEED_HOLD as char => named("`!` (feed hold)"),
+                    c if c == proto::CYCLE_START as char => named("`~` (cycle start)"),
+                    c if c == proto::SOFT_RESET as char => named("Ctrl-X (reset)"),
+                    c if !c.is_ascii() => Some(format!(
+                        "a byte that is not ASCII (`{}`)",
+                        c.escape_unicode()
+                    )),
+                    _ => None,
+                }
             });
             if let Some(what) = what {
                 return Err(StreamError::RealtimeInLine {
