@@ -29,6 +29,7 @@ fn chain(curves: usize, count: usize) -> Model {
         curves: c,
         apex: None,
         fixed: Vec::new(),
+        creases: Vec::new(),
     }
 }
 

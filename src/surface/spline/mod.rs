@@ -5,8 +5,13 @@
 //! whose rulings are exact edges, for the exact unfolder.
 //!
 //! Several curves make a chain of strips, curve k to curve k + 1, each with its own normals;
-//! their shared curves are creases with no condition yet (`free`: the curved-fold, geodesic
-//! and smooth conditions of eq. 7–8 are not implemented).
+//! each shared (interior) curve is a crease with a condition (§3.3): `fold` (eq. 7), `geodesic`
+//! (eq. 8), `smooth` (equal normals) or `free` (none). The normals of every strip are oriented
+//! as e × a′ with e the ruling from curve k to curve k + 1, so both sides of a crease have
+//! their normals on one side of the sheet (the paper leaves this unstated; with it, a flat
+//! sheet satisfies eq. 7 and a fold by reflection in a plane satisfies eq. 7 but not eq. 8).
+//! The mesh keeps the strips joined along their creases, whose edges are fold lines with
+//! their dihedral angles whatever `bend_lines` says (it picks among the rulings only).
 //!
 //! Choices where the paper is silent:
 //!
@@ -24,7 +29,9 @@
 //!   `flatness_delta` (Fig. 17's δ: distance of the diagonals of each sampled quad over the
 //!   mean of its two ruling-free edges, largest), `isometry_error` (largest relative
 //!   difference between a quad's second diagonal in 3D and in its two triangles unfolded),
-//!   `control_points_moved_mm`. Seconds per iteration are not written there (the report must
+//!   `control_points_moved_mm`, `crease_sine` (the largest intrinsic crease sine at 64
+//!   parameters per span, [`solve::crease_sine`]) and `crease_angle_defect` (Fig. 17's crease
+//!   flatness |K|: the largest |angle sum − 2π| at the sampled mesh's vertices on creases). Seconds per iteration are not written there (the report must
 //!   be byte-identical between runs); `benches/spline.rs` measures them.
 //! - A final sine above 1e-6 is a warning.
 
@@ -35,7 +42,7 @@ use super::Bend;
 use crate::geom::bspline::BSpline;
 use crate::geom::mesh::{Face, Mesh};
 use glam::DVec3;
-pub use solve::{Model, Report, SolveError, SolveOptions};
+pub use solve::{Crease, Model, Report, SolveError, SolveOptions};
 
 /// A spline surface as the spec describes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,6 +55,8 @@ pub struct SplineSpec {
     pub closed: bool,
     /// Fixed control points (curve, index), 0-based; curve `curves.len()` is the apex.
     pub fixed: Vec<(usize, usize)>,
+    /// The condition on each interior curve (entry k for curve k + 1); empty: all `free`.
+    pub creases: Vec<Crease>,
     pub options: SolveOptions,
     /// Chordal tolerance of the output sampling (mm).
     pub tolerance: f64,
@@ -101,12 +110,79 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
             )))
         }
     }
-    Ok(Model {
+    let interior = spec.curves.len().saturating_sub(2);
+    if !spec.creases.is_empty() && spec.creases.len() != interior {
+        return Err(SplineError::Shape(format!(
+            "`creases` has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
+            spec.creases.len()
+        )));
+    }
+    let m = Model {
         basis,
         curves: spec.curves.clone(),
         apex: spec.apex,
         fixed: spec.fixed.clone(),
-    })
+        creases: spec.creases.clone(),
+    };
+    let straight = solve::STRAIGHT / diameter(&m);
+    for (k, &kind) in spec.creases.iter().enumerate() {
+        if !matches!(kind, Crease::Fold | Crease::Geodesic) {
+            continue;
+        }
+        let curved = (0..=m.basis.spans() * 16).any(|i| {
+            let r = m.basis.rows(i as f64 / 16.0);
+            let c = &m.curves[k + 1];
+            let (t, d2) = (
+                crate::geom::bspline::apply(&r.d1, c),
+                crate::geom::bspline::apply(&r.d2, c),
+            );
+            t.cross(d2).length() > straight * t.length().powi(3)
+        });
+        if !curved {
+            return Err(SplineError::Shape(format!(
+                "crease {} (curve {}) is straight: a `{}` condition says nothing on a straight crease; make it `free` or `smooth`, or bend the curve",
+                k + 1,
+                k + 2,
+                if kind == Crease::Fold { "fold" } else { "geodesic" }
+            )));
+        }
+    }
+    Ok(m)
+}
+
+/// The diagonal of the model's control points' bounding box (mm), at least 1e-300.
+fn diameter(m: &Model) -> f64 {
+    let pts = m.curves.iter().flatten().chain(m.apex.iter());
+    let (lo, hi) = pts.fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    (hi - lo).length().max(1e-300)
+}
+
+/// The largest intrinsic crease sine at `per` parameters per span over the creases with a
+/// condition; with `flip`, the right side's normals are turned over (the sign test: a fold
+/// then reads as a geodesic crease).
+pub fn dense_crease_sine(m: &Model, per: usize, flip: bool) -> f64 {
+    let straight = solve::STRAIGHT / diameter(m);
+    let mut worst: f64 = 0.0;
+    if m.apex.is_some() {
+        return 0.0;
+    }
+    for c in 1..m.curves.len().saturating_sub(1) {
+        for k in 0..=m.basis.spans() * per {
+            let u = k as f64 / per as f64;
+            let r = m.basis.rows(u);
+            let p = |j: usize, row: &[(usize, f64)]| crate::geom::bspline::apply(row, &m.curves[j]);
+            let here = p(c, &r.point);
+            let el = here - p(c - 1, &r.point);
+            let er = p(c + 1, &r.point) - here;
+            let er = if flip { -er } else { er };
+            let s = solve::crease_sine(m.crease(c), el, er, p(c, &r.d1), p(c, &r.d2), straight);
+            worst = worst.max(s);
+        }
+    }
+    worst
 }
 
 /// Solve and sample a spline surface.
@@ -115,14 +191,24 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     let report = solve::solve(&mut m, &spec.options)?;
     let params = sample_params(&m, spec.tolerance);
     check_striction(&m, &params)?;
-    let (mesh, rulings) = sample_mesh(&m, &params);
-    let bends = bends(&mesh, &rulings, spec.bend_lines, m.apex.is_some());
+    let sampled = sample_mesh(&m, &params);
+    let mesh = sampled.mesh;
+    let mut bends = bends(&mesh, &sampled.rulings, spec.bend_lines);
+    bends.extend(crease_bends(&mesh, &sampled.creases));
     let (delta, iso) = quad_figures(&m, &params);
+    let defect = angle_defect(&mesh, &sampled.crease_verts);
+    let crease_sine = dense_crease_sine(&m, 64, false);
     let sine = dense_sine(&m, 64);
     let mut warnings = Vec::new();
     if sine > 1e-6 {
         warnings.push(format!(
             "the solve stopped at a developability sine of {sine:.2e} (above 1e-6) after {} iterations: the blank will need some stretching; raise `max_iterations` or free some control points",
+            report.iterations
+        ));
+    }
+    if crease_sine > 1e-6 {
+        warnings.push(format!(
+            "the solve stopped at a crease sine of {crease_sine:.2e} (above 1e-6) after {} iterations: the sides will not meet exactly along the crease; raise `max_iterations` or free some control points",
             report.iterations
         ));
     }
@@ -133,6 +219,8 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
         ("flatness_delta", delta),
         ("isometry_error", iso),
         ("control_points_moved_mm", report.moved),
+        ("crease_sine", crease_sine),
+        ("crease_angle_defect", defect),
     ];
     Ok(Solved {
         model: m,
@@ -226,12 +314,27 @@ fn check_striction(m: &Model, params: &[f64]) -> Result<(), SplineError> {
     Ok(())
 }
 
-/// The triangle mesh and its rulings: (face before, face after, corner of the ruling in the
-/// face before) for each interior ruling, in order along the strips.
-fn sample_mesh(m: &Model, params: &[f64]) -> (Mesh, Vec<(usize, usize, usize)>) {
+/// The sampled mesh with its rulings and creases, each edge as (face, corner of the edge in
+/// it, the other face).
+struct Sampled {
+    mesh: Mesh,
+    /// Interior rulings, in order along the strips.
+    rulings: Vec<(usize, usize, usize)>,
+    /// Edges along the interior curves.
+    creases: Vec<(usize, usize, usize)>,
+    /// Vertices on the interior curves, ends left out.
+    crease_verts: Vec<usize>,
+}
+
+/// Sample the model into triangles whose rulings are edges.
+fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
     let mut vertices = Vec::new();
     let mut faces = Vec::new();
     let mut rulings = Vec::new();
+    let mut creases = Vec::new();
+    let mut crease_verts = Vec::new();
+    // The previous strip's triangles along its curve b: (face, corner of b_i+1 → b_i).
+    let mut pending: Vec<(usize, usize)> = Vec::new();
     let k = params.len();
     let mut row_a: Vec<usize> = Vec::new();
     let first = strips(m).first().map_or(0, |s| s.0);
@@ -259,6 +362,9 @@ fn sample_mesh(m: &Model, params: &[f64]) -> (Mesh, Vec<(usize, usize, usize)>) 
                 }
             }
             Some(b) => {
+                if !pending.is_empty() {
+                    crease_verts.extend_from_slice(&row_a[1..k - 1]);
+                }
                 let row_b: Vec<usize> = params
                     .iter()
                     .map(|&u| {
@@ -266,7 +372,12 @@ fn sample_mesh(m: &Model, params: &[f64]) -> (Mesh, Vec<(usize, usize, usize)>) 
                         vertices.len() - 1
                     })
                     .collect();
+                let before = std::mem::take(&mut pending);
                 for i in 0..k - 1 {
+                    if let Some(&(f, corner)) = before.get(i) {
+                        creases.push((f, corner, faces.len()));
+                    }
+                    pending.push((faces.len() + 1, 1));
                     let (a0, a1, b0, b1) = (row_a[i], row_a[i + 1], row_b[i], row_b[i + 1]);
                     faces.push(Face {
                         verts: vec![a0, a1, b1],
@@ -286,17 +397,52 @@ fn sample_mesh(m: &Model, params: &[f64]) -> (Mesh, Vec<(usize, usize, usize)>) 
             }
         }
     }
-    (Mesh { vertices, faces }, rulings)
+    Sampled {
+        mesh: Mesh { vertices, faces },
+        rulings,
+        creases,
+        crease_verts,
+    }
+}
+
+/// Fold lines on the crease edges that bend (more than 0.01°), with their dihedral angles.
+fn crease_bends(mesh: &Mesh, creases: &[(usize, usize, usize)]) -> Vec<Bend> {
+    creases
+        .iter()
+        .filter_map(|&(f, corner, g)| {
+            let (va, vb) = crate::geom::mesh::Topology::corner_verts(mesh, f, corner);
+            let deg = mesh.signed_dihedral(f, corner, g)?.to_degrees();
+            (deg.abs() > 0.01).then_some(Bend {
+                verts: [va.min(vb), va.max(vb)],
+                angle_deg: deg,
+            })
+        })
+        .collect()
+}
+
+/// The largest |angle sum − 2π| (radians) at `verts` over the faces of `mesh`.
+fn angle_defect(mesh: &Mesh, verts: &[usize]) -> f64 {
+    let mut sum = vec![0.0; mesh.vertices.len()];
+    for f in &mesh.faces {
+        let n = f.verts.len();
+        for i in 0..n {
+            let (p, a, b) = (f.verts[i], f.verts[(i + 1) % n], f.verts[(i + n - 1) % n]);
+            let (o, u, w) = (mesh.vertices[p], mesh.vertices[a], mesh.vertices[b]);
+            let angle = (u - o).angle_between(w - o);
+            if angle.is_finite() {
+                sum[p] += angle;
+            }
+        }
+    }
+    verts
+        .iter()
+        .map(|&v| (sum[v] - std::f64::consts::TAU).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Bend lines on the rulings per `lines` (as strips pick them: all, none, or a spacing with
 /// the angles in between summed).
-fn bends(
-    mesh: &Mesh,
-    rulings: &[(usize, usize, usize)],
-    lines: BendLines,
-    _cone: bool,
-) -> Vec<Bend> {
+fn bends(mesh: &Mesh, rulings: &[(usize, usize, usize)], lines: BendLines) -> Vec<Bend> {
     const EPS_DEG: f64 = 0.01;
     let mut out: Vec<Bend> = Vec::new();
     let mut acc = 0.0;

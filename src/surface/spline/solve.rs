@@ -18,7 +18,9 @@
 //!   two rims collapsed to a double cone in our first trials); measured against the input it
 //!   keeps the designed shape without shrinking it. Schedule
 //!   ε₁ = `epsilon1`·0.9ⁱ for the first `iterations` rounds and 0 after (Fig. 17's schedule);
-//!   ε₂ = `epsilon2` throughout.
+//!   ε₂ = `epsilon2` while the fairness acts, then divided by 10 per round down to 1e-4 (held
+//!   at ε₂ it damps the last rounds into linear convergence; much below 1e-4 the normal
+//!   equations lose the digits the last rounds need).
 //! - The model is moved to its bounding box centre and scaled to diameter 1 inside.
 //! - A step whose squared constraint residual is larger than the current one is halved, up to
 //!   8 times (then taken as it is).
@@ -26,7 +28,13 @@
 //!   the angle between the tangent planes at `a(u)` and `b(u)`,
 //!   |det(e, a′, b′)|·|e| / (|e × a′|·|e × b′|) with e = b − a, which does not depend on the
 //!   auxiliary normals. It is tested before the first iteration too, so an exact developable is
-//!   returned untouched.
+//!   returned untouched; so is the largest intrinsic crease sine ([`crease_sine`]).
+//! - Creases (§3.3): eq. 7–8 are written with c″ (the paper's c₀⁽²⁾ − c₁⁽²⁾ and c₁⁽²⁾ − c₂⁽²⁾
+//!   span the same osculating plane together with c′, and ⟨n, c′⟩ = 0 holds already on both
+//!   sides), as the one equation ⟨n_L ± n_R, c″⟩ / |c″ ⟂ c′| = 0 per sample parameter of the
+//!   strips, at the strips' own samples (3m − 2 per span: enforced numerically, as the paper
+//!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
+//!   nothing and is left out. Smooth: n_L − n_R = 0.
 
 use crate::geom::bspline::{apply, BSpline};
 use faer::linalg::solvers::Solve;
@@ -62,6 +70,29 @@ impl Default for SolveOptions {
     }
 }
 
+/// The condition on an interior curve of a chain, shared by the strips to either side (spec
+/// `creases`): eq. 7 (`Fold`: the sheet folds along it and unfolds in one piece), eq. 8
+/// (`Geodesic`: the two sides unfold to mirror images), `Smooth` (equal normals, no crease)
+/// or `Free` (no condition: the strips are cut apart there).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Crease {
+    #[default]
+    Free,
+    Fold,
+    Geodesic,
+    Smooth,
+}
+
+impl Crease {
+    /// The names a spec file uses, in the order messages list them.
+    pub const NAMES: [(&'static str, Crease); 4] = [
+        ("fold", Crease::Fold),
+        ("geodesic", Crease::Geodesic),
+        ("smooth", Crease::Smooth),
+        ("free", Crease::Free),
+    ];
+}
+
 /// A spline developable's unknowns before and after the solve, in millimetres.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -72,6 +103,20 @@ pub struct Model {
     pub apex: Option<DVec3>,
     /// Fixed control points: (curve, index); curve `curves.len()` is the apex.
     pub fixed: Vec<(usize, usize)>,
+    /// The condition on each interior curve (curve k + 1 for entry k); shorter means `Free`.
+    pub creases: Vec<Crease>,
+}
+
+impl Model {
+    /// The condition on curve `c` (0-based): `Free` on the first and last.
+    pub fn crease(&self, c: usize) -> Crease {
+        match c.checked_sub(1) {
+            Some(k) if c + 1 < self.curves.len() => {
+                self.creases.get(k).copied().unwrap_or_default()
+            }
+            _ => Crease::Free,
+        }
+    }
 }
 
 /// What the solve did.
@@ -116,6 +161,8 @@ struct Layout {
     var: Vec<Option<usize>>,
     /// Per sample: e = B − A, tangent of A, tangent of B (None for a cone), normal's offset.
     samples: Vec<Sample>,
+    /// Crease conditions, one per sample parameter of each constrained interior curve.
+    creases: Vec<CreaseSample>,
     /// Second-difference expressions of the control polygons.
     fair: Vec<Expr>,
     /// Their values in the input (the fairness target s).
@@ -133,6 +180,15 @@ struct Sample {
     normal: usize,
 }
 
+/// One crease condition at one parameter: the samples (normals) of the strips to the left
+/// (ending at the crease) and right (starting there), and the crease's second derivative.
+struct CreaseSample {
+    kind: Crease,
+    left: usize,
+    right: usize,
+    d2: Expr,
+}
+
 fn eval(e: &Expr, p: &[DVec3]) -> DVec3 {
     apply(e, p)
 }
@@ -147,6 +203,48 @@ pub fn plane_sine(e: DVec3, ta: DVec3, tb: Option<DVec3>) -> f64 {
         return 0.0;
     }
     (e.dot(ta.cross(tb)).abs() * e.length() / (na * nb)).min(1.0)
+}
+
+/// Curvature (in the diameter-1 frame) at or under which a crease point counts as straight:
+/// the fold and geodesic conditions say nothing there.
+pub const STRAIGHT: f64 = 1e-6;
+
+/// The smallest ε₂ the schedule decays to once the fairness is off.
+const EPS2_FLOOR: f64 = 1e-4;
+
+/// The crease's principal normal at a point (c″ without its tangential part), unit; `None`
+/// where the crease is straight (curvature |c′ × c″| / |c′|³ at most `straight`).
+fn principal_normal(t: DVec3, d2: DVec3, straight: f64) -> Option<DVec3> {
+    let tl = t.length();
+    if tl <= 1e-300 {
+        return None;
+    }
+    let th = t / tl;
+    let perp = d2 - th * d2.dot(th);
+    (perp.length() / (tl * tl) > straight).then(|| perp.normalize())
+}
+
+/// The intrinsic crease sine at one crease point, from the tangent planes to either side: `el`
+/// the left strip's ruling towards the crease, `er` the right strip's away from it (so that
+/// both normals e × c′ lie on one side of the sheet), `t` = c′, `d2` = c″, `straight` the
+/// curvature (1/mm, or in the scaled frame) under which eq. 7–8 say nothing. Fold (eq. 7):
+/// the cosine between n_L + n_R and the principal normal; geodesic (eq. 8) the same with
+/// n_L − n_R; smooth: |n_L − n_R| / 2, the sine of half the angle between the sides.
+pub fn crease_sine(kind: Crease, el: DVec3, er: DVec3, t: DVec3, d2: DVec3, straight: f64) -> f64 {
+    let nl = el.cross(t).normalize_or_zero();
+    let nr = er.cross(t).normalize_or_zero();
+    let sigma = match kind {
+        Crease::Free => return 0.0,
+        Crease::Smooth => return 0.5 * (nl - nr).length(),
+        Crease::Fold => 1.0,
+        Crease::Geodesic => -1.0,
+    };
+    let n = nl + sigma * nr;
+    let len = n.length();
+    match principal_normal(t, d2, straight) {
+        Some(k) if len > 1e-9 => (n.dot(k) / len).abs().min(1.0),
+        _ => 0.0,
+    }
 }
 
 fn layout(m: &Model, points: Vec<DVec3>) -> Layout {
@@ -195,6 +293,26 @@ fn layout(m: &Model, points: Vec<DVec3>) -> Layout {
             }
         }
     }
+    let per_strip = m.basis.spans() * per;
+    let mut creases = Vec::new();
+    if m.apex.is_none() {
+        for c in 1..nc.saturating_sub(1) {
+            let kind = m.crease(c);
+            if kind == Crease::Free {
+                continue;
+            }
+            for j in 0..per_strip {
+                let left = (c - 1) * per_strip + j;
+                let r = m.basis.rows(samples[left].u);
+                creases.push(CreaseSample {
+                    kind,
+                    left,
+                    right: c * per_strip + j,
+                    d2: r.d2.iter().map(|&(i, w)| (c * count + i, w)).collect(),
+                });
+            }
+        }
+    }
     let mut fair = Vec::new();
     for c in 0..nc {
         let range: Vec<usize> = if m.basis.closed() {
@@ -213,6 +331,7 @@ fn layout(m: &Model, points: Vec<DVec3>) -> Layout {
         points,
         var,
         samples,
+        creases,
         fair,
         fair_s,
         n,
@@ -273,7 +392,78 @@ fn residual(l: &Layout, x: &[f64]) -> (f64, f64) {
         sum += (n.length_squared() - 1.0).powi(2);
         worst = worst.max(plane_sine(e, ta, tb));
     }
+    for c in &l.creases {
+        let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
+        let (nl, nr) = (normal_of(x, sl), normal_of(x, sr));
+        let t = eval(&sr.ta, &l.points);
+        let d2 = eval(&c.d2, &l.points);
+        let el = eval(&sl.e, &l.points);
+        let er = eval(&sr.e, &l.points);
+        match c.kind {
+            Crease::Smooth => sum += (nl - nr).length_squared(),
+            Crease::Fold | Crease::Geodesic => {
+                let sigma = if c.kind == Crease::Fold { 1.0 } else { -1.0 };
+                if let Some(k) = principal_normal(t, d2, STRAIGHT) {
+                    sum += (nl + sigma * nr).dot(k).powi(2);
+                }
+            }
+            Crease::Free => {}
+        }
+        worst = worst.max(crease_sine(c.kind, el, er, t, d2, STRAIGHT));
+    }
     (sum, worst)
+}
+
+/// The rows of one crease condition at the current iterate: ⟨n_L ± n_R, c″⟩ / |c″ ⟂ c′| for
+/// a fold or geodesic crease, n_L − n_R = 0 (three rows) for a smooth one.
+fn crease_rows(l: &Layout, x: &[f64], c: &CreaseSample, rows: &mut Vec<Row>) {
+    let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
+    let sigma = match c.kind {
+        Crease::Free => return,
+        Crease::Smooth => {
+            for k in 0..3 {
+                rows.push(Row {
+                    entries: vec![(sl.normal + k, 1.0), (sr.normal + k, -1.0)],
+                    rhs: 0.0,
+                    w: 1.0,
+                });
+            }
+            return;
+        }
+        Crease::Fold => 1.0,
+        Crease::Geodesic => -1.0,
+    };
+    let t = eval(&sr.ta, &l.points);
+    let d = eval(&c.d2, &l.points);
+    let tl = t.length();
+    let perp = if tl > 1e-300 {
+        (d - t * (d.dot(t) / (tl * tl))).length()
+    } else {
+        0.0
+    };
+    if tl <= 1e-300 || perp / (tl * tl) <= STRAIGHT {
+        return;
+    }
+    let n0 = normal_of(x, sl) + sigma * normal_of(x, sr);
+    let mut entries = Vec::with_capacity(6 + 3 * c.d2.len());
+    let mut rhs = 0.0;
+    for k in 0..3 {
+        entries.push((sl.normal + k, d[k] / perp));
+        entries.push((sr.normal + k, sigma * d[k] / perp));
+    }
+    for &(p, w) in &c.d2 {
+        if let Some(o) = l.var[p] {
+            for k in 0..3 {
+                entries.push((o + k, w * n0[k] / perp));
+            }
+            rhs += w * n0.dot(l.points[p]) / perp;
+        }
+    }
+    rows.push(Row {
+        entries,
+        rhs,
+        w: 1.0,
+    });
 }
 
 /// The rows of one bilinear constraint ⟨n, Σ w·P⟩ / |d| at the current iterate.
@@ -316,6 +506,9 @@ fn rows(l: &Layout, x: &[f64], eps1: f64) -> Vec<Row> {
             rhs: n.length_squared() + 1.0,
             w: 1.0,
         });
+    }
+    for c in &l.creases {
+        crease_rows(l, x, c, &mut rows);
     }
     for (f, target) in l.fair.iter().zip(&l.fair_s) {
         for c in 0..3 {
@@ -497,12 +690,16 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
     let mut sines = vec![pr.sine()];
     let mut it = 0;
     while it < o.max_iterations && pr.sine() > o.stop_sine {
-        let eps1 = if it < o.iterations {
-            o.epsilon1 * 0.9f64.powi(it as i32)
+        let (eps1, eps2) = if it < o.iterations {
+            (o.epsilon1 * 0.9f64.powi(it as i32), o.epsilon2)
         } else {
-            0.0
+            let k = (it + 1 - o.iterations) as i32;
+            (
+                0.0,
+                (o.epsilon2 * 0.1f64.powi(k)).max(EPS2_FLOOR.min(o.epsilon2)),
+            )
         };
-        pr.iterate(eps1, o.epsilon2, it + 1)?;
+        pr.iterate(eps1, eps2, it + 1)?;
         it += 1;
         sines.push(pr.sine());
     }

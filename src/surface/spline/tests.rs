@@ -9,6 +9,7 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         degree: 3,
         closed,
         fixed: Vec::new(),
+        creases: Vec::new(),
         options: SolveOptions::default(),
         tolerance: 0.05,
         bend_lines: BendLines::All,
@@ -182,4 +183,116 @@ fn unequal_curves_and_a_cone_with_two_curves_are_refused() {
     s.curves = vec![wave()];
     s.apex = None;
     assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+}
+
+/// Issue 24's fold by reflection: a cylinder over a half-circle cubic (r = 100) cut by the
+/// plane z = 100 + 2 y, its part above the plane mirrored in it. Curves: the bottom rim, the
+/// crease (on the plane) and the mirrored top rim.
+fn reflected_fold() -> Vec<Vec<DVec3>> {
+    let c0: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let t = std::f64::consts::PI * i as f64 / 7.0;
+            DVec3::new(100.0 * t.cos(), 100.0 * t.sin(), 0.0)
+        })
+        .collect();
+    let m = DVec3::new(0.0, -2.0, 1.0).normalize();
+    let o = DVec3::new(0.0, 0.0, 100.0);
+    let mirror = |p: DVec3| p - 2.0 * (p - o).dot(m) * m;
+    let c1 = c0
+        .iter()
+        .map(|p| DVec3::new(p.x, p.y, 100.0 + 2.0 * p.y))
+        .collect();
+    let c2 = c0.iter().map(|p| mirror(*p + DVec3::Z * 400.0)).collect();
+    vec![c0, c1, c2]
+}
+
+fn figure(out: &Solved, k: &str) -> f64 {
+    out.figures.iter().find(|f| f.0 == k).unwrap().1
+}
+
+#[test]
+fn a_fold_by_reflection_is_a_fixed_point_and_fails_with_one_side_flipped() {
+    let curves = reflected_fold();
+    let mut s = spec(curves.clone(), None, false);
+    s.creases = vec![Crease::Fold];
+    let out = build(&s).unwrap();
+    assert!(out.report.moved <= 1e-9, "moved {}", out.report.moved);
+    assert!(dense_sine(&out.model, 200) <= 1e-10);
+    assert!(figure(&out, "crease_sine") <= 1e-9, "{:?}", out.figures);
+    assert!(
+        figure(&out, "crease_angle_defect") <= 1e-9,
+        "{:?}",
+        out.figures
+    );
+    // The sign test: with the right side's normals turned over, eq. 7 reads as eq. 8.
+    let flipped = dense_crease_sine(&out.model, 64, true);
+    assert!(flipped > 0.1, "flipped {flipped}");
+    // As a geodesic crease the same shape is far from a solution.
+    let mut g = s.clone();
+    g.creases = vec![Crease::Geodesic];
+    assert!(dense_crease_sine(&model(&g).unwrap(), 64, false) > 0.1);
+    // The crease edges are fold lines, all of one sense.
+    let k = out.mesh.vertices.len();
+    let folds: Vec<&Bend> = out
+        .bends
+        .iter()
+        .filter(|b| {
+            let on = |v: usize| {
+                let p = out.mesh.vertices[v];
+                (p.z - 100.0 - 2.0 * p.y).abs() < 1e-6
+            };
+            on(b.verts[0]) && on(b.verts[1])
+        })
+        .collect();
+    assert!(folds.len() > 10, "{} folds of {k} vertices", folds.len());
+    let sense = folds[0].angle_deg.signum();
+    assert!(folds
+        .iter()
+        .all(|b| b.angle_deg.signum() == sense && b.angle_deg.abs() > 10.0));
+}
+
+#[test]
+fn a_perturbed_fold_is_restored_in_ten_iterations() {
+    let mut curves = reflected_fold();
+    let mut rng = crate::geom::rng::Rng::new(24);
+    for p in &mut curves[1] {
+        *p += DVec3::new(
+            rng.range(-3.0, 3.0),
+            rng.range(-3.0, 3.0),
+            rng.range(-3.0, 3.0),
+        );
+    }
+    let mut s = spec(curves, None, false);
+    s.creases = vec![Crease::Fold];
+    let m0 = model(&s).unwrap();
+    assert!(dense_sine(&m0, 64).max(dense_crease_sine(&m0, 64, false)) > 1e-3);
+    s.options.max_iterations = 10;
+    let out = build(&s).unwrap();
+    let sine = dense_sine(&out.model, 200);
+    let crease = dense_crease_sine(&out.model, 200, false);
+    assert!(sine <= 1e-6, "sine {sine}");
+    assert!(crease <= 1e-6, "crease sine {crease}");
+    // Fig. 17, row 13: δ max 4.4e-4, |K| max 6.4e-4.
+    assert!(figure(&out, "flatness_delta") <= 4.4e-4);
+    assert!(figure(&out, "crease_angle_defect") <= 6.4e-4);
+}
+
+#[test]
+fn crease_counts_and_straight_creases_are_refused() {
+    let mut s = spec(reflected_fold(), None, false);
+    s.creases = vec![Crease::Fold, Crease::Fold];
+    let e = model(&s).unwrap_err().to_string();
+    assert!(e.contains("`creases` has 2 entries"), "{e}");
+    // Three parallel straight lines: a fold condition on the middle one is refused.
+    let line = |y: f64| -> Vec<DVec3> {
+        (0..6)
+            .map(|i| DVec3::new(i as f64 * 20.0, y, 0.0))
+            .collect()
+    };
+    let mut s = spec(vec![line(0.0), line(50.0), line(100.0)], None, false);
+    s.creases = vec![Crease::Fold];
+    let e = model(&s).unwrap_err().to_string();
+    assert!(e.contains("crease 1 (curve 2) is straight"), "{e}");
+    s.creases = vec![Crease::Smooth];
+    assert!(model(&s).is_ok());
 }
