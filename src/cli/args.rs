@@ -4,6 +4,7 @@
 
 use crate::pipeline::{Folds, Search, Toolpath};
 use crate::spec::Spec;
+use crate::surface::strip::BendLines;
 use crate::Error;
 use clap::Args;
 use std::path::PathBuf;
@@ -31,6 +32,11 @@ pub struct PatternArgs {
     /// edges or rulings so that every part fits) or none (refuse them). Default: auto.
     #[arg(long, value_enum)]
     pub split: Option<crate::pattern::split::Split>,
+    /// Which rulings of strips, bent sheets and spline surfaces are scored: all, none or one
+    /// every MM millimetres (the angles in between summed); overrides their `bend_lines`.
+    /// Creases of spline surfaces are folds whatever this says.
+    #[arg(long, value_name = "all|none|MM", value_parser = parse_bend_lines)]
+    pub bend_lines: Option<BendLines>,
 }
 
 impl PatternArgs {
@@ -54,6 +60,19 @@ impl PatternArgs {
             p.bend_notches = Some(true);
         }
         p.split = self.split.or(p.split);
+        if let Some(lines) = self.bend_lines {
+            for s in &mut spec.surfaces {
+                if let Some(st) = &mut s.strip {
+                    st.bend_lines = lines;
+                }
+                if let Some(b) = &mut s.bent {
+                    b.bend_lines = lines;
+                }
+                if let Some(sp) = &mut s.spline {
+                    sp.bend_lines = lines;
+                }
+            }
+        }
         Ok(())
     }
 }
@@ -397,5 +416,19 @@ pub fn parse_dpi(s: &str) -> Result<f64, String> {
         _ => Err(format!(
             "must be a number of dots per inch more than 0 and at most {MAX_DPI}, got {s:?}"
         )),
+    }
+}
+
+/// `all`, `none` or a positive number of millimetres.
+pub fn parse_bend_lines(s: &str) -> Result<BendLines, String> {
+    match s.trim().to_ascii_lowercase().as_str() {
+        "all" => Ok(BendLines::All),
+        "none" => Ok(BendLines::None),
+        t => match t.parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(BendLines::Spacing(v)),
+            _ => Err(format!(
+                "expected all, none or a spacing in mm more than 0, got {s:?}"
+            )),
+        },
     }
 }

@@ -9,6 +9,7 @@
 //! named after the kind (`cone`, `square-to-round`, …) unless `--name` is given; the device,
 //! as for `cut`, defaults to `sim`.
 
+use super::args::parse_bend_lines;
 use crate::pipeline::{Extras, Search, Toolpath};
 use crate::spec::{
     Material, MaterialKind, PatternSpec, SheetSpec, Spec, SurfaceKind, SurfaceSpec, Units,
@@ -137,20 +138,6 @@ pub struct FittingArgs {
     pub quiet: bool,
 }
 
-/// `all`, `none` or a positive number of millimetres.
-pub fn parse_bend_lines(s: &str) -> Result<BendLines, String> {
-    match s.trim().to_ascii_lowercase().as_str() {
-        "all" => Ok(BendLines::All),
-        "none" => Ok(BendLines::None),
-        t => match t.parse::<f64>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(BendLines::Spacing(v)),
-            _ => Err(format!(
-                "expected all, none or a spacing in mm more than 0, got {s:?}"
-            )),
-        },
-    }
-}
-
 fn need(v: Option<f64>, flag: &str, kind: &str) -> Result<f64, Error> {
     v.ok_or_else(|| Error::Usage(format!("--{flag}: missing: a {kind} needs it")))
 }
@@ -255,6 +242,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             strip: Some(strip),
             bent: None,
             boundary: None,
+            spline: None,
             segment: Default::default(),
         }],
         material: Material {

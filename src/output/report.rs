@@ -6,7 +6,7 @@
 //! splitting a piece too large for the sheet), sheets (size, pieces, utilisation; on a
 //! roll the length used, on sheets the rectangle left free on the last sheet),
 //! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
-//! it measured some) and the files written. Pieces and surfaces laid out from charts of a
+//! it measured some, to 6 significant digits) and the files written. Pieces and surfaces laid out from charts of a
 //! smooth mesh (issue 7) carry `stretch`: `{l2, linf, flipped}` (1 = isometric); it is `null`
 //! for exact unfoldings. Those whose seams were simplified (thesis §5.3) also carry `simplify`:
 //! `{tolerance_mm, vertices_before, vertices_after, max_deviation_mm, max_seam_mismatch_mm}`
@@ -40,6 +40,15 @@ pub struct RunInfo {
     /// What the job left out for want of a tool, per piece (`dropped`, and one `warnings`
     /// entry each, only when there is something).
     pub dropped: Vec<crate::toolpath::passes::Dropped>,
+}
+
+/// `v` to 6 significant digits: the sources' figures range from residuals of 1e-12 to
+/// energies of 1e4, and 6 decimals would write the small ones as 0.
+fn sig6(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    format!("{v:.5e}").parse().unwrap_or(v)
 }
 
 fn r6(v: f64) -> f64 {
@@ -186,7 +195,7 @@ fn surfaces_json(flats: &[Flat]) -> Vec<Value> {
                     .surface
                     .figures
                     .iter()
-                    .map(|(k, x)| (k.to_string(), json!(r6(*x))))
+                    .map(|(k, x)| (k.to_string(), json!(sig6(*x))))
                     .collect();
                 v["figures"] = Value::Object(figs);
             }

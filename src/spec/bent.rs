@@ -340,6 +340,7 @@ impl Ctx<'_> {
             line: line_no,
             strip: None,
             boundary: None,
+            spline: None,
             segment: SegmentSpec::default(),
             bent: Some(BentSpec {
                 outline,

@@ -97,6 +97,7 @@ impl Ctx<'_> {
             strip: None,
             bent: None,
             boundary: Some(BoundarySpec { input, options }),
+            spline: None,
             segment: SegmentSpec::default(),
         })
     }

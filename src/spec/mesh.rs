@@ -82,6 +82,7 @@ impl Ctx<'_> {
             strip: None,
             bent: None,
             boundary: None,
+            spline: None,
             segment: self.segment(s, key)?,
         })
     }

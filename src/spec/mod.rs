@@ -157,6 +157,7 @@ mod curves;
 mod mesh;
 mod names;
 mod spanned;
+mod spline;
 mod strip;
 
 // The stage types a spec is made of, defined by the stages that read them (mostly `surface`),
@@ -290,6 +291,7 @@ impl Spec {
                 strip: None,
                 bent: None,
                 boundary: None,
+                spline: None,
                 segment: SegmentSpec::default(),
             }],
             material: Material::default(),
@@ -439,21 +441,25 @@ impl Ctx<'_> {
                         &kind_key,
                         format!(
                             "missing: each [[surface]] needs a `kind`, {}",
-                            one_of(&["mesh", "strip", "bent-sheet", "boundary"])
+                            one_of(&["mesh", "strip", "bent-sheet", "boundary", "spline"])
                         ),
                     )
                 })?;
-            if kind != SurfaceKind::BentSheet {
+            if !matches!(kind, SurfaceKind::BentSheet | SurfaceKind::Spline) {
                 self.no_bent_keys(s, &key)?;
             }
-            if kind != SurfaceKind::Boundary {
+            if !matches!(kind, SurfaceKind::Boundary | SurfaceKind::Spline) {
                 self.no_boundary_keys(s, &key)?;
+            }
+            if kind != SurfaceKind::Spline {
+                self.no_spline_keys(s, &key)?;
             }
             let mut surface = match kind {
                 SurfaceKind::BentSheet => self.bent_surface(s, &key, header_line, dir)?,
                 SurfaceKind::Strip => self.strip_surface(s, &key, header_line, dir)?,
                 SurfaceKind::Boundary => self.boundary_surface(s, &key, header_line, dir)?,
                 SurfaceKind::Mesh => self.mesh_surface(s, &key, header_line, dir)?,
+                SurfaceKind::Spline => self.spline_surface(s, &key, header_line)?,
             };
             surface.size = self
                 .number(&s.size, &format!("{key}.size"), MM_POSITIVE, |v| v > 0.0)?

@@ -68,6 +68,15 @@ pub(super) struct RawSurface {
     pub(super) f_max: Option<Spanned<Val>>,
     pub(super) approximate: Option<Spanned<toml::Value>>,
     pub(super) simplify: Option<Spanned<Val>>,
+    pub(super) curves: Option<Spanned<List<Spanned<toml::Value>>>>,
+    pub(super) apex: Option<Spanned<toml::Value>>,
+    pub(super) degree: Option<Spanned<Val>>,
+    pub(super) closed: Option<Spanned<Val>>,
+    pub(super) creases: Option<Spanned<toml::Value>>,
+    pub(super) fixed: Option<Spanned<toml::Value>>,
+    pub(super) iterations: Option<Spanned<Val>>,
+    pub(super) epsilon1: Option<Spanned<Val>>,
+    pub(super) epsilon2: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]

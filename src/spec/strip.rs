@@ -116,6 +116,7 @@ impl Ctx<'_> {
             }),
             bent: None,
             boundary: None,
+            spline: None,
             segment: SegmentSpec::default(),
         })
     }

@@ -98,6 +98,7 @@ fn full_example_parses_exactly() {
                 strip: None,
                 bent: None,
                 boundary: None,
+                spline: None,
                 segment: SegmentSpec::default(),
             }],
             material: Material {
@@ -197,6 +198,7 @@ fn minimal_spec_gets_all_defaults() {
             strip: None,
             bent: None,
             boundary: None,
+            spline: None,
             segment: SegmentSpec::default(),
         }]
     );
@@ -472,7 +474,7 @@ fn bad_surface_kind_lists_allowed() {
     assert_eq!((line, key.as_str()), (2, "surface[1].kind"));
     assert_eq!(
         message,
-        "must be one of mesh, strip, bent-sheet, boundary, got \"nurbs\""
+        "must be one of mesh, strip, bent-sheet, boundary, spline, got \"nurbs\""
     );
 }
 
@@ -576,6 +578,7 @@ fn obj_path_gives_mesh_defaults() {
                 strip: None,
                 bent: None,
                 boundary: None,
+                spline: None,
                 segment: SegmentSpec::default(),
             }]
         );

@@ -445,6 +445,7 @@ mod tests {
             strip: Some(f.strip_spec(opts).unwrap()),
             bent: None,
             boundary: None,
+            spline: None,
             segment: Default::default(),
         };
         crate::surface::build(&spec).unwrap()

@@ -81,6 +81,9 @@ pub struct Surface {
     /// Other meshes the source found for the same boundary, best first (boundary surfaces,
     /// `--alternatives`); they share the vertices of `mesh`.
     pub alternatives: Vec<Mesh>,
+    /// The solved design of a spline surface (curves, creases; `--spline-json`), in the
+    /// surface's millimetres; `None` for other kinds.
+    pub spline: Option<Box<spline::Model>>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -135,6 +138,11 @@ pub enum SurfaceError {
     },
     #[error("surface `{surface}`: {message}")]
     Boundary { surface: String, message: String },
+    #[error("surface `{surface}`: {}{source}", source.key_prefix())]
+    Spline {
+        surface: String,
+        source: spline::SplineError,
+    },
     #[error("{}{}: the mesh is not orientable (a Möbius-like band): its faces cannot all be wound the same way", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     NonOrientable { path: PathBuf, line: Option<usize> },
 }
@@ -180,6 +188,7 @@ fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
         SurfaceKind::Strip => build_strip(spec),
         SurfaceKind::BentSheet => build_bent(spec),
         SurfaceKind::Boundary => build_boundary(spec),
+        SurfaceKind::Spline => build_spline(spec),
     }
 }
 
@@ -309,6 +318,36 @@ fn build_bent(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             .map(|w| format!("surface `{}`: {w}", spec.name))
             .collect(),
         bends: Some(bent.bends),
+        ..Default::default()
+    })
+}
+
+/// A [`spline`] surface (Tang et al.): solved by guided projection, sampled with its rulings
+/// as edges and its creases as fold lines.
+fn build_spline(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
+    let err = |source| SurfaceError::Spline {
+        surface: spec.name.clone(),
+        source,
+    };
+    let sp = spec.spline.as_ref().ok_or_else(|| {
+        err(spline::SplineError::Shape {
+            key: "curves".into(),
+            message: "missing: a spline surface needs `curves`".into(),
+        })
+    })?;
+    let solved = spline::build(sp).map_err(err)?;
+    Ok(Surface {
+        name: spec.name.clone(),
+        source: spec.path.clone(),
+        mesh: solved.mesh,
+        warnings: solved
+            .warnings
+            .into_iter()
+            .map(|w| format!("surface `{}`: {w}", spec.name))
+            .collect(),
+        bends: Some(solved.bends),
+        figures: solved.figures,
+        spline: Some(Box::new(solved.model)),
         ..Default::default()
     })
 }

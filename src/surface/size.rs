@@ -85,6 +85,12 @@ impl Surface {
                 *v *= f;
             }
         }
+        if let Some(m) = &mut self.spline {
+            m.curves.iter_mut().flatten().for_each(|p| *p *= f);
+            if let Some(a) = &mut m.apex {
+                *a *= f;
+            }
+        }
     }
 }
 

@@ -37,6 +37,8 @@ pub struct SurfaceSpec {
     pub bent: Option<BentSpec>,
     /// The loops and settings of a [`SurfaceKind::Boundary`]; `None` for other kinds.
     pub boundary: Option<BoundarySpec>,
+    /// The curves and solver settings of a [`SurfaceKind::Spline`]; `None` for other kinds.
+    pub spline: Option<super::spline::SplineSpec>,
     /// How a mesh is cut into pieces (issue 7); default: decided from the mesh.
     pub segment: SegmentSpec,
 }
@@ -129,6 +131,8 @@ pub enum SurfaceKind {
     BentSheet,
     /// A developable from a closed 3D boundary polyline (Rose et al.).
     Boundary,
+    /// A spline developable between B-spline curves (Tang et al., `surface::spline`).
+    Spline,
 }
 
 /// Length units of a surface's source coordinates.
@@ -143,11 +147,12 @@ pub enum Units {
 
 impl SurfaceKind {
     /// The names a spec file and the command line use, in the order messages list them.
-    pub(crate) const NAMES: [(&'static str, SurfaceKind); 4] = [
+    pub(crate) const NAMES: [(&'static str, SurfaceKind); 5] = [
         ("mesh", SurfaceKind::Mesh),
         ("strip", SurfaceKind::Strip),
         ("bent-sheet", SurfaceKind::BentSheet),
         ("boundary", SurfaceKind::Boundary),
+        ("spline", SurfaceKind::Spline),
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -156,6 +161,7 @@ impl SurfaceKind {
             SurfaceKind::Strip => "strip",
             SurfaceKind::BentSheet => "bent-sheet",
             SurfaceKind::Boundary => "boundary",
+            SurfaceKind::Spline => "spline",
         }
     }
 }

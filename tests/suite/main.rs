@@ -25,6 +25,7 @@ mod resume;
 mod robust;
 mod simplify;
 mod sizing;
+mod spline;
 mod split;
 mod strip;
 mod toolchange;

@@ -77,45 +77,93 @@ pub struct Solved {
 /// What can go wrong making a spline surface.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SplineError {
-    #[error("{0}")]
-    Shape(String),
+    /// A shape the spec cannot have; `key` is the spec key concerned, relative to the surface
+    /// (`curves[2]`, `creases[1]`, `degree`, `apex`).
+    #[error("`{key}`: {message}")]
+    Shape { key: String, message: String },
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error("the rulings cross inside the strip (a striction point, the curve of regression) at u = {u:.4}, v = {v:.4} of strip {strip}: the sheet would fold over itself there; move the curves apart or reduce the twist")]
     Striction { u: f64, v: f64, strip: usize },
 }
 
+impl SplineError {
+    /// "`KEY`: " for errors about the design as a whole (they concern `curves`), nothing for
+    /// shape errors, whose message names their key.
+    pub fn key_prefix(&self) -> &'static str {
+        match self {
+            SplineError::Shape { .. } => "",
+            _ => "`curves`: ",
+        }
+    }
+}
+
 /// Check the spec's shapes and build the model.
 pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
     let count = spec.curves.first().map_or(0, Vec::len);
+    let shape = |key: String, message: String| SplineError::Shape { key, message };
+    if !(2..=5).contains(&spec.degree) {
+        return Err(shape(
+            "degree".into(),
+            format!("must be 2, 3, 4 or 5, got {}", spec.degree),
+        ));
+    }
     let basis = BSpline::new(spec.degree, count, spec.closed)
-        .map_err(|e| SplineError::Shape(format!("curve 1: {e}")))?;
+        .map_err(|e| shape("curves[1]".into(), e.to_string()))?;
     if let Some(k) = spec.curves.iter().position(|c| c.len() != count) {
-        return Err(SplineError::Shape(format!(
-            "curve {} has {} control points, curve 1 has {count}: all curves need the same count",
-            k + 1,
-            spec.curves[k].len()
-        )));
+        return Err(shape(
+            format!("curves[{}]", k + 1),
+            format!(
+                "has {} control points, curve 1 has {count}: all curves need the same count",
+                spec.curves[k].len()
+            ),
+        ));
     }
     match (spec.apex, spec.curves.len()) {
         (Some(_), 1) | (None, 2..) => {}
         (Some(_), n) => {
-            return Err(SplineError::Shape(format!(
-                "a cone takes one curve and `apex`, got {n} curves"
-            )))
+            return Err(shape(
+                "apex".into(),
+                format!("a cone takes one curve and `apex`, got {n} curves"),
+            ))
         }
         (None, n) => {
-            return Err(SplineError::Shape(format!(
-                "a spline surface needs two or more curves (or one and `apex`), got {n}"
-            )))
+            return Err(shape(
+                "curves".into(),
+                format!("a spline surface needs two or more curves (or one and `apex`), got {n}"),
+            ))
         }
     }
     let interior = spec.curves.len().saturating_sub(2);
     if !spec.creases.is_empty() && spec.creases.len() != interior {
-        return Err(SplineError::Shape(format!(
-            "`creases` has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
-            spec.creases.len()
-        )));
+        return Err(shape(
+            "creases".into(),
+            format!(
+                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
+                spec.creases.len()
+            ),
+        ));
+    }
+    let total = count.saturating_mul(spec.curves.len() + 1);
+    if total > MAX_CONTROL_POINTS {
+        return Err(shape(
+            "curves".into(),
+            format!("{total} control points in all is over {MAX_CONTROL_POINTS}: a design of that size is not interactive; split it into several surfaces"),
+        ));
+    }
+    if let Some(&(c, i)) = spec.fixed.iter().find(|&&(c, i)| {
+        !(c < spec.curves.len() && i < count
+            || c == spec.curves.len() && i == 0 && spec.apex.is_some())
+    }) {
+        return Err(shape(
+            "fixed".into(),
+            format!(
+                "control point {} of curve {} does not exist ({} curves of {count} points)",
+                i + 1,
+                c + 1,
+                spec.curves.len()
+            ),
+        ));
     }
     let m = Model {
         basis,
@@ -139,16 +187,21 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
             t.cross(d2).length() > straight * t.length().powi(3)
         });
         if !curved {
-            return Err(SplineError::Shape(format!(
-                "crease {} (curve {}) is straight: a `{}` condition says nothing on a straight crease; make it `free` or `smooth`, or bend the curve",
-                k + 1,
-                k + 2,
-                if kind == Crease::Fold { "fold" } else { "geodesic" }
-            )));
+            return Err(shape(
+                format!("creases[{}]", k + 1),
+                format!(
+                    "curve {} is straight: a `{}` condition says nothing on a straight crease; make it `free` or `smooth`, or bend the curve",
+                    k + 2,
+                    if kind == Crease::Fold { "fold" } else { "geodesic" }
+                ),
+            ));
         }
     }
     Ok(m)
 }
+
+/// Most control points of one surface (all curves and the apex).
+pub const MAX_CONTROL_POINTS: usize = 20_000;
 
 /// The diagonal of the model's control points' bounding box (mm), at least 1e-300.
 fn diameter(m: &Model) -> f64 {

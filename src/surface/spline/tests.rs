@@ -176,13 +176,13 @@ fn err_text() -> String {
 #[test]
 fn unequal_curves_and_a_cone_with_two_curves_are_refused() {
     let mut s = spec(vec![wave(), wave()[..7].to_vec()], None, false);
-    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+    assert!(matches!(model(&s), Err(SplineError::Shape { .. })));
     s.curves = vec![wave(), wave()];
     s.apex = Some(DVec3::Z);
-    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+    assert!(matches!(model(&s), Err(SplineError::Shape { .. })));
     s.curves = vec![wave()];
     s.apex = None;
-    assert!(matches!(model(&s), Err(SplineError::Shape(_))));
+    assert!(matches!(model(&s), Err(SplineError::Shape { .. })));
 }
 
 /// Issue 24's fold by reflection: a cylinder over a half-circle cubic (r = 100) cut by the
@@ -282,7 +282,7 @@ fn crease_counts_and_straight_creases_are_refused() {
     let mut s = spec(reflected_fold(), None, false);
     s.creases = vec![Crease::Fold, Crease::Fold];
     let e = model(&s).unwrap_err().to_string();
-    assert!(e.contains("`creases` has 2 entries"), "{e}");
+    assert!(e.contains("`creases`: has 2 entries"), "{e}");
     // Three parallel straight lines: a fold condition on the middle one is refused.
     let line = |y: f64| -> Vec<DVec3> {
         (0..6)
@@ -292,7 +292,7 @@ fn crease_counts_and_straight_creases_are_refused() {
     let mut s = spec(vec![line(0.0), line(50.0), line(100.0)], None, false);
     s.creases = vec![Crease::Fold];
     let e = model(&s).unwrap_err().to_string();
-    assert!(e.contains("crease 1 (curve 2) is straight"), "{e}");
+    assert!(e.contains("`creases[1]`: curve 2 is straight"), "{e}");
     s.creases = vec![Crease::Smooth];
     assert!(model(&s).is_ok());
 }

@@ -1,0 +1,349 @@
+//! The reader of `kind = "spline"` surfaces (Tang et al. 2016, `surface::spline`): B-spline
+//! curves of one degree and control-point count, or one curve and an `apex`, made developable
+//! by guided projection, with `creases`, `fixed` control points and the solver's settings.
+//!
+//! Choices: `curves` is a list of inline control-point lists (each curve's line is its own,
+//! so a curve with the wrong count is reported where it stands); `fixed` takes a curve number
+//! (the whole curve), `[curve, point]` (1-based) or `"apex"`; the shape checks of
+//! [`crate::surface::spline::model`] (counts, degree, creases on straight curves) run here, so
+//! their messages name the line of the key concerned. Mesh, strip and bent-sheet keys are
+//! refused; `max_iterations` is shared with boundaries (the same meaning).
+
+use super::context::{Ctx, MM_POSITIVE};
+use super::spanned::{span, List, RawSurface};
+use super::SpecError;
+use crate::surface::spline::{Crease, SolveOptions, SplineError, SplineSpec};
+use crate::surface::{SegmentSpec, SurfaceKind, SurfaceSpec, Units};
+use glam::DVec3;
+use toml::{Spanned, Value};
+
+impl Ctx<'_> {
+    /// One `kind = "spline"` entry.
+    pub(super) fn spline_surface(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        header_line: usize,
+    ) -> Result<SurfaceSpec, SpecError> {
+        self.no_other_keys_on_spline(s, key)?;
+        let k = |name: &str| format!("{key}.{name}");
+        let (curves, lines, curves_line) = self.spline_curves(s, key, header_line)?;
+        let apex = match &s.apex {
+            None => None,
+            Some(v) => {
+                let line = self.line(v.span());
+                match v.get_ref() {
+                    Value::Array(a) => Some(self.point(a, &k("apex"), line)?),
+                    other => {
+                        return Err(self.invalid(
+                            line,
+                            &k("apex"),
+                            format!("must be a point [x, y, z], got {other}"),
+                        ))
+                    }
+                }
+            }
+        };
+        let degree = self
+            .number(&s.degree, &k("degree"), "2, 3, 4 or 5", |v| {
+                v.fract() == 0.0 && (2.0..=5.0).contains(&v)
+            })?
+            .map_or(3, |(v, _)| v as usize);
+        let closed = self.boolean(&s.closed, &k("closed"))?.unwrap_or(false);
+        let creases = self.spline_creases(s, key)?;
+        let fixed = self.spline_fixed(s, key, &curves, apex.is_some())?;
+        let d = SolveOptions::default();
+        let count = |v: &super::context::Opt, name: &str, min: f64| {
+            self.number(
+                v,
+                &k(name),
+                &format!("a whole number from {min} to 10000"),
+                |x| x.fract() == 0.0 && (min..=10_000.0).contains(&x),
+            )
+        };
+        let iterations = count(&s.iterations, "iterations", 0.0)?.map(|(v, _)| v as usize);
+        let max_iterations =
+            count(&s.max_iterations, "max_iterations", 1.0)?.map(|(v, _)| v as usize);
+        let eps = |v: &super::context::Opt, name: &str| {
+            self.number(v, &k(name), "a positive number (at most 1e3)", |x| {
+                x > 0.0 && x <= 1e3
+            })
+        };
+        let options = SolveOptions {
+            iterations: iterations.unwrap_or(d.iterations),
+            max_iterations: max_iterations.unwrap_or(d.max_iterations),
+            epsilon1: eps(&s.epsilon1, "epsilon1")?.map_or(d.epsilon1, |(v, _)| v),
+            epsilon2: eps(&s.epsilon2, "epsilon2")?.map_or(d.epsilon2, |(v, _)| v),
+            ..d
+        };
+        let tolerance = self
+            .number(&s.tolerance, &k("tolerance"), MM_POSITIVE, |v| v > 0.0)?
+            .map_or(0.05, |(v, _)| v);
+        let bend_lines = self.bend_lines(&s.bend_lines, key)?;
+        let spec = SplineSpec {
+            curves,
+            apex,
+            degree,
+            closed,
+            fixed,
+            creases,
+            options,
+            tolerance,
+            bend_lines,
+        };
+        if let Err(SplineError::Shape { key: sub, message }) = crate::surface::spline::model(&spec)
+        {
+            let line = self.spline_key_line(s, &sub, &lines).unwrap_or(curves_line);
+            return Err(self.invalid(line, &k(&sub), message));
+        }
+        let name = self
+            .file_name(&s.name, &k("name"))?
+            .unwrap_or_else(|| format!("spline{}", key.trim_start_matches("surface")));
+        Ok(SurfaceSpec {
+            kind: SurfaceKind::Spline,
+            path: self.path.to_path_buf(),
+            scale: 1.0,
+            units: Units::Mm,
+            size: None,
+            name,
+            line: curves_line,
+            strip: None,
+            bent: None,
+            boundary: None,
+            spline: Some(spec),
+            segment: SegmentSpec::default(),
+        })
+    }
+
+    /// `curves`: a list of control-point lists; with each curve's line, and the line of
+    /// `curves`.
+    #[allow(clippy::type_complexity)]
+    fn spline_curves(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        header_line: usize,
+    ) -> Result<(Vec<Vec<DVec3>>, Vec<usize>, usize), SpecError> {
+        let ck = format!("{key}.curves");
+        const WHAT: &str =
+            "a list of curves, each a list of control points [[x, y, z], ...]: two or more, or one with `apex`";
+        let Some(v) = &s.curves else {
+            return Err(self.invalid(header_line, &ck, format!("missing: must be {WHAT}")));
+        };
+        let line = self.line(v.span());
+        let items: &Vec<Spanned<Value>> = match v.get_ref() {
+            List::Items(items) => items,
+            List::Wrong(w) => {
+                return Err(self.invalid(line, &ck, format!("must be {WHAT}, got {w}")))
+            }
+        };
+        let mut curves = Vec::with_capacity(items.len());
+        let mut lines = Vec::with_capacity(items.len());
+        for (i, c) in items.iter().enumerate() {
+            let cl = self.line(c.span());
+            let key_i = format!("{ck}[{}]", i + 1);
+            match c.get_ref() {
+                Value::Array(points) => curves.push(self.points(points, &key_i, cl)?),
+                other => {
+                    return Err(self.invalid(
+                        cl,
+                        &key_i,
+                        format!("must be a list of control points [[x, y, z], ...], got {other}"),
+                    ))
+                }
+            }
+            lines.push(cl);
+        }
+        Ok((curves, lines, line))
+    }
+
+    /// `creases`: one name per interior curve.
+    fn spline_creases(&self, s: &RawSurface, key: &str) -> Result<Vec<Crease>, SpecError> {
+        let ck = format!("{key}.creases");
+        let Some(v) = &s.creases else {
+            return Ok(Vec::new());
+        };
+        let line = self.line(v.span());
+        let names: Vec<&str> = Crease::NAMES.iter().map(|(n, _)| *n).collect();
+        let expected = format!(
+            "a list with one of {} per interior curve",
+            super::names::one_of(&names)
+        );
+        let Value::Array(items) = v.get_ref() else {
+            return Err(self.invalid(
+                line,
+                &ck,
+                format!("must be {expected}, got {}", v.get_ref()),
+            ));
+        };
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, it)| {
+                let found = match it {
+                    Value::String(t) => super::names::pick(t, &Crease::NAMES).ok(),
+                    _ => None,
+                };
+                found.ok_or_else(|| {
+                    self.invalid(
+                        line,
+                        &format!("{ck}[{}]", i + 1),
+                        format!("must be {}, got {it}", super::names::one_of(&names)),
+                    )
+                })
+            })
+            .collect()
+    }
+
+    /// `fixed`: curve numbers, `[curve, point]` pairs (1-based) or `"apex"`, as 0-based
+    /// (curve, point) pairs; curve `curves.len()` is the apex. A pair out of range is left to
+    /// the shape check.
+    fn spline_fixed(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        curves: &[Vec<DVec3>],
+        has_apex: bool,
+    ) -> Result<Vec<(usize, usize)>, SpecError> {
+        let n_curves = curves.len();
+        let fk = format!("{key}.fixed");
+        let Some(v) = &s.fixed else {
+            return Ok(Vec::new());
+        };
+        let line = self.line(v.span());
+        const WHAT: &str =
+            "a list of curve numbers (the whole curve), [curve, point] pairs counted from 1, or \"apex\"";
+        let Value::Array(items) = v.get_ref() else {
+            return Err(self.invalid(line, &fk, format!("must be {WHAT}, got {}", v.get_ref())));
+        };
+        let whole = |x: &Value| match x {
+            Value::Integer(i) if *i >= 1 => Some(*i as usize - 1),
+            _ => None,
+        };
+        let mut out = Vec::new();
+        for (i, it) in items.iter().enumerate() {
+            let bad = || {
+                self.invalid(
+                    line,
+                    &format!("{fk}[{}]", i + 1),
+                    format!(
+                        "must be a curve number, [curve, point] (from 1) or \"apex\", got {it}"
+                    ),
+                )
+            };
+            match it {
+                Value::String(t) if t.trim().eq_ignore_ascii_case("apex") => {
+                    if !has_apex {
+                        return Err(self.invalid(
+                            line,
+                            &format!("{fk}[{}]", i + 1),
+                            "names the apex, but the surface has no `apex`".into(),
+                        ));
+                    }
+                    out.push((n_curves, 0));
+                }
+                Value::Integer(_) => {
+                    let c = whole(it).ok_or_else(bad)?;
+                    if c >= n_curves {
+                        return Err(self.invalid(
+                            line,
+                            &format!("{fk}[{}]", i + 1),
+                            format!(
+                                "curve {} does not exist: there are {n_curves} curves",
+                                c + 1
+                            ),
+                        ));
+                    }
+                    out.extend((0..curves[c].len()).map(|p| (c, p)));
+                }
+                Value::Array(pair) if pair.len() == 2 => {
+                    let (c, p) = (
+                        whole(&pair[0]).ok_or_else(bad)?,
+                        whole(&pair[1]).ok_or_else(bad)?,
+                    );
+                    out.push((c, p));
+                }
+                _ => return Err(bad()),
+            }
+        }
+        Ok(out)
+    }
+
+    /// The line of a spline key named by a shape error (`curves[2]`, `creases[1]`, ...).
+    fn spline_key_line(&self, s: &RawSurface, sub: &str, lines: &[usize]) -> Option<usize> {
+        let base = sub.split('[').next().unwrap_or(sub);
+        let index = sub
+            .split('[')
+            .nth(1)
+            .and_then(|t| t.trim_end_matches(']').parse::<usize>().ok());
+        match base {
+            "curves" => index.and_then(|i| lines.get(i.checked_sub(1)?).copied()),
+            "creases" => span(&s.creases).map(|sp| self.line(sp)),
+            "fixed" => span(&s.fixed).map(|sp| self.line(sp)),
+            "apex" => span(&s.apex).map(|sp| self.line(sp)),
+            "degree" => span(&s.degree).map(|sp| self.line(sp)),
+            _ => None,
+        }
+    }
+
+    /// Keys of other kinds on a spline are mistakes.
+    fn no_other_keys_on_spline(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        self.refuse(
+            key,
+            &[
+                ("path", span(&s.path)),
+                ("scale", span(&s.scale)),
+                ("units", span(&s.units)),
+                ("segment", span(&s.segment)),
+                ("charts", span(&s.charts)),
+                ("f_max", span(&s.f_max)),
+                ("approximate", span(&s.approximate)),
+                ("simplify", span(&s.simplify)),
+                ("p", span(&s.p)),
+                ("q", span(&s.q)),
+                ("method", span(&s.method)),
+                ("side", span(&s.side)),
+                ("k_factor", span(&s.k_factor)),
+            ],
+            "is not a spline key; a spline takes `curves` (and `apex`), `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
+        )?;
+        self.no_bent_keys(s, key)?;
+        self.refuse(
+            key,
+            &[
+                ("loop", span(&s.loop_)),
+                ("loop_csv", span(&s.loop_csv)),
+                ("loops", span(&s.loops)),
+                ("darts", span(&s.darts)),
+                ("rulings", span(&s.rulings)),
+                ("max_dihedral", span(&s.max_dihedral)),
+                ("min_chart_area", span(&s.min_chart_area)),
+                ("smooth", span(&s.smooth)),
+                ("good_interior", span(&s.good_interior)),
+                ("good_fairness", span(&s.good_fairness)),
+            ],
+            "is for boundary surfaces (kind = \"boundary\")",
+        )
+    }
+}
+
+impl Ctx<'_> {
+    /// Keys only a spline takes are errors on other kinds.
+    pub(super) fn no_spline_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        self.refuse(
+            key,
+            &[
+                ("curves", span(&s.curves)),
+                ("apex", span(&s.apex)),
+                ("degree", span(&s.degree)),
+                ("closed", span(&s.closed)),
+                ("creases", span(&s.creases)),
+                ("fixed", span(&s.fixed)),
+                ("iterations", span(&s.iterations)),
+                ("epsilon1", span(&s.epsilon1)),
+                ("epsilon2", span(&s.epsilon2)),
+            ],
+            "is for spline surfaces (kind = \"spline\")",
+        )
+    }
+}

@@ -1,0 +1,380 @@
+//! Issue 24 acceptance through the command line: `kind = "spline"` specs with exact answers
+//! (a cylinder, a cone in both forms, a fold by reflection), a loft that is not developable as
+//! given, and bad input exiting 1 with `FILE:LINE` and the key. Blank figures are read from
+//! what the user gets (the cut contour of the HP-GL of a dry run, report.json); the 3D figures
+//! they are compared with are computed here by quadrature on the spec's own curves.
+
+use crate::common::*;
+use flatcut::geom::bspline::BSpline;
+use flatcut::output::hpgl;
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+
+/// A TOML list of curves.
+fn toml_curves(curves: &[Vec<DVec3>]) -> String {
+    let curve = |c: &Vec<DVec3>| {
+        let pts: Vec<String> = c
+            .iter()
+            .map(|p| format!("[{:.12}, {:.12}, {:.12}]", p.x, p.y, p.z))
+            .collect();
+        format!("  [{}],\n", pts.join(", "))
+    };
+    format!("[\n{}]", curves.iter().map(curve).collect::<String>())
+}
+
+/// A spline spec with `curves` and `extra` surface keys, on a 1200 × 1200 mm sheet.
+fn spline_spec(dir: &Path, curves: &[Vec<DVec3>], extra: &str) -> PathBuf {
+    let text = format!(
+        "name = \"spline\"\n[[surface]]\nkind = \"spline\"\ncurves = {}\n{extra}\n[sheet]\nwidth = 1200\nheight = 1200\n",
+        toml_curves(curves)
+    );
+    let path = dir.join("spline.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Run a dry run on the pen plotter profile; returns the output folder's report.json.
+fn cut(dir: &Path, spec: &Path, extra: &[&str]) -> serde_json::Value {
+    let out = dir.join("out");
+    let mut args = vec![
+        "cut",
+        spec.to_str().unwrap(),
+        "--device",
+        "hpgl-pens",
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = flatcut(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
+}
+
+/// Area (mm²) and perimeter (mm) of each pen-1 (cut) contour of the run's HP-GL (40 units/mm).
+fn cut_contours(dir: &Path) -> Vec<(f64, f64)> {
+    let plt = std::fs::read_to_string(dir.join("out/spline.plt")).unwrap();
+    let strokes = hpgl::parse(&plt).expect("valid HPGL");
+    strokes
+        .iter()
+        .filter(|s| s.pen == 1)
+        .map(|s| {
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .map(|&(x, y)| (x as f64 / 40.0, y as f64 / 40.0))
+                .collect();
+            let mut area = 0.0;
+            let mut per = 0.0;
+            for w in pts.windows(2) {
+                area += w[0].0 * w[1].1 - w[1].0 * w[0].1;
+                per += ((w[1].0 - w[0].0).powi(2) + (w[1].1 - w[0].1).powi(2)).sqrt();
+            }
+            (0.5 * area.abs(), per)
+        })
+        .collect()
+}
+
+fn figure(report: &serde_json::Value, k: &str) -> f64 {
+    report["surfaces"][0]["figures"][k]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no figure {k}: {}", report["surfaces"][0]))
+}
+
+/// Length of a curve by the midpoint rule.
+fn length(basis: &BSpline, c: &[DVec3]) -> f64 {
+    let per = 4000;
+    (0..basis.spans() * per)
+        .map(|k| basis.deriv(c, (k as f64 + 0.5) / per as f64).length() / per as f64)
+        .sum()
+}
+
+/// Area of the ruled surface (1 − v) a + v b (b the apex when `apex`) by the midpoint rule.
+fn ruled_area(basis: &BSpline, a: &[DVec3], b: Option<&[DVec3]>, apex: DVec3) -> f64 {
+    let per = 2000;
+    let mut area = 0.0;
+    for k in 0..basis.spans() * per {
+        let u = (k as f64 + 0.5) / per as f64;
+        let (pa, ta) = (basis.eval(a, u), basis.deriv(a, u));
+        let (pb, tb) = match b {
+            Some(b) => (basis.eval(b, u), basis.deriv(b, u)),
+            None => (apex, DVec3::ZERO),
+        };
+        for j in 0..20 {
+            let v = (j as f64 + 0.5) / 20.0;
+            area += (ta * (1.0 - v) + tb * v).cross(pb - pa).length() / (per as f64 * 20.0);
+        }
+    }
+    area
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn spline_cylinder_blank_is_length_by_150() {
+    let dir = scratch("spline-cylinder");
+    let a: Vec<DVec3> = (0..8)
+        .map(|i| DVec3::new(i as f64 * 60.0, 40.0 * (i as f64 * 1.3).sin(), 0.0))
+        .collect();
+    let b: Vec<DVec3> = a.iter().map(|p| *p + 150.0 * DVec3::Z).collect();
+    let spec = spline_spec(&dir, &[a.clone(), b.clone()], "");
+    let report = cut(&dir, &spec, &[]);
+    assert!(figure(&report, "control_points_moved_mm") <= 1e-9);
+    assert_eq!(figure(&report, "iterations"), 0.0);
+    // The developability sine at 200 parameters per span, on the solved design as built.
+    let s = flatcut::spec::load(&spec).unwrap();
+    let surface = flatcut::surface::build(&s.surfaces[0]).unwrap();
+    let model = surface.spline.as_ref().unwrap();
+    // The spec holds the points to 12 decimals; the solve leaves them where they are.
+    for (c, given) in model.curves.iter().zip([&a, &b]) {
+        for (p, q) in c.iter().zip(given) {
+            assert!(p.distance(*q) <= 1e-9, "{p} moved from {q}");
+        }
+    }
+    let sine = flatcut::surface::spline::dense_sine(model, 200);
+    assert!(sine <= 1e-12, "sine {sine}");
+    let l = length(&model.basis, &a);
+    let contours = cut_contours(&dir);
+    assert_eq!(contours.len(), 1, "one piece");
+    let (area, per) = contours[0];
+    eprintln!(
+        "cylinder blank: {area:.1} mm² vs {:.1}, perimeter {per:.2} vs {:.2}",
+        l * 150.0,
+        2.0 * l + 300.0
+    );
+    assert!(rel(area, l * 150.0) < 1e-3);
+    assert!(rel(per, 2.0 * l + 300.0) < 1e-3);
+}
+
+fn circle(r: f64, z: f64, phase: f64) -> Vec<DVec3> {
+    (0..8)
+        .map(|i| {
+            let t = phase + i as f64 * std::f64::consts::TAU / 8.0;
+            DVec3::new(r * t.cos(), r * t.sin(), z + 15.0 * (2.0 * t).sin())
+        })
+        .collect()
+}
+
+#[test]
+fn spline_cone_blanks_have_the_area_of_the_cone() {
+    let a = circle(100.0, 0.0, 0.1);
+    let p = DVec3::new(10.0, -5.0, 200.0);
+    let b: Vec<DVec3> = a.iter().map(|x| p + 0.4 * (*x - p)).collect();
+    let basis = BSpline::new(3, 8, true).unwrap();
+    let apex = format!("apex = [{}, {}, {}]\nclosed = true", p.x, p.y, p.z);
+    for (name, curves, extra, want) in [
+        (
+            "frustum",
+            vec![a.clone(), b.clone()],
+            "closed = true".to_string(),
+            ruled_area(&basis, &a, Some(&b), p),
+        ),
+        (
+            "apex",
+            vec![a.clone()],
+            apex,
+            ruled_area(&basis, &a, None, p),
+        ),
+    ] {
+        let dir = scratch(&format!("spline-cone-{name}"));
+        let spec = spline_spec(&dir, &curves, &extra);
+        let report = cut(&dir, &spec, &["--bend-lines", "none"]);
+        assert!(figure(&report, "control_points_moved_mm") <= 1e-9, "{name}");
+        let contours = cut_contours(&dir);
+        assert_eq!(contours.len(), 1, "{name}: one piece");
+        let area = contours[0].0;
+        eprintln!("cone ({name}) blank: {area:.1} mm² vs {want:.1} by quadrature");
+        assert!(rel(area, want) < 1e-3, "{name}: {area} vs {want}");
+    }
+}
+
+/// Issue 24's fold by reflection (see the library's tests): bottom rim, crease on the plane
+/// z = 100 + 2y, mirrored top rim.
+fn reflected_fold() -> Vec<Vec<DVec3>> {
+    let c0: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let t = std::f64::consts::PI * i as f64 / 7.0;
+            DVec3::new(100.0 * t.cos(), 100.0 * t.sin(), 0.0)
+        })
+        .collect();
+    let m = DVec3::new(0.0, -2.0, 1.0).normalize();
+    let o = DVec3::new(0.0, 0.0, 100.0);
+    let mirror = |p: DVec3| p - 2.0 * (p - o).dot(m) * m;
+    let c1 = c0
+        .iter()
+        .map(|p| DVec3::new(p.x, p.y, 100.0 + 2.0 * p.y))
+        .collect();
+    let c2 = c0.iter().map(|p| mirror(*p + DVec3::Z * 400.0)).collect();
+    vec![c0, c1, c2]
+}
+
+#[test]
+fn spline_fold_by_reflection_gives_one_piece_with_the_crease_length() {
+    let dir = scratch("spline-fold");
+    let curves = reflected_fold();
+    let spec = spline_spec(&dir, &curves, "creases = [\"fold\"]");
+    let report = cut(&dir, &spec, &["--bend-lines", "none"]);
+    assert!(figure(&report, "control_points_moved_mm") <= 1e-9);
+    assert!(figure(&report, "crease_angle_defect") <= 1e-9);
+    assert!(figure(&report, "crease_sine") <= 1e-9);
+    let pieces = report["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 1, "one piece");
+    // With no ruling scored, every fold line is on the crease.
+    let folds = pieces[0]["fold_lines"].as_array().unwrap();
+    let flat: f64 = folds.iter().map(|f| f["length_mm"].as_f64().unwrap()).sum();
+    let kinds: std::collections::BTreeSet<&str> =
+        folds.iter().map(|f| f["kind"].as_str().unwrap()).collect();
+    let basis = BSpline::new(3, 8, false).unwrap();
+    let crease = length(&basis, &curves[1]);
+    eprintln!(
+        "fold: flat crease {flat:.3} mm vs 3D {crease:.3} mm in {} segments, {kinds:?}",
+        folds.len()
+    );
+    assert!(rel(flat, crease) < 1e-3, "{flat} vs {crease}");
+    assert_eq!(kinds.len(), 1, "the crease folds one way: {kinds:?}");
+    assert!(folds
+        .iter()
+        .all(|f| f["angle_deg"].as_f64().unwrap() > 10.0));
+}
+
+#[test]
+fn spline_loft_between_rims_that_are_not_developable_is_solved() {
+    let dir = scratch("spline-loft");
+    let a: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let t = i as f64 * std::f64::consts::TAU / 8.0;
+            DVec3::new(100.0 * t.cos(), 100.0 * t.sin(), 0.0)
+        })
+        .collect();
+    let b: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let t = 0.45 + i as f64 * std::f64::consts::TAU / 8.0;
+            DVec3::new(60.0 * t.cos(), 60.0 * t.sin(), 120.0)
+        })
+        .collect();
+    let basis = BSpline::new(3, 8, true).unwrap();
+    let area0 = ruled_area(&basis, &a, Some(&b), DVec3::ZERO);
+    let spec = spline_spec(&dir, &[a, b], "closed = true");
+    let report = cut(&dir, &spec, &["--bend-lines", "none"]);
+    let sine = figure(&report, "largest_sine");
+    let moved = figure(&report, "control_points_moved_mm");
+    let area: f64 = report["pieces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["area_mm2"].as_f64().unwrap())
+        .sum();
+    eprintln!(
+        "loft: sine {sine:.2e} after {} iterations, control points moved {moved:.2} mm, area {area:.0} of {area0:.0} mm²",
+        figure(&report, "iterations")
+    );
+    assert!(sine <= 1e-6);
+    assert!(moved > 0.1, "the rims had to move");
+    assert!(area >= 0.5 * area0);
+    assert!(report["surfaces"][0]["warnings"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+}
+
+/// A spec from `body` (the surface's keys after `kind`) must exit 1 naming `FILE:LINE` and
+/// `key`.
+fn refused(body: &str, line: usize, key: &str) {
+    let dir = scratch("spline-bad");
+    let path = dir.join("bad.toml");
+    let text = format!("[[surface]]\nkind = \"spline\"\n{body}\n");
+    std::fs::write(&path, &text).unwrap();
+    let o = flatcut(&[
+        "cut",
+        path.to_str().unwrap(),
+        "--dry-run",
+        "-o",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{text}\n{e}");
+    let at = format!("{}:{line}", path.display());
+    assert!(
+        e.contains(&at) && e.contains(&format!("`{key}`")),
+        "{text}\nwant {at} and `{key}`, got: {e}"
+    );
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(!dir.join("out/report.json").exists());
+}
+
+#[test]
+fn spline_bad_input_exits_1_with_file_line_and_key() {
+    let line4 = "[[0, 0, 0], [50, 10, 0], [100, 0, 0], [150, 10, 0]]";
+    let line3 = "[[0, 0, 100], [50, 10, 100], [100, 0, 100]]";
+    let up = |z: f64| format!("[[0, 0, {z}], [50, 10, {z}], [100, 0, {z}], [150, 10, {z}]]");
+    let flat = |y: f64| format!("[[0, {y}, 0], [50, {y}, 0], [100, {y}, 0], [150, {y}, 0]]");
+    let two = format!("curves = [\n  {line4},\n  {},\n]", up(100.0));
+    let cases: Vec<(String, usize, &str)> = vec![
+        ("degree = 3".into(), 1, "surface[1].curves"),
+        (
+            format!("curves = [\n  {line4},\n  {line3},\n]"),
+            5,
+            "surface[1].curves[2]",
+        ),
+        (format!("{two}\ndegree = 6"), 7, "surface[1].degree"),
+        (format!("{two}\ndegree = 2.5"), 7, "surface[1].degree"),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"fold\", \"fold\"]", up(100.0), up(200.0)),
+            8,
+            "surface[1].creases",
+        ),
+        (
+            format!("curves = [\n  {},\n  {},\n  {},\n]\ncreases = [\"fold\"]", flat(0.0), flat(50.0), flat(100.0)),
+            8,
+            "surface[1].creases[1]",
+        ),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"crumple\"]", up(100.0), up(200.0)),
+            8,
+            "surface[1].creases[1]",
+        ),
+        (format!("{two}\nepsilon2 = 0"), 7, "surface[1].epsilon2"),
+        (format!("{two}\nepsilon1 = -1"), 7, "surface[1].epsilon1"),
+        (format!("{two}\nmax_iterations = 0"), 7, "surface[1].max_iterations"),
+        (format!("{two}\ntolerance = nan"), 7, "surface[1].tolerance"),
+        (format!("{two}\napex = [0, 0, 300]"), 7, "surface[1].apex"),
+        (format!("{two}\nfixed = [[3, 1]]"), 7, "surface[1].fixed"),
+        (format!("{two}\nfixed = [[1, 9]]"), 7, "surface[1].fixed"),
+        (format!("{two}\nfixed = [\"apex\"]"), 7, "surface[1].fixed[1]"),
+        (format!("{two}\npath = \"x.obj\""), 7, "surface[1].path"),
+        (format!("{two}\nloop = [[0, 0], [1, 0], [0, 1]]"), 7, "surface[1].loop"),
+        (
+            format!("curves = [\n  [[0, 0, 0], [50, nan, 0], [100, 0, 0], [150, 10, 0]],\n  {},\n]", up(100.0)),
+            4,
+            "surface[1].curves[1][2]",
+        ),
+        ("curves = 3".into(), 3, "surface[1].curves"),
+        ("curves = [3, 4]".into(), 3, "surface[1].curves[1]"),
+        // Rulings that all cross the strip's middle: refused at the line of `curves`.
+        (
+            "curves = [\n  [[0, 0, 0], [25, 0, 0], [50, 0, 0], [75, 0, 0], [100, 0, 0]],\n  [[100, 50, 0], [75, 50, 0], [50, 50, 0], [25, 50, 0], [0, 50, 0]],\n]".into(),
+            3,
+            "curves",
+        ),
+    ];
+    for (body, line, key) in cases {
+        refused(&body, line, key);
+    }
+    // Spline keys on another kind are refused too.
+    let dir = scratch("spline-bad-kind");
+    let path = dir.join("strip.toml");
+    std::fs::write(
+        &path,
+        "[[surface]]\nkind = \"strip\"\np = [[0, 0, 0], [100, 0, 0]]\nq = [[0, 0, 50], [100, 0, 50]]\ncreases = [\"fold\"]\n",
+    )
+    .unwrap();
+    let o = flatcut(&["cut", path.to_str().unwrap(), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains(":5: `surface[1].creases`"),
+        "{}",
+        stderr(&o)
+    );
+}
