@@ -398,6 +398,8 @@ pub struct Extras {
     pub surface_obj: Option<PathBuf>,
     /// Write each surface's mesh with its flat layout as `vt` here.
     pub uv_obj: Option<PathBuf>,
+    /// Write the solved spline designs as JSON here (`output::design`).
+    pub spline_json: Option<PathBuf>,
     /// Print no warnings.
     pub quiet: bool,
     /// Resolution of the PNG pictures in dots per inch (`--dpi`); `None`: the preview's
@@ -662,6 +664,18 @@ fn write_extras(flats: &[Flat], extras: &Extras) -> Result<(), Error> {
     }
     if let Some(p) = &extras.uv_obj {
         write_uv_obj(p, flats)?;
+    }
+    if let Some(p) = &extras.spline_json {
+        let text = crate::output::design::spline_json(flats).ok_or_else(|| {
+            Error::Usage(format!(
+                "--spline-json {}: no spline surface to write",
+                p.display()
+            ))
+        })?;
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+            create_dir(dir)?;
+        }
+        write_atomic(p, text.as_bytes())?;
     }
     Ok(())
 }

@@ -432,3 +432,19 @@ pub fn parse_bend_lines(s: &str) -> Result<BendLines, String> {
         },
     }
 }
+
+/// `--spline-json FILE`, refused when the spec has no spline surface to write.
+pub fn spline_json(spec: &Spec, path: &Option<PathBuf>) -> Result<Option<PathBuf>, Error> {
+    let has = spec
+        .surfaces
+        .iter()
+        .any(|s| s.kind == crate::spec::SurfaceKind::Spline);
+    match path {
+        Some(p) if !has => Err(Error::Usage(format!(
+            "--spline-json {}: {} has no spline surface (kind = \"spline\") to write",
+            p.display(),
+            spec.path.display()
+        ))),
+        _ => Ok(path.clone()),
+    }
+}

@@ -42,6 +42,10 @@ pub struct FlattenArgs {
     /// Also write the 3D surface mesh (all surfaces, mm) as a Wavefront OBJ file.
     #[arg(long, value_name = "FILE")]
     pub surface_obj: Option<PathBuf>,
+    /// Also write the solved spline designs (knots, control points, strips, creases and where
+    /// the curves lie on the flat pieces) as JSON; the spec needs a spline surface.
+    #[arg(long, value_name = "FILE")]
+    pub spline_json: Option<PathBuf>,
 }
 
 pub fn run(a: &FlattenArgs) -> Result<(), Error> {
@@ -60,6 +64,7 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         alternatives: a.alternatives,
         surface_obj: a.surface_obj.clone(),
         uv_obj: a.smooth.uv_obj.clone(),
+        spline_json: super::args::spline_json(&spec, &a.spline_json)?,
         quiet: a.quiet,
         dpi: a.pictures.dpi,
     };

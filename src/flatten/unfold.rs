@@ -17,7 +17,8 @@
 //! edge length); faces that merely touch along a fold or at a vertex never count. After the
 //! forest is built, cut edges whose two copies coincide within that distance inside one island
 //! (typically inside planar regions) are joined again, because cutting there would only slit the
-//! material.
+//! material. Edges the source lists in [`Surface::cuts`] are never joined (the seam where a
+//! closed spline surface is opened).
 
 use super::{Flat, FlattenError};
 use crate::geom::mesh::Topology;
@@ -273,9 +274,15 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         w * t - opts.length_weight * lengths[e] / mean
     };
 
-    // Join islands across edges in priority order (Kruskal), the smaller moved onto the larger.
+    // Join islands across edges in priority order (Kruskal), the smaller moved onto the larger;
+    // the source's cuts (the seam of a closed spline surface) stay cut.
+    let forced: std::collections::HashSet<[usize; 2]> = surface.cuts.iter().copied().collect();
+    let is_forced = |e: usize| {
+        let [a, b] = topology.edges[e].verts;
+        forced.contains(&[a.min(b), a.max(b)])
+    };
     let mut order: Vec<usize> = (0..ne)
-        .filter(|&e| topology.edges[e].uses.len() == 2 && !joined[e])
+        .filter(|&e| topology.edges[e].uses.len() == 2 && !joined[e] && !is_forced(e))
         .collect();
     order.sort_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
     for e in order {
@@ -293,7 +300,7 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
 
     // Edges cut inside one island whose copies coincide would only slit the material.
     for (e, edge) in topology.edges.iter().enumerate() {
-        if joined[e] || edge.uses.len() != 2 {
+        if joined[e] || edge.uses.len() != 2 || is_forced(e) {
             continue;
         }
         let [(f, i), (g, j)] = [edge.uses[0], edge.uses[1]];

@@ -4,8 +4,8 @@
 //! document of all sheets ([`svg`]), a 1:1 PDF with a page per sheet and switchable layers
 //! ([`pdf`]) and a PNG preview per sheet ([`png`]); a DXF per sheet of
 //! the nested layout for CAD/CAM ([`dxf`]); a mesh as Wavefront OBJ, with its flat layout as
-//! texture coordinates ([`obj`]); the run's report ([`report`]); and the atomic writing of a
-//! run's files ([`files`]).
+//! texture coordinates ([`obj`]); the run's report ([`report`]); the solved spline designs
+//! ([`design`], `--spline-json`); and the atomic writing of a run's files ([`files`]).
 //! Device units (plotter units, pixels) appear only here; everything upstream is millimetres,
 //! x right, y up, origin at the sheet's lower-left corner.
 //!
@@ -23,6 +23,7 @@ use crate::profile::{Language, Profile, StrokeKind, Tool};
 use crate::toolpath::{SheetJob, Stroke, StrokeRole};
 use glam::DVec2;
 
+pub mod design;
 pub mod dxf;
 pub mod files;
 pub(crate) mod gcode;

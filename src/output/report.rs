@@ -44,7 +44,7 @@ pub struct RunInfo {
 
 /// `v` to 6 significant digits: the sources' figures range from residuals of 1e-12 to
 /// energies of 1e4, and 6 decimals would write the small ones as 0.
-fn sig6(v: f64) -> f64 {
+pub(super) fn sig6(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
         return v;
     }

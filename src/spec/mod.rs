@@ -8,7 +8,7 @@
 //!                          # surfaces together, aspect kept; `--size` wins)
 //!
 //! [[surface]]              # one or more
-//! kind = "mesh"            # required: "mesh", "strip", "bent-sheet" or "boundary"
+//! kind = "mesh"            # required: "mesh", "strip", "bent-sheet", "boundary" or "spline"
 //! path = "cube.obj"        # required for mesh; relative to the spec file's directory
 //! scale = 1.0              # optional, > 0, finite; default 1
 //! units = "mm"             # optional: "mm" | "cm" | "m" | "in"; default "mm"
@@ -149,6 +149,25 @@
 //! points, default false) and `tolerance` (chordal, for curves and smoothing, default 0.5 mm).
 //! Open polylines, fewer than three points, repeated consecutive points and loops that cross
 //! themselves are errors naming the loop and point.
+//!
+//! # Spline surfaces (issue 24)
+//!
+//! A `kind = "spline"` surface is a ruled surface between B-spline curves, made developable by
+//! guided projection (see `surface::spline`, Tang et al. 2016): `curves` (required: two or
+//! more curves, each an inline list of control points `[[x, y, z], ...]`, all of one count;
+//! or one curve and `apex = [x, y, z]` for a cone), `degree` (2 to 5, default 3), `closed`
+//! (periodic curves, default false), `creases` (one per interior curve of a chain of three or
+//! more: "fold" (the sheet folds along it), "geodesic" (a geodesic of both sides: it
+//! unfolds to a straight line), "smooth" (no crease) or "free" (no condition, the strips are cut apart); default
+//! all "free"), `fixed` (control points the solve keeps: curve numbers for whole curves,
+//! `[curve, point]` counted from 1, or "apex"), `iterations` (rounds with the fairness
+//! energy, default 5), `max_iterations` (default 50), `epsilon1` (fairness weight, default
+//! 0.1), `epsilon2` (step damping, default 0.01), `tolerance` (chordal tolerance of the
+//! output sampling, mm, default 0.05), `bend_lines` (which rulings are scored, as strips;
+//! creases are folds whatever it says) and `name`. Unequal control-point counts, a wrong
+//! number of `creases`, a "fold" or "geodesic" crease on a straight curve and a control point
+//! that does not exist are errors at the line of the key concerned; rulings that cross inside
+//! the surface (a curve of regression) and a solve that breaks down name `curves`.
 
 mod bent;
 mod boundary;

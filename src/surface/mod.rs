@@ -72,7 +72,8 @@ pub struct Surface {
     /// in one chart: the seams that make a tube or a closed shell a disk, and darts (issue 7,
     /// thesis §5.2.3). The flatten stage splits the vertices along them before parameterising
     /// and the pattern stage draws them as cut lines with seam marks on both sides. Empty for
-    /// none; only meaningful with `charts`.
+    /// none. Without `charts` the exact unfolder never joins them (the seam ruling where a
+    /// closed spline surface is opened).
     pub cuts: Vec<[usize; 2]>,
     /// Figures the source measured, written under the surface in `report.json` (strips: points
     /// on each curve, interior and locally convex bridges, bending energy; boundary surfaces:
@@ -83,7 +84,7 @@ pub struct Surface {
     pub alternatives: Vec<Mesh>,
     /// The solved design of a spline surface (curves, creases; `--spline-json`), in the
     /// surface's millimetres; `None` for other kinds.
-    pub spline: Option<Box<spline::Model>>,
+    pub spline: Option<Box<spline::Design>>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -346,8 +347,13 @@ fn build_spline(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             .map(|w| format!("surface `{}`: {w}", spec.name))
             .collect(),
         bends: Some(solved.bends),
+        cuts: solved.seam,
         figures: solved.figures,
-        spline: Some(Box::new(solved.model)),
+        spline: Some(Box::new(spline::Design {
+            model: solved.model,
+            params: solved.params,
+            curve_verts: solved.curve_verts,
+        })),
         ..Default::default()
     })
 }

@@ -85,7 +85,8 @@ impl Surface {
                 *v *= f;
             }
         }
-        if let Some(m) = &mut self.spline {
+        if let Some(d) = &mut self.spline {
+            let m = &mut d.model;
             m.curves.iter_mut().flatten().for_each(|p| *p *= f);
             if let Some(a) = &mut m.apex {
                 *a *= f;

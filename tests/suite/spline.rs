@@ -126,7 +126,7 @@ fn spline_cylinder_blank_is_length_by_150() {
     // The developability sine at 200 parameters per span, on the solved design as built.
     let s = flatcut::spec::load(&spec).unwrap();
     let surface = flatcut::surface::build(&s.surfaces[0]).unwrap();
-    let model = surface.spline.as_ref().unwrap();
+    let model = &surface.spline.as_ref().unwrap().model;
     // The spec holds the points to 12 decimals; the solve leaves them where they are.
     for (c, given) in model.curves.iter().zip([&a, &b]) {
         for (p, q) in c.iter().zip(given) {
@@ -180,13 +180,26 @@ fn spline_cone_blanks_have_the_area_of_the_cone() {
     ] {
         let dir = scratch(&format!("spline-cone-{name}"));
         let spec = spline_spec(&dir, &curves, &extra);
-        let report = cut(&dir, &spec, &["--bend-lines", "none"]);
+        let report = cut(&dir, &spec, &["--bend-lines", "none", "--tabs", "none"]);
         assert!(figure(&report, "control_points_moved_mm") <= 1e-9, "{name}");
         let contours = cut_contours(&dir);
         assert_eq!(contours.len(), 1, "{name}: one piece");
         let area = contours[0].0;
         eprintln!("cone ({name}) blank: {area:.1} mm² vs {want:.1} by quadrature");
         assert!(rel(area, want) < 1e-3, "{name}: {area} vs {want}");
+        // Opened at one seam ruling, which is a seam of the piece with itself and a tab.
+        let seams = report["seams"].as_array().unwrap();
+        assert_eq!(seams.len(), 1, "{name}: {seams:?}");
+        let s = &seams[0];
+        assert_eq!(
+            (s["piece_a"].as_u64(), s["piece_b"].as_u64()),
+            (Some(1), Some(1))
+        );
+        let (la, lb) = (
+            s["length_a_mm"].as_f64().unwrap(),
+            s["length_b_mm"].as_f64().unwrap(),
+        );
+        assert!((la - lb).abs() < 1e-6 && la > 100.0, "{name}: {la} vs {lb}");
     }
 }
 
@@ -215,7 +228,17 @@ fn spline_fold_by_reflection_gives_one_piece_with_the_crease_length() {
     let dir = scratch("spline-fold");
     let curves = reflected_fold();
     let spec = spline_spec(&dir, &curves, "creases = [\"fold\"]");
-    let report = cut(&dir, &spec, &["--bend-lines", "none"]);
+    let json = dir.join("design/fold.json");
+    let report = cut(
+        &dir,
+        &spec,
+        &[
+            "--bend-lines",
+            "none",
+            "--spline-json",
+            json.to_str().unwrap(),
+        ],
+    );
     assert!(figure(&report, "control_points_moved_mm") <= 1e-9);
     assert!(figure(&report, "crease_angle_defect") <= 1e-9);
     assert!(figure(&report, "crease_sine") <= 1e-9);
@@ -237,6 +260,58 @@ fn spline_fold_by_reflection_gives_one_piece_with_the_crease_length() {
     assert!(folds
         .iter()
         .all(|f| f["angle_deg"].as_f64().unwrap() > 10.0));
+    // The design as JSON: the curves as solved (here as given), the crease, and the crease
+    // on the flat piece with its 3D length.
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = &d["surfaces"][0];
+    assert_eq!(s["degree"], 3);
+    assert_eq!(s["knots"].as_array().unwrap().len(), 8 + 3 + 1);
+    assert_eq!(s["creases"][0]["condition"], "fold");
+    assert_eq!(s["strips"], serde_json::json!([[1, 2], [2, 3]]));
+    for (c, curve) in curves.iter().enumerate() {
+        for (k, p) in curve.iter().enumerate() {
+            let q = &s["curves"][c][k];
+            let q = DVec3::new(
+                q[0].as_f64().unwrap(),
+                q[1].as_f64().unwrap(),
+                q[2].as_f64().unwrap(),
+            );
+            assert!(
+                p.distance(q) < 1e-8,
+                "curve {} point {}: {q} vs {p}",
+                c + 1,
+                k + 1
+            );
+        }
+    }
+    let dev = s["development"]["curves"].as_array().unwrap();
+    let on2: Vec<&serde_json::Value> = dev.iter().filter(|c| c["curve"] == 2).collect();
+    assert_eq!(on2.len(), 1, "the crease lies on one piece");
+    let pts = on2[0]["points"].as_array().unwrap();
+    let flat_len: f64 = pts
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (&w[0], &w[1]);
+            let dx = a[0].as_f64().unwrap() - b[0].as_f64().unwrap();
+            let dy = a[1].as_f64().unwrap() - b[1].as_f64().unwrap();
+            dx.hypot(dy)
+        })
+        .sum();
+    assert!(rel(flat_len, crease) < 1e-3, "{flat_len} vs {crease}");
+    // Asked of a spec without a spline surface, the flag is refused before anything is cut.
+    let o = flatcut(&[
+        "cut",
+        "patterns/cube.toml",
+        "--dry-run",
+        "-o",
+        dir.join("cube").to_str().unwrap(),
+        "--spline-json",
+        dir.join("cube.json").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--spline-json"), "{}", stderr(&o));
+    assert!(!dir.join("cube/report.json").exists());
 }
 
 #[test]
@@ -377,4 +452,34 @@ fn spline_bad_input_exits_1_with_file_line_and_key() {
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn spline_lamp_pattern_is_one_sheet_folded_on_its_circle_with_a_glued_seam() {
+    let dir = scratch("spline-lamp");
+    let out = dir.join("out");
+    let o = flatcut(&[
+        "cut",
+        "patterns/spline-fold-lamp.toml",
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let pieces = report["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 1);
+    assert_eq!(pieces[0]["tabs"], 1, "a glue tab on the seam");
+    assert!(figure(&report, "largest_sine") <= 1e-10);
+    assert!(figure(&report, "crease_angle_defect") <= 1e-9);
+    // The crease, a circle of radius 100 in 3D, is one fold of that length on the sheet.
+    let folds = pieces[0]["fold_lines"].as_array().unwrap();
+    let flat: f64 = folds.iter().map(|f| f["length_mm"].as_f64().unwrap()).sum();
+    let s = flatcut::spec::load(&manifest("patterns/spline-fold-lamp.toml")).unwrap();
+    let sp = s.surfaces[0].spline.as_ref().unwrap();
+    let basis = BSpline::new(3, 8, true).unwrap();
+    let crease = length(&basis, &sp.curves[1]);
+    assert!(rel(flat, crease) < 1e-3, "{flat} vs {crease}");
+    assert!(folds.iter().all(|f| f["kind"] == folds[0]["kind"]));
 }

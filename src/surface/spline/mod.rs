@@ -19,8 +19,9 @@
 //!   keeps the chordal error `max|a″| h²/8` (of both curves) within `tolerance`, at least 2
 //!   and at most 512 per span. Each quad a_i a_i+1 b_i+1 b_i becomes the triangles
 //!   (a_i, a_i+1, b_i+1) and (a_i, b_i+1, b_i), so that rulings a_i b_i are edges; a cone's
-//!   triangles share one apex vertex. A closed surface repeats its first ruling at the end (the
-//!   seam is cut).
+//!   triangles share one apex vertex. A closed surface is welded around and its ruling at
+//!   u = 0 is a cut ([`Solved::seam`], the surface's `cuts`): the unfolder opens it there and
+//!   the pattern stage sees a seam (glue tab, matched marks) instead of two loose ends.
 //! - A striction point (where rulings cross, the curve of regression) at a parameter v in
 //!   [0, 1] of a sampled ruling is refused, naming u (0-based span parameter) and v; a cone's
 //!   apex (v = 1) is allowed.
@@ -63,10 +64,28 @@ pub struct SplineSpec {
     pub bend_lines: BendLines,
 }
 
+/// A solved design as the output keeps it (`--spline-json`): the model and where its curves
+/// are in the sampled mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Design {
+    pub model: Model,
+    /// The output parameters (the sampled rulings), over `[0, spans]`.
+    pub params: Vec<f64>,
+    /// For each curve (then the apex, for a cone), its mesh vertices at `params` (the apex:
+    /// one vertex).
+    pub curve_verts: Vec<Vec<usize>>,
+}
+
 /// The solved surface, sampled.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solved {
     pub model: Model,
+    /// The output parameters and each curve's vertices in `mesh`.
+    pub params: Vec<f64>,
+    pub curve_verts: Vec<Vec<usize>>,
+    /// A closed surface's seam: the rulings at u = 0 (their two vertices, smaller first),
+    /// where the mesh, welded around, is cut open.
+    pub seam: Vec<[usize; 2]>,
     pub report: Report,
     pub mesh: Mesh,
     pub bends: Vec<Bend>,
@@ -245,6 +264,17 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     let params = sample_params(&m, spec.tolerance);
     check_striction(&m, &params)?;
     let sampled = sample_mesh(&m, &params);
+    let curve_verts = sampled.curve_verts;
+    let seam = if m.basis.closed() {
+        let mut s: Vec<[usize; 2]> = curve_verts
+            .windows(2)
+            .map(|w| [w[0][0].min(w[1][0]), w[0][0].max(w[1][0])])
+            .collect();
+        s.sort_unstable();
+        s
+    } else {
+        Vec::new()
+    };
     let mesh = sampled.mesh;
     let mut bends = bends(&mesh, &sampled.rulings, spec.bend_lines);
     bends.extend(crease_bends(&mesh, &sampled.creases));
@@ -277,6 +307,9 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     ];
     Ok(Solved {
         model: m,
+        params,
+        curve_verts,
+        seam,
         report,
         mesh,
         bends,
@@ -377,6 +410,8 @@ struct Sampled {
     creases: Vec<(usize, usize, usize)>,
     /// Vertices on the interior curves, ends left out.
     crease_verts: Vec<usize>,
+    /// Each curve's vertices (then the apex's one).
+    curve_verts: Vec<Vec<usize>>,
 }
 
 /// Sample the model into triangles whose rulings are edges.
@@ -391,10 +426,17 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
     let k = params.len();
     let mut row_a: Vec<usize> = Vec::new();
     let first = strips(m).first().map_or(0, |s| s.0);
-    for &u in params {
+    // A closed surface is welded around: the last ruling is the first one.
+    let weld = m.basis.closed();
+    for (i, &u) in params.iter().enumerate() {
+        if weld && i + 1 == k {
+            row_a.push(row_a[0]);
+            continue;
+        }
         row_a.push(vertices.len());
         vertices.push(at(m, Some(first), u).0);
     }
+    let mut curve_verts = vec![row_a.clone()];
     for (a, b) in strips(m) {
         debug_assert!(a + 1 == b.unwrap_or(a + 1) || b.is_none());
         let face0 = faces.len();
@@ -402,6 +444,7 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
             None => {
                 let apex = vertices.len();
                 vertices.push(m.apex.unwrap_or_default());
+                curve_verts.push(vec![apex]);
                 for i in 0..k - 1 {
                     let f = [row_a[i], row_a[i + 1], apex];
                     faces.push(Face {
@@ -418,13 +461,16 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
                 if !pending.is_empty() {
                     crease_verts.extend_from_slice(&row_a[1..k - 1]);
                 }
-                let row_b: Vec<usize> = params
-                    .iter()
-                    .map(|&u| {
-                        vertices.push(m.basis.eval(&m.curves[b], u));
-                        vertices.len() - 1
-                    })
-                    .collect();
+                let mut row_b: Vec<usize> = Vec::with_capacity(k);
+                for (i, &u) in params.iter().enumerate() {
+                    if weld && i + 1 == k {
+                        row_b.push(row_b[0]);
+                        continue;
+                    }
+                    vertices.push(m.basis.eval(&m.curves[b], u));
+                    row_b.push(vertices.len() - 1);
+                }
+                curve_verts.push(row_b.clone());
                 let before = std::mem::take(&mut pending);
                 for i in 0..k - 1 {
                     if let Some(&(f, corner)) = before.get(i) {
@@ -455,6 +501,7 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
         rulings,
         creases,
         crease_verts,
+        curve_verts,
     }
 }
 
