@@ -30,6 +30,7 @@ fn chain(curves: usize, count: usize) -> Model {
         apex: None,
         fixed: Vec::new(),
         creases: Vec::new(),
+        target: None,
     }
 }
 

@@ -478,7 +478,7 @@ impl Ctx<'_> {
                 SurfaceKind::Strip => self.strip_surface(s, &key, header_line, dir)?,
                 SurfaceKind::Boundary => self.boundary_surface(s, &key, header_line, dir)?,
                 SurfaceKind::Mesh => self.mesh_surface(s, &key, header_line, dir)?,
-                SurfaceKind::Spline => self.spline_surface(s, &key, header_line)?,
+                SurfaceKind::Spline => self.spline_surface(s, &key, header_line, dir)?,
             };
             surface.size = self
                 .number(&s.size, &format!("{key}.size"), MM_POSITIVE, |v| v > 0.0)?

@@ -77,6 +77,7 @@ pub(super) struct RawSurface {
     pub(super) iterations: Option<Spanned<Val>>,
     pub(super) epsilon1: Option<Spanned<Val>>,
     pub(super) epsilon2: Option<Spanned<Val>>,
+    pub(super) target: Option<Spanned<toml::Value>>,
 }
 
 #[derive(serde::Deserialize)]

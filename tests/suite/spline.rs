@@ -483,3 +483,80 @@ fn spline_lamp_pattern_is_one_sheet_folded_on_its_circle_with_a_glued_seam() {
     assert!(rel(flat, crease) < 1e-3, "{flat} vs {crease}");
     assert!(folds.iter().all(|f| f["kind"] == folds[0]["kind"]));
 }
+
+#[test]
+fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
+    require_shared!();
+    let dir = scratch("spline-target");
+    let mesh = shared_data("meshes/cylinder.obj");
+    let spec = dir.join("spline.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "name = \"spline\"\n[[surface]]\nkind = \"spline\"\ntarget = {{ path = {:?}, scale = 100 }}\nbend_lines = \"none\"\n[sheet]\nwidth = 1000\nheight = 1000\n",
+            mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let json = dir.join("design.json");
+    let report = cut(&dir, &spec, &["--spline-json", json.to_str().unwrap()]);
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let s = &d["surfaces"][0];
+    let curves: Vec<Vec<DVec3>> = s["curves"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            c.as_array()
+                .unwrap()
+                .iter()
+                .map(|p| {
+                    DVec3::new(
+                        p[0].as_f64().unwrap(),
+                        p[1].as_f64().unwrap(),
+                        p[2].as_f64().unwrap(),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    assert_eq!(curves.len(), 2);
+    let basis = BSpline::new(3, curves[0].len(), false).unwrap();
+    // Rulings along the cylinder's axis (x).
+    let mut worst: f64 = 0.0;
+    for k in 0..=200 {
+        let u = basis.spans() as f64 * k as f64 / 200.0;
+        let e = basis.eval(&curves[1], u) - basis.eval(&curves[0], u);
+        worst = worst.max(e.angle_between(DVec3::X * e.x.signum()).to_degrees());
+    }
+    // Distances of the target's vertices (mm) from the solved surface.
+    let raw = flatcut::surface::import::read(&mesh).unwrap();
+    let mut target_mesh = raw.mesh;
+    target_mesh.vertices.iter_mut().for_each(|p| *p *= 100.0);
+    let model = flatcut::surface::spline::Model {
+        basis: basis.clone(),
+        curves,
+        apex: None,
+        fixed: Vec::new(),
+        creases: Vec::new(),
+        target: Some(flatcut::surface::spline::target::Target::from_mesh(
+            &target_mesh,
+        )),
+    };
+    let dist = flatcut::surface::spline::target_distances(&model);
+    let within = dist.iter().filter(|&&x| x <= 0.3).count() as f64 / dist.len() as f64;
+    let sine = flatcut::surface::spline::dense_sine(&model, 200);
+    eprintln!(
+        "target: rulings within {worst:.4}° of the axis, {:.1} % of {} vertices within 0.3 mm (RMS {:.3} mm, coverage {}), sine {sine:.2e} after {} iterations",
+        100.0 * within,
+        dist.len(),
+        figure(&report, "approximation_rms_mm"),
+        figure(&report, "coverage"),
+        figure(&report, "iterations")
+    );
+    assert!(worst <= 0.5, "rulings {worst}° off the axis");
+    assert!(within >= 0.9, "{within}");
+    assert!(sine <= 1e-6, "{sine}");
+    assert_eq!(report["pieces"].as_array().unwrap().len(), 1);
+}

@@ -37,6 +37,7 @@
 //! - A final sine above 1e-6 is a warning.
 
 pub mod solve;
+pub mod target;
 
 use super::strip::BendLines;
 use super::Bend;
@@ -58,6 +59,9 @@ pub struct SplineSpec {
     pub fixed: Vec<(usize, usize)>,
     /// The condition on each interior curve (entry k for curve k + 1); empty: all `free`.
     pub creases: Vec<Crease>,
+    /// A shape to approximate (eq. 9–11); without `curves` the start is its principal
+    /// rectangle.
+    pub target: Option<target::Target>,
     pub options: SolveOptions,
     /// Chordal tolerance of the output sampling (mm).
     pub tolerance: f64,
@@ -119,8 +123,32 @@ impl SplineError {
 
 /// Check the spec's shapes and build the model.
 pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
-    let count = spec.curves.first().map_or(0, Vec::len);
     let shape = |key: String, message: String| SplineError::Shape { key, message };
+    let started;
+    let spec = match (&spec.target, spec.curves.is_empty()) {
+        (Some(t), true) => {
+            if spec.closed {
+                return Err(shape(
+                    "closed".into(),
+                    "a start from the target's principal rectangle is open; give `curves` for a closed surface".into(),
+                ));
+            }
+            let curves = t.principal_rectangle(RECTANGLE_POINTS).ok_or_else(|| {
+                shape(
+                    "target".into(),
+                    "has no extent in two directions: no rectangle to start from; give `curves`"
+                        .into(),
+                )
+            })?;
+            started = SplineSpec {
+                curves,
+                ..spec.clone()
+            };
+            &started
+        }
+        _ => spec,
+    };
+    let count = spec.curves.first().map_or(0, Vec::len);
     if !(2..=5).contains(&spec.degree) {
         return Err(shape(
             "degree".into(),
@@ -190,6 +218,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         apex: spec.apex,
         fixed: spec.fixed.clone(),
         creases: spec.creases.clone(),
+        target: spec.target.clone(),
     };
     let straight = solve::STRAIGHT / diameter(&m);
     for (k, &kind) in spec.creases.iter().enumerate() {
@@ -218,6 +247,12 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
     }
     Ok(m)
 }
+
+/// A target point within this distance (mm) of the surface counts as covered (`coverage`).
+pub const COVERAGE_MM: f64 = 0.5;
+
+/// Control points per curve of a start from a target's principal rectangle.
+pub const RECTANGLE_POINTS: usize = 8;
 
 /// Most control points of one surface (all curves and the apex).
 pub const MAX_CONTROL_POINTS: usize = 20_000;
@@ -295,7 +330,7 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
             report.iterations
         ));
     }
-    let figures = vec![
+    let mut figures = vec![
         ("iterations", report.iterations as f64),
         ("largest_sine", sine),
         ("solver_sine", report.sines.last().copied().unwrap_or(0.0)),
@@ -305,6 +340,19 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
         ("crease_sine", crease_sine),
         ("crease_angle_defect", defect),
     ];
+    let dist = target_distances(&m);
+    if !dist.is_empty() {
+        let n = dist.len() as f64;
+        let rms = (dist.iter().map(|d| d * d).sum::<f64>() / n).sqrt();
+        let covered = dist.iter().filter(|&&d| d <= COVERAGE_MM).count() as f64 / n;
+        figures.push(("approximation_rms_mm", rms));
+        figures.push((
+            "approximation_max_mm",
+            dist.iter().copied().fold(0.0, f64::max),
+        ));
+        figures.push(("coverage", covered));
+        figures.push(("target_points", n));
+    }
     Ok(Solved {
         model: m,
         params,
@@ -335,6 +383,36 @@ fn at(m: &Model, c: Option<usize>, u: f64) -> (DVec3, Option<DVec3>) {
         ),
         None => (m.apex.unwrap_or_default(), None),
     }
+}
+
+/// The distance (mm) of each target point from the surface (its footpoint on the nearest
+/// strip); empty without a target.
+pub fn target_distances(m: &Model) -> Vec<f64> {
+    let Some(t) = &m.target else {
+        return Vec::new();
+    };
+    let refs: Vec<target::StripRef> = strips(m)
+        .into_iter()
+        .map(|(a, b)| target::StripRef {
+            basis: &m.basis,
+            a: &m.curves[a],
+            b: match b {
+                Some(b) => Ok(&m.curves[b]),
+                None => Err(m.apex.unwrap_or_default()),
+            },
+        })
+        .collect();
+    let grids: Vec<_> = refs.iter().map(|r| r.grid()).collect();
+    t.points
+        .iter()
+        .map(|&q| {
+            refs.iter()
+                .zip(&grids)
+                .map(|(r, g)| r.footpoint(g, q).2)
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
+        })
+        .collect()
 }
 
 /// The largest intrinsic developability sine at `per` parameters per span.

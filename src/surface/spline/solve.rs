@@ -36,6 +36,7 @@
 //!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
 //!   nothing and is left out. Smooth: n_L − n_R = 0.
 
+use super::target::{StripRef, Target};
 use crate::geom::bspline::{apply, BSpline};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -105,6 +106,8 @@ pub struct Model {
     pub fixed: Vec<(usize, usize)>,
     /// The condition on each interior curve (curve k + 1 for entry k); shorter means `Free`.
     pub creases: Vec<Crease>,
+    /// A shape to approximate (eq. 9–11); `None` for none.
+    pub target: Option<Target>,
 }
 
 impl Model {
@@ -167,9 +170,32 @@ struct Layout {
     fair: Vec<Expr>,
     /// Their values in the input (the fairness target s).
     fair_s: Vec<DVec3>,
+    /// Target points and unit normals (eq. 9–11), in the scaled frame.
+    target: Vec<(DVec3, DVec3)>,
+    /// The strips: (curve a, curve b or `None` for the apex).
+    strips: Vec<(usize, Option<usize>)>,
     /// Number of unknowns.
     n: usize,
 }
+
+/// A target point's footpoint at the current iterate: strip, parameters and the surface's
+/// unit normal there (held fixed within the iteration, as Fig. 16 does).
+#[derive(Debug, Clone, Copy)]
+struct Foot {
+    strip: usize,
+    u: f64,
+    v: f64,
+    n: DVec3,
+}
+
+/// A target fit has converged when its RMS distance changes by less than this (relative to
+/// the model's diameter) in one iteration.
+const TARGET_CONVERGED: f64 = 1e-7;
+
+/// Weights of eq. 9, 10 and 11 (Fig. 17's footnote: 1e-3, 1e-4, 1e-2).
+const W9: f64 = 1e-3;
+const W10: f64 = 1e-4;
+const W11: f64 = 1e-2;
 
 struct Sample {
     u: f64,
@@ -247,7 +273,7 @@ pub fn crease_sine(kind: Crease, el: DVec3, er: DVec3, t: DVec3, d2: DVec3, stra
     }
 }
 
-fn layout(m: &Model, points: Vec<DVec3>) -> Layout {
+fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout {
     let count = m.basis.count();
     let nc = m.curves.len();
     let mut var = vec![None; points.len()];
@@ -334,6 +360,8 @@ fn layout(m: &Model, points: Vec<DVec3>) -> Layout {
         creases,
         fair,
         fair_s,
+        target,
+        strips,
         n,
     }
 }
@@ -492,8 +520,9 @@ fn bilinear(l: &Layout, x: &[f64], s: &Sample, expr: &Expr, rows: &mut Vec<Row>)
 }
 
 /// Every linearised row at `x`: the constraints (H, r) and the fairness (K, s) weighted ε₁.
-fn rows(l: &Layout, x: &[f64], eps1: f64) -> Vec<Row> {
+fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec<Row> {
     let mut rows = Vec::new();
+    target_rows(l, basis, feet, &mut rows);
     for s in &l.samples {
         bilinear(l, x, s, &s.e, &mut rows);
         bilinear(l, x, s, &s.ta, &mut rows);
@@ -528,6 +557,150 @@ fn rows(l: &Layout, x: &[f64], eps1: f64) -> Vec<Row> {
         }
     }
     rows
+}
+
+/// The strip `k` of the layout's points as the footpoint search sees it.
+fn strip_ref<'a>(l: &'a Layout, basis: &'a BSpline, k: usize) -> StripRef<'a> {
+    let count = basis.count();
+    let (a, b) = l.strips[k];
+    let curve = |c: usize| &l.points[c * count..(c + 1) * count];
+    StripRef {
+        basis,
+        a: curve(a),
+        b: match b {
+            Some(b) => Ok(curve(b)),
+            None => Err(l.points[l.points.len() - 1]),
+        },
+    }
+}
+
+/// The footpoint of every target point on its nearest strip, with the surface normal there.
+fn feet(l: &Layout, basis: &BSpline) -> Vec<Foot> {
+    let grids: Vec<_> = (0..l.strips.len())
+        .map(|k| strip_ref(l, basis, k).grid())
+        .collect();
+    l.target
+        .iter()
+        .map(|&(q, _)| {
+            let mut best = (
+                f64::INFINITY,
+                Foot {
+                    strip: 0,
+                    u: 0.0,
+                    v: 0.0,
+                    n: DVec3::ZERO,
+                },
+            );
+            for (k, grid) in grids.iter().enumerate() {
+                let st = strip_ref(l, basis, k);
+                let (u, v, d) = st.footpoint(grid, q);
+                if d < best.0 {
+                    let (_, su, sv) = st.eval(u, v);
+                    let n = su.cross(sv).normalize_or_zero();
+                    best = (d, Foot { strip: k, u, v, n });
+                }
+            }
+            best.1
+        })
+        .collect()
+}
+
+/// Expressions of s(u, v), e = b(u) − a(u) and a′(u) on strip `k`.
+fn foot_exprs(l: &Layout, basis: &BSpline, f: &Foot) -> (Expr, Expr, Expr) {
+    let count = basis.count();
+    let (a, b) = l.strips[f.strip];
+    let r = basis.rows(f.u);
+    let on = |c: usize, row: &[(usize, f64)], k: f64| -> Expr {
+        row.iter().map(|&(j, w)| (c * count + j, k * w)).collect()
+    };
+    let apex = l.points.len() - 1;
+    let (mut s, mut e) = (on(a, &r.point, 1.0 - f.v), on(a, &r.point, -1.0));
+    match b {
+        Some(b) => {
+            s.extend(on(b, &r.point, f.v));
+            e.extend(on(b, &r.point, 1.0));
+        }
+        None => {
+            s.push((apex, f.v));
+            e.push((apex, 1.0));
+        }
+    }
+    (s, e, on(a, &r.d1, 1.0))
+}
+
+/// The row ⟨d, Σ w·P⟩ = rhs with weight `w`, fixed points moved to the right-hand side.
+fn dot_row(l: &Layout, expr: &Expr, d: DVec3, rhs: f64, w: f64) -> Row {
+    let mut entries = Vec::with_capacity(3 * expr.len());
+    let mut rhs = rhs;
+    for &(p, k) in expr {
+        match l.var[p] {
+            Some(o) => {
+                for c in 0..3 {
+                    if d[c] != 0.0 {
+                        entries.push((o + c, k * d[c]));
+                    }
+                }
+            }
+            None => rhs -= k * d.dot(l.points[p]),
+        }
+    }
+    Row { entries, rhs, w }
+}
+
+/// Eq. 9–11 at the footpoints: s(u, v) = q (three rows), ⟨m, e⟩/|e| = ⟨m, a′⟩/|a′| = 0 and
+/// ⟨s(u, v) − q, n⟩ = 0 with n held fixed.
+fn target_rows(l: &Layout, basis: &BSpline, feet: &[Foot], rows: &mut Vec<Row>) {
+    for (f, &(q, m)) in feet.iter().zip(&l.target) {
+        let (s, e, ta) = foot_exprs(l, basis, f);
+        for c in 0..3 {
+            rows.push(dot_row(l, &s, DVec3::AXES[c], q[c], w9(l, basis, f)));
+        }
+        for d in [&e, &ta] {
+            let len = eval(d, &l.points).length();
+            if len > 1e-12 {
+                rows.push(dot_row(l, d, m / len, 0.0, W10));
+            }
+        }
+        if f.n != DVec3::ZERO {
+            rows.push(dot_row(l, &s, f.n, f.n.dot(q), W11));
+        }
+    }
+}
+
+/// The weight of eq. 9 at a footpoint: [`W9`] inside the strip, [`W11`] on its edge (where
+/// the target goes on beyond the strip, eq. 9 is what makes it grow).
+fn w9(l: &Layout, basis: &BSpline, f: &Foot) -> f64 {
+    let spans = basis.spans() as f64;
+    let on_end = !basis.closed() && (f.u <= 1e-9 || f.u >= spans - 1e-9);
+    let (a, b) = l.strips[f.strip];
+    // An edge curve: the first curve of the chain at v = 0, the last at v = 1.
+    let first = a == 0 && f.v <= 1e-9;
+    let last = b == Some(l.strips.len()) && f.v >= 1.0 - 1e-9;
+    if on_end || first || last {
+        W11
+    } else {
+        W9
+    }
+}
+
+/// The weighted squared residual of eq. 9–11 at `feet` and the mean squared distance.
+fn target_merit(l: &Layout, basis: &BSpline, feet: &[Foot]) -> (f64, f64) {
+    let (mut sum, mut dist) = (0.0, 0.0);
+    for (f, &(q, m)) in feet.iter().zip(&l.target) {
+        let (s, e, ta) = foot_exprs(l, basis, f);
+        let r = eval(&s, &l.points) - q;
+        dist += r.length_squared();
+        let w = w9(l, basis, f);
+        sum += w * w * r.length_squared() + W11 * W11 * r.dot(f.n).powi(2);
+        for d in [&e, &ta] {
+            let d = eval(d, &l.points);
+            let len = d.length();
+            if len > 1e-12 {
+                sum += W10 * W10 * (m.dot(d) / len).powi(2);
+            }
+        }
+    }
+    (sum, dist / feet.len().max(1) as f64)
 }
 
 /// The normal equations' lower triangle and right-hand side.
@@ -589,6 +762,11 @@ fn flat_points(m: &Model) -> Vec<DVec3> {
 /// One prepared problem, in the scaled frame: for the solver and the benchmark.
 pub struct Problem {
     l: Layout,
+    basis: BSpline,
+    /// The target's footpoints (empty without a target), and whether they are those of the
+    /// current iterate.
+    feet: Vec<Foot>,
+    feet_fresh: bool,
     x: Vec<f64>,
     centre: DVec3,
     diameter: f64,
@@ -601,11 +779,14 @@ impl Problem {
     /// Scale the model to diameter 1 and set up the unknowns and the initial normals.
     pub fn new(m: &Model) -> Result<Problem, SolveError> {
         let pts = flat_points(m);
+        let target: &[DVec3] = m.target.as_ref().map_or(&[], |t| &t.points);
         let lo = pts
             .iter()
+            .chain(target)
             .fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
         let hi = pts
             .iter()
+            .chain(target)
             .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
         let diameter = (hi - lo).length();
         if !(diameter > 0.0 && diameter.is_finite()) {
@@ -613,7 +794,14 @@ impl Problem {
         }
         let centre = 0.5 * (lo + hi);
         let scaled = pts.iter().map(|p| (*p - centre) / diameter).collect();
-        let l = layout(m, scaled);
+        let target = m.target.as_ref().map_or(Vec::new(), |t| {
+            t.points
+                .iter()
+                .zip(&t.normals)
+                .map(|(p, n)| ((*p - centre) / diameter, *n))
+                .collect()
+        });
+        let l = layout(m, scaled, target);
         let mut x = vec![0.0; l.n];
         for (p, v) in l.var.iter().enumerate() {
             if let Some(o) = *v {
@@ -622,8 +810,13 @@ impl Problem {
         }
         initial_normals(&l, &mut x)?;
         let (merit, sine) = residual(&l, &x);
+        let basis = m.basis.clone();
+        let feet = feet(&l, &basis);
         Ok(Problem {
             l,
+            basis,
+            feet,
+            feet_fresh: true,
             x,
             centre,
             diameter,
@@ -643,9 +836,28 @@ impl Problem {
         self.l.n
     }
 
+    /// Whether a target is approximated.
+    pub fn has_target(&self) -> bool {
+        !self.l.target.is_empty()
+    }
+
+    /// The root mean square distance (mm) of the target points from their footpoints.
+    pub fn target_rms_mm(&self) -> f64 {
+        target_merit(&self.l, &self.basis, &self.feet).1.sqrt() * self.diameter
+    }
+
     /// One round of guided projection with fairness weight `eps1`.
     pub fn iterate(&mut self, eps1: f64, eps2: f64, iteration: usize) -> Result<(), SolveError> {
-        let rows = rows(&self.l, &self.x, eps1);
+        if self.has_target() {
+            // Footpoints found again every iteration (§4.2); the merit counts eq. 9–11 at them.
+            if !self.feet_fresh {
+                self.feet = feet(&self.l, &self.basis);
+            }
+            self.feet_fresh = false;
+            self.merit =
+                residual(&self.l, &self.x).0 + target_merit(&self.l, &self.basis, &self.feet).0;
+        }
+        let rows = rows(&self.l, &self.x, eps1, &self.basis, &self.feet);
         let (t, b) = normal_equations(self.l.n, &rows, &self.x, eps2);
         let full = sparse_solve(self.l.n, &t, &b, &mut self.symbolic)?;
         if full.iter().any(|v| !v.is_finite()) {
@@ -663,6 +875,7 @@ impl Problem {
             self.l.points.clone_from(&old_points);
             unpack(&mut self.l, &self.x);
             let (merit, sine) = residual(&self.l, &self.x);
+            let merit = merit + target_merit(&self.l, &self.basis, &self.feet).0;
             if merit <= self.merit || step < 0.01 {
                 self.merit = merit;
                 self.sine = sine;
@@ -689,7 +902,10 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
     let mut pr = Problem::new(m)?;
     let mut sines = vec![pr.sine()];
     let mut it = 0;
-    while it < o.max_iterations && pr.sine() > o.stop_sine {
+    // With a target, the solve goes on until the distance stops improving too.
+    let mut converged = !pr.has_target();
+    let mut last_rms = f64::INFINITY;
+    while it < o.max_iterations && (pr.sine() > o.stop_sine || !converged) {
         let (eps1, eps2) = if it < o.iterations {
             (o.epsilon1 * 0.9f64.powi(it as i32), o.epsilon2)
         } else {
@@ -702,6 +918,13 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
         pr.iterate(eps1, eps2, it + 1)?;
         it += 1;
         sines.push(pr.sine());
+        if pr.has_target() {
+            pr.feet = feet(&pr.l, &pr.basis);
+            pr.feet_fresh = true;
+            let rms = pr.target_rms_mm();
+            converged = (last_rms - rms).abs() <= TARGET_CONVERGED * pr.diameter;
+            last_rms = rms;
+        }
     }
     let after = pr.points_mm();
     let moved = before

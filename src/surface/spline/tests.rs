@@ -10,6 +10,7 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         closed,
         fixed: Vec::new(),
         creases: Vec::new(),
+        target: None,
         options: SolveOptions::default(),
         tolerance: 0.05,
         bend_lines: BendLines::All,
