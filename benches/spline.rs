@@ -31,6 +31,7 @@ fn chain(curves: usize, count: usize) -> Model {
         fixed: Vec::new(),
         creases: Vec::new(),
         target: None,
+        handles: Vec::new(),
     }
 }
 

@@ -65,6 +65,7 @@ impl Ctx<'_> {
         let closed = self.boolean(&s.closed, &k("closed"))?.unwrap_or(false);
         let creases = self.spline_creases(s, key)?;
         let fixed = self.spline_fixed(s, key, &curves, apex.is_some())?;
+        let handles = self.spline_handles(s, key)?;
         let d = SolveOptions::default();
         let count = |v: &super::context::Opt, name: &str, min: f64| {
             self.number(
@@ -105,6 +106,7 @@ impl Ctx<'_> {
             fixed,
             creases,
             target,
+            handles,
             options,
             tolerance,
             bend_lines,
@@ -273,6 +275,55 @@ impl Ctx<'_> {
         Ok(Some(target))
     }
 
+    /// `handles = [{ at = [x, y, z], to = [x, y, z] }, ...]`: a point of the surface as given
+    /// (its nearest point is taken) dragged towards `to`.
+    fn spline_handles(&self, s: &RawSurface, key: &str) -> Result<Vec<(DVec3, DVec3)>, SpecError> {
+        let hk = format!("{key}.handles");
+        let Some(v) = &s.handles else {
+            return Ok(Vec::new());
+        };
+        let line = self.line(v.span());
+        const WHAT: &str = "a list of tables { at = [x, y, z], to = [x, y, z] }";
+        let Value::Array(items) = v.get_ref() else {
+            return Err(self.invalid(line, &hk, format!("must be {WHAT}, got {}", v.get_ref())));
+        };
+        let mut out = Vec::new();
+        for (i, it) in items.iter().enumerate() {
+            let ik = format!("{hk}[{}]", i + 1);
+            let Value::Table(t) = it else {
+                return Err(self.invalid(
+                    line,
+                    &ik,
+                    format!("must be a table {{ at = [x, y, z], to = [x, y, z] }}, got {it}"),
+                ));
+            };
+            if let Some(bad) = t.keys().find(|k| !matches!(k.as_str(), "at" | "to")) {
+                return Err(self.invalid(
+                    line,
+                    &format!("{ik}.{bad}"),
+                    "is not a handle key; a handle takes `at` and `to`".into(),
+                ));
+            }
+            let pt = |name: &str| -> Result<DVec3, SpecError> {
+                match t.get(name) {
+                    Some(Value::Array(a)) => self.point(a, &format!("{ik}.{name}"), line),
+                    Some(o) => Err(self.invalid(
+                        line,
+                        &format!("{ik}.{name}"),
+                        format!("must be a point [x, y, z], got {o}"),
+                    )),
+                    None => Err(self.invalid(
+                        line,
+                        &format!("{ik}.{name}"),
+                        "missing: a handle needs `at` and `to`".into(),
+                    )),
+                }
+            };
+            out.push((pt("at")?, pt("to")?));
+        }
+        Ok(out)
+    }
+
     /// `creases`: one name per interior curve.
     fn spline_creases(&self, s: &RawSurface, key: &str) -> Result<Vec<Crease>, SpecError> {
         let ck = format!("{key}.creases");
@@ -423,9 +474,22 @@ impl Ctx<'_> {
                 ("side", span(&s.side)),
                 ("k_factor", span(&s.k_factor)),
             ],
-            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
+            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
         )?;
-        self.no_bent_keys(s, key)?;
+        self.refuse(
+            key,
+            &[
+                ("outline", span(&s.outline)),
+                ("holes", span(&s.holes)),
+                ("line", span(&s.line)),
+                ("arc", span(&s.arc)),
+                ("flat_curve", span(&s.flat_curve)),
+                ("control_points", span(&s.control_points)),
+                ("length_fit", span(&s.length_fit)),
+                ("pieces", span(&s.pieces)),
+            ],
+            "is for bent sheets (kind = \"bent-sheet\")",
+        )?;
         self.refuse(
             key,
             &[

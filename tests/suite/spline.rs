@@ -426,6 +426,11 @@ fn spline_bad_input_exits_1_with_file_line_and_key() {
             "surface[1].curves[1][2]",
         ),
         ("curves = 3".into(), 3, "surface[1].curves"),
+        (format!("{two}\nhandles = [{{ at = [0, 0, 0] }}]"), 7, "surface[1].handles[1].to"),
+        (format!("{two}\nhandles = [{{ at = [0, 0, 0], to = [1, 2], by = 3 }}]"), 7, "surface[1].handles[1].by"),
+        (format!("{two}\nhandles = 4"), 7, "surface[1].handles"),
+        (format!("{two}\ntarget = \"missing.obj\""), 7, "surface[1].target"),
+        (format!("{two}\ntarget = {{ path = \"x.csv\", scale = -1 }}"), 7, "surface[1].target.scale"),
         ("curves = [3, 4]".into(), 3, "surface[1].curves[1]"),
         // Rulings that all cross the strip's middle: refused at the line of `curves`.
         (
@@ -543,6 +548,7 @@ fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
         target: Some(flatcut::surface::spline::target::Target::from_mesh(
             &target_mesh,
         )),
+        handles: Vec::new(),
     };
     let dist = flatcut::surface::spline::target_distances(&model);
     let within = dist.iter().filter(|&&x| x <= 0.3).count() as f64 / dist.len() as f64;
@@ -559,4 +565,49 @@ fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
     assert!(within >= 0.9, "{within}");
     assert!(sine <= 1e-6, "{sine}");
     assert_eq!(report["pieces"].as_array().unwrap().len(), 1);
+}
+
+#[test]
+fn spline_handle_drags_a_corner_and_the_fixed_edge_stays() {
+    let dir = scratch("spline-handle");
+    let a: Vec<DVec3> = (0..5)
+        .map(|i| DVec3::new(50.0 * i as f64, 0.0, 0.0))
+        .collect();
+    let b: Vec<DVec3> = a.iter().map(|p| *p + 120.0 * DVec3::Y).collect();
+    let spec = spline_spec(
+        &dir,
+        &[a.clone(), b],
+        "fixed = [1]\nhandles = [{ at = [200, 120, 0], to = [190, 100, 50] }]",
+    );
+    let json = dir.join("design.json");
+    let report = cut(&dir, &spec, &["--spline-json", json.to_str().unwrap()]);
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let curve = |c: usize| -> Vec<DVec3> {
+        d["surfaces"][0]["curves"][c]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                DVec3::new(
+                    p[0].as_f64().unwrap(),
+                    p[1].as_f64().unwrap(),
+                    p[2].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(curve(0), a, "the fixed edge stays");
+    // The corner is the last control point of the clamped curve 2.
+    let corner = *curve(1).last().unwrap();
+    let goal = DVec3::new(190.0, 100.0, 50.0);
+    eprintln!(
+        "handle: corner at {corner} ({:.2e} mm from the goal) after {} iterations, sine {:.2e}",
+        corner.distance(goal),
+        figure(&report, "iterations"),
+        figure(&report, "largest_sine")
+    );
+    assert!(corner.distance(goal) < 1e-6);
+    assert!(figure(&report, "handle_distance_mm") < 1e-6);
+    assert!(figure(&report, "largest_sine") <= 1e-6);
 }

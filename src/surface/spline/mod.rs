@@ -62,6 +62,8 @@ pub struct SplineSpec {
     /// A shape to approximate (eq. 9–11); without `curves` the start is its principal
     /// rectangle.
     pub target: Option<target::Target>,
+    /// Handles (at, to): a point of the surface as given dragged towards a 3D position (mm).
+    pub handles: Vec<(DVec3, DVec3)>,
     pub options: SolveOptions,
     /// Chordal tolerance of the output sampling (mm).
     pub tolerance: f64,
@@ -219,6 +221,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         fixed: spec.fixed.clone(),
         creases: spec.creases.clone(),
         target: spec.target.clone(),
+        handles: spec.handles.clone(),
     };
     let straight = solve::STRAIGHT / diameter(&m);
     for (k, &kind) in spec.creases.iter().enumerate() {
@@ -340,6 +343,9 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
         ("crease_sine", crease_sine),
         ("crease_angle_defect", defect),
     ];
+    if !m.handles.is_empty() {
+        figures.push(("handle_distance_mm", report.handle_distance));
+    }
     let dist = target_distances(&m);
     if !dist.is_empty() {
         let n = dist.len() as f64;

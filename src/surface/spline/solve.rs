@@ -108,6 +108,9 @@ pub struct Model {
     pub creases: Vec<Crease>,
     /// A shape to approximate (eq. 9–11); `None` for none.
     pub target: Option<Target>,
+    /// Handles: a point on the surface as given (`at`) dragged towards a 3D position (`to`),
+    /// as (at, to), in millimetres.
+    pub handles: Vec<(DVec3, DVec3)>,
 }
 
 impl Model {
@@ -131,6 +134,8 @@ pub struct Report {
     pub sines: Vec<f64>,
     /// Largest distance a control point moved (mm).
     pub moved: f64,
+    /// Largest distance of a handle from its goal at the end (mm); 0 without handles.
+    pub handle_distance: f64,
 }
 
 /// A solve that failed.
@@ -174,6 +179,8 @@ struct Layout {
     target: Vec<(DVec3, DVec3)>,
     /// The strips: (curve a, curve b or `None` for the apex).
     strips: Vec<(usize, Option<usize>)>,
+    /// Handles: where on the surface (found once, on the start) and the goal, scaled.
+    handles: Vec<(Foot, DVec3)>,
     /// Number of unknowns.
     n: usize,
 }
@@ -188,8 +195,12 @@ struct Foot {
     n: DVec3,
 }
 
-/// A target fit has converged when its RMS distance changes by less than this (relative to
-/// the model's diameter) in one iteration.
+/// The weight of a handle's three rows (Fig. 17: user-defined constraints weigh 1).
+const W_HANDLE: f64 = 1.0;
+
+/// A target fit or a drag by handles has converged when its goal measure (RMS distance plus
+/// the largest handle distance, relative to the model's diameter) changes by less than this
+/// in one iteration.
 const TARGET_CONVERGED: f64 = 1e-7;
 
 /// Weights of eq. 9, 10 and 11 (Fig. 17's footnote: 1e-3, 1e-4, 1e-2).
@@ -362,6 +373,7 @@ fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout 
         fair_s,
         target,
         strips,
+        handles: Vec::new(),
         n,
     }
 }
@@ -523,6 +535,12 @@ fn bilinear(l: &Layout, x: &[f64], s: &Sample, expr: &Expr, rows: &mut Vec<Row>)
 fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec<Row> {
     let mut rows = Vec::new();
     target_rows(l, basis, feet, &mut rows);
+    for (f, to) in &l.handles {
+        let (s, _, _) = foot_exprs(l, basis, f);
+        for c in 0..3 {
+            rows.push(dot_row(l, &s, DVec3::AXES[c], to[c], W_HANDLE));
+        }
+    }
     for s in &l.samples {
         bilinear(l, x, s, &s.e, &mut rows);
         bilinear(l, x, s, &s.ta, &mut rows);
@@ -683,6 +701,17 @@ fn w9(l: &Layout, basis: &BSpline, f: &Foot) -> f64 {
     }
 }
 
+/// The handles' weighted squared residual and their largest distance from the goal.
+fn handle_merit(l: &Layout, basis: &BSpline) -> (f64, f64) {
+    let (mut sum, mut worst) = (0.0, 0.0f64);
+    for (f, to) in &l.handles {
+        let d = eval(&foot_exprs(l, basis, f).0, &l.points).distance(*to);
+        sum += W_HANDLE * W_HANDLE * d * d;
+        worst = worst.max(d);
+    }
+    (sum, worst)
+}
+
 /// The weighted squared residual of eq. 9–11 at `feet` and the mean squared distance.
 fn target_merit(l: &Layout, basis: &BSpline, feet: &[Foot]) -> (f64, f64) {
     let (mut sum, mut dist) = (0.0, 0.0);
@@ -780,12 +809,15 @@ impl Problem {
     pub fn new(m: &Model) -> Result<Problem, SolveError> {
         let pts = flat_points(m);
         let target: &[DVec3] = m.target.as_ref().map_or(&[], |t| &t.points);
+        let goals: Vec<DVec3> = m.handles.iter().map(|h| h.1).collect();
         let lo = pts
             .iter()
+            .chain(&goals)
             .chain(target)
             .fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
         let hi = pts
             .iter()
+            .chain(&goals)
             .chain(target)
             .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
         let diameter = (hi - lo).length();
@@ -801,7 +833,42 @@ impl Problem {
                 .map(|(p, n)| ((*p - centre) / diameter, *n))
                 .collect()
         });
-        let l = layout(m, scaled, target);
+        let mut l = layout(m, scaled, target);
+        let basis = m.basis.clone();
+        let grids: Vec<_> = (0..l.strips.len())
+            .map(|k| strip_ref(&l, &basis, k).grid())
+            .collect();
+        l.handles = m
+            .handles
+            .iter()
+            .map(|&(at, to)| {
+                let q = (at - centre) / diameter;
+                let mut best = (
+                    f64::INFINITY,
+                    Foot {
+                        strip: 0,
+                        u: 0.0,
+                        v: 0.0,
+                        n: DVec3::ZERO,
+                    },
+                );
+                for (k, g) in grids.iter().enumerate() {
+                    let (u, v, d) = strip_ref(&l, &basis, k).footpoint(g, q);
+                    if d < best.0 {
+                        best = (
+                            d,
+                            Foot {
+                                strip: k,
+                                u,
+                                v,
+                                n: DVec3::ZERO,
+                            },
+                        );
+                    }
+                }
+                (best.1, (to - centre) / diameter)
+            })
+            .collect();
         let mut x = vec![0.0; l.n];
         for (p, v) in l.var.iter().enumerate() {
             if let Some(o) = *v {
@@ -810,7 +877,6 @@ impl Problem {
         }
         initial_normals(&l, &mut x)?;
         let (merit, sine) = residual(&l, &x);
-        let basis = m.basis.clone();
         let feet = feet(&l, &basis);
         Ok(Problem {
             l,
@@ -839,6 +905,24 @@ impl Problem {
     /// Whether a target is approximated.
     pub fn has_target(&self) -> bool {
         !self.l.target.is_empty()
+    }
+
+    /// Whether there are goals besides the constraints (a target, handles): the solve then
+    /// goes on until they stop improving.
+    pub fn has_goals(&self) -> bool {
+        self.has_target() || !self.l.handles.is_empty()
+    }
+
+    /// The goals' measure of progress: RMS target distance plus the largest handle distance
+    /// (scaled).
+    fn goal(&self) -> f64 {
+        target_merit(&self.l, &self.basis, &self.feet).1.sqrt()
+            + handle_merit(&self.l, &self.basis).1
+    }
+
+    /// The largest distance (mm) of a handle from its goal.
+    pub fn handle_distance_mm(&self) -> f64 {
+        handle_merit(&self.l, &self.basis).1 * self.diameter
     }
 
     /// The root mean square distance (mm) of the target points from their footpoints.
@@ -875,7 +959,9 @@ impl Problem {
             self.l.points.clone_from(&old_points);
             unpack(&mut self.l, &self.x);
             let (merit, sine) = residual(&self.l, &self.x);
-            let merit = merit + target_merit(&self.l, &self.basis, &self.feet).0;
+            let merit = merit
+                + target_merit(&self.l, &self.basis, &self.feet).0
+                + handle_merit(&self.l, &self.basis).0;
             if merit <= self.merit || step < 0.01 {
                 self.merit = merit;
                 self.sine = sine;
@@ -903,8 +989,8 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
     let mut sines = vec![pr.sine()];
     let mut it = 0;
     // With a target, the solve goes on until the distance stops improving too.
-    let mut converged = !pr.has_target();
-    let mut last_rms = f64::INFINITY;
+    let mut converged = !pr.has_goals();
+    let mut last_goal = f64::INFINITY;
     while it < o.max_iterations && (pr.sine() > o.stop_sine || !converged) {
         let (eps1, eps2) = if it < o.iterations {
             (o.epsilon1 * 0.9f64.powi(it as i32), o.epsilon2)
@@ -918,12 +1004,14 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
         pr.iterate(eps1, eps2, it + 1)?;
         it += 1;
         sines.push(pr.sine());
-        if pr.has_target() {
-            pr.feet = feet(&pr.l, &pr.basis);
-            pr.feet_fresh = true;
-            let rms = pr.target_rms_mm();
-            converged = (last_rms - rms).abs() <= TARGET_CONVERGED * pr.diameter;
-            last_rms = rms;
+        if pr.has_goals() {
+            if pr.has_target() {
+                pr.feet = feet(&pr.l, &pr.basis);
+                pr.feet_fresh = true;
+            }
+            let goal = pr.goal();
+            converged = (last_goal - goal).abs() <= TARGET_CONVERGED;
+            last_goal = goal;
         }
     }
     let after = pr.points_mm();
@@ -949,5 +1037,6 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
         iterations: it,
         sines,
         moved,
+        handle_distance: pr.handle_distance_mm(),
     })
 }

@@ -11,6 +11,7 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         fixed: Vec::new(),
         creases: Vec::new(),
         target: None,
+        handles: Vec::new(),
         options: SolveOptions::default(),
         tolerance: 0.05,
         bend_lines: BendLines::All,
