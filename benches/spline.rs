@@ -1,18 +1,19 @@
 //! One guided-projection iteration of spline developables (issue 24, Tang et al. 2016 Fig. 17):
 //! a two-strip problem of 36 control points (Fig. 13's size; the paper: 0.04 s per iteration)
 //! and a 44-strip chain of 270 control points (near Fig. 12's 48 strips, 270 points; the
-//! paper: 0.36 s). The goal is 10× faster than the paper. Each sample times one
+//! paper: 0.36 s), each also with every interior curve a fold crease (eq. 7), as the paper's
+//! examples have. The goal is 10× faster than the paper. Each sample times one
 //! `Problem::iterate` from a freshly set-up, non-developable start (the set-up is not timed).
 //! Run: `cargo bench --bench spline`.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use flatcut::geom::bspline::BSpline;
-use flatcut::surface::spline::solve::{Model, Problem};
+use flatcut::surface::spline::solve::{Crease, Model, Problem};
 use glam::DVec3;
 
 /// `curves` wavy open cubic curves of `count` control points, 40 mm apart, twisted so that no
-/// strip is developable as given.
-fn chain(curves: usize, count: usize) -> Model {
+/// strip is developable as given; with `folds`, every interior curve is a fold crease (eq. 7).
+fn chain(curves: usize, count: usize, folds: bool) -> Model {
     let c = (0..curves)
         .map(|k| {
             (0..count)
@@ -29,7 +30,11 @@ fn chain(curves: usize, count: usize) -> Model {
         curves: c,
         apex: None,
         fixed: Vec::new(),
-        creases: Vec::new(),
+        creases: if folds {
+            vec![Crease::Fold; curves.saturating_sub(2)]
+        } else {
+            Vec::new()
+        },
         target: None,
         handles: Vec::new(),
     }
@@ -37,8 +42,10 @@ fn chain(curves: usize, count: usize) -> Model {
 
 fn bench(c: &mut Criterion) {
     for (name, m) in [
-        ("36 control points, 2 strips", chain(3, 12)),
-        ("270 control points, 44 strips", chain(45, 6)),
+        ("36 control points, 2 strips", chain(3, 12, false)),
+        ("36 control points, 2 strips, fold crease", chain(3, 12, true)),
+        ("270 control points, 44 strips", chain(45, 6, false)),
+        ("270 control points, 44 strips, 43 fold creases", chain(45, 6, true)),
     ] {
         let p = Problem::new(&m).expect("set up");
         eprintln!(
