@@ -37,15 +37,22 @@ fn chain(curves: usize, count: usize, folds: bool) -> Model {
         },
         target: None,
         handles: Vec::new(),
+        outline: None,
     }
 }
 
 fn bench(c: &mut Criterion) {
     for (name, m) in [
         ("36 control points, 2 strips", chain(3, 12, false)),
-        ("36 control points, 2 strips, fold crease", chain(3, 12, true)),
+        (
+            "36 control points, 2 strips, fold crease",
+            chain(3, 12, true),
+        ),
         ("270 control points, 44 strips", chain(45, 6, false)),
-        ("270 control points, 44 strips, 43 fold creases", chain(45, 6, true)),
+        (
+            "270 control points, 44 strips, 43 fold creases",
+            chain(45, 6, true),
+        ),
     ] {
         let p = Problem::new(&m).expect("set up");
         eprintln!(

@@ -66,6 +66,7 @@ impl Ctx<'_> {
         let creases = self.spline_creases(s, key)?;
         let fixed = self.spline_fixed(s, key, &curves, apex.is_some())?;
         let handles = self.spline_handles(s, key)?;
+        let outline = self.spline_outline(s, key, &curves)?;
         let d = SolveOptions::default();
         let count = |v: &super::context::Opt, name: &str, min: f64| {
             self.number(
@@ -107,6 +108,7 @@ impl Ctx<'_> {
             creases,
             target,
             handles,
+            outline,
             options,
             tolerance,
             bend_lines,
@@ -276,7 +278,8 @@ impl Ctx<'_> {
     }
 
     /// `handles = [{ at = [x, y, z], to = [x, y, z] }, ...]`: a point of the surface as given
-    /// (its nearest point is taken) dragged towards `to`.
+    /// (its nearest point is taken) dragged towards `to`, or with `lift = H` only raised by H
+    /// (its x and y left free).
     fn spline_handles(&self, s: &RawSurface, key: &str) -> Result<Vec<(DVec3, DVec3)>, SpecError> {
         let hk = format!("{key}.handles");
         let Some(v) = &s.handles else {
@@ -297,11 +300,14 @@ impl Ctx<'_> {
                     format!("must be a table {{ at = [x, y, z], to = [x, y, z] }}, got {it}"),
                 ));
             };
-            if let Some(bad) = t.keys().find(|k| !matches!(k.as_str(), "at" | "to")) {
+            if let Some(bad) = t
+                .keys()
+                .find(|k| !matches!(k.as_str(), "at" | "to" | "lift"))
+            {
                 return Err(self.invalid(
                     line,
                     &format!("{ik}.{bad}"),
-                    "is not a handle key; a handle takes `at` and `to`".into(),
+                    "is not a handle key; a handle takes `at` and `to` or `lift`".into(),
                 ));
             }
             let pt = |name: &str| -> Result<DVec3, SpecError> {
@@ -319,9 +325,98 @@ impl Ctx<'_> {
                     )),
                 }
             };
-            out.push((pt("at")?, pt("to")?));
+            let at = pt("at")?;
+            match (t.get("to"), t.get("lift")) {
+                (Some(_), Some(_)) => {
+                    return Err(self.invalid(
+                        line,
+                        &format!("{ik}.lift"),
+                        "a handle takes `to` or `lift`, not both".into(),
+                    ))
+                }
+                (None, Some(v)) => {
+                    let lift = match v {
+                        Value::Integer(i) => *i as f64,
+                        Value::Float(f) if f.is_finite() => *f,
+                        o => {
+                            return Err(self.invalid(
+                                line,
+                                &format!("{ik}.lift"),
+                                format!("must be a height in mm, got {o}"),
+                            ))
+                        }
+                    };
+                    out.push((at, DVec3::new(f64::NAN, f64::NAN, at.z + lift)));
+                }
+                _ => out.push((at, pt("to")?)),
+            }
         }
         Ok(out)
+    }
+
+    /// `outline`: the flat sheet the surface stays isometric to, `[width, height]` from the
+    /// origin or a list of `[x, y]` points, in the plane z = 0 where every curve must start.
+    fn spline_outline(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        curves: &[Vec<DVec3>],
+    ) -> Result<Option<Vec<glam::DVec2>>, SpecError> {
+        use glam::DVec2;
+        let ok = format!("{key}.outline");
+        let Some(v) = &s.outline else {
+            return Ok(None);
+        };
+        let line = self.line(v.span());
+        let num = |x: &Value| match x {
+            Value::Integer(i) => Some(*i as f64),
+            Value::Float(f) if f.is_finite() => Some(*f),
+            _ => None,
+        };
+        let poly: Vec<DVec2> = match v.get_ref() {
+            Value::Array(a) if a.len() == 2 && a.iter().all(|x| num(x).is_some()) => {
+                let (w, h) = (num(&a[0]).unwrap_or(0.0), num(&a[1]).unwrap_or(0.0));
+                if !(w > 0.0 && h > 0.0) {
+                    return Err(self.invalid(
+                        line,
+                        &ok,
+                        format!("the sheet must have a positive width and height, got {w} x {h}"),
+                    ));
+                }
+                vec![
+                    DVec2::ZERO,
+                    DVec2::new(w, 0.0),
+                    DVec2::new(w, h),
+                    DVec2::new(0.0, h),
+                ]
+            }
+            Value::Array(a) if a.len() >= 3 => self
+                .points(a, &ok, line)?
+                .into_iter()
+                .map(|p| p.truncate())
+                .collect(),
+            other => return Err(self.invalid(
+                line,
+                &ok,
+                format!(
+                    "must be [width, height] or a list of three or more [x, y] points, got {other}"
+                ),
+            )),
+        };
+        if curves.is_empty() {
+            return Err(self.invalid(line, &ok, "needs `curves` drawn on the flat sheet".into()));
+        }
+        for (c, curve) in curves.iter().enumerate() {
+            for (i, p) in curve.iter().enumerate() {
+                if p.z.abs() > 1e-6 || !inside(&poly, p.truncate()) {
+                    return Err(self.invalid(line, &ok, format!(
+                        "control point {} of curve {} ({}, {}, {}) is not on the flat sheet: with an outline, every curve starts in the plane z = 0 inside it",
+                        i + 1, c + 1, p.x, p.y, p.z
+                    )));
+                }
+            }
+        }
+        Ok(Some(poly))
     }
 
     /// `creases`: one name per interior curve.
@@ -474,12 +569,11 @@ impl Ctx<'_> {
                 ("side", span(&s.side)),
                 ("k_factor", span(&s.k_factor)),
             ],
-            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
+            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
         )?;
         self.refuse(
             key,
             &[
-                ("outline", span(&s.outline)),
                 ("holes", span(&s.holes)),
                 ("line", span(&s.line)),
                 ("arc", span(&s.arc)),
@@ -529,4 +623,22 @@ impl Ctx<'_> {
             "is for spline surfaces (kind = \"spline\")",
         )
     }
+}
+
+/// Whether `p` lies inside or on the polygon (even-odd rule, edges within 1e-6 count).
+fn inside(poly: &[glam::DVec2], p: glam::DVec2) -> bool {
+    let n = poly.len();
+    let mut odd = false;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let ab = b - a;
+        let t = ((p - a).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
+        if (a + ab * t).distance(p) <= 1e-6 {
+            return true;
+        }
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            odd = !odd;
+        }
+    }
+    odd
 }

@@ -549,6 +549,7 @@ fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
             &target_mesh,
         )),
         handles: Vec::new(),
+        outline: None,
     };
     let dist = flatcut::surface::spline::target_distances(&model);
     let within = dist.iter().filter(|&&x| x <= 0.3).count() as f64 / dist.len() as f64;
@@ -609,5 +610,112 @@ fn spline_handle_drags_a_corner_and_the_fixed_edge_stays() {
     );
     assert!(corner.distance(goal) < 1e-6);
     assert!(figure(&report, "handle_distance_mm") < 1e-6);
+    assert!(figure(&report, "largest_sine") <= 1e-6);
+}
+
+/// Control points (8, cubic, clamped) of the least-squares fit to `f(t)`, t in [0, 1] with
+/// t = u / spans.
+fn fit_curve(f: impl Fn(f64) -> DVec3) -> Vec<DVec3> {
+    let basis = BSpline::new(3, 8, false).unwrap();
+    let n = 8;
+    let mut a = vec![vec![0.0; n]; n];
+    let mut b = vec![DVec3::ZERO; n];
+    for k in 0..=400 {
+        let t = k as f64 / 400.0;
+        let r = basis.rows(t * basis.spans() as f64);
+        let p = f(t);
+        for &(i, wi) in &r.point {
+            b[i] += p * wi;
+            for &(j, wj) in &r.point {
+                a[i][j] += wi * wj;
+            }
+        }
+    }
+    // Gaussian elimination (the matrix is positive definite).
+    for c in 0..n {
+        for r in c + 1..n {
+            let f = a[r][c] / a[c][c];
+            for k in c..n {
+                a[r][k] -= f * a[c][k];
+            }
+            b[r] = b[r] - b[c] * f;
+        }
+    }
+    let mut x = vec![DVec3::ZERO; n];
+    for c in (0..n).rev() {
+        let mut s = b[c];
+        for k in c + 1..n {
+            s -= x[k] * a[c][k];
+        }
+        x[c] = s / a[c][c];
+    }
+    x
+}
+
+/// The arc through (0, 120), (105, 150), (210, 120): centre (105, −48.75), radius 198.75.
+fn a4_arc(t: f64) -> DVec3 {
+    let (cy, r) = (-48.75, 198.75);
+    let half = (105.0f64 / r).asin();
+    let a = std::f64::consts::FRAC_PI_2 + half - 2.0 * half * t;
+    DVec3::new(105.0 + r * a.cos(), cy + r * a.sin(), 0.0)
+}
+
+#[test]
+fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
+    let dir = scratch("spline-a4");
+    let mut crease = fit_curve(a4_arc);
+    crease[0] = DVec3::new(0.0, 120.0, 0.0);
+    crease[7] = DVec3::new(210.0, 120.0, 0.0);
+    let line = |y: f64| fit_curve(move |t| DVec3::new(210.0 * t, y, 0.0));
+    let spec = spline_spec(
+        &dir,
+        &[line(0.0), crease, line(297.0)],
+        "outline = [210, 297]\ncreases = [\"fold\"]\nfixed = [1]\nbend_lines = \"none\"\nhandles = [{ at = [0, 297, 0], lift = 80 }, { at = [210, 297, 0], lift = 80 }]",
+    );
+    let json = dir.join("design.json");
+    let report = cut(
+        &dir,
+        &spec,
+        &["--tabs", "none", "--spline-json", json.to_str().unwrap()],
+    );
+    let iso = figure(&report, "outline_isometry_error");
+    let lifted = figure(&report, "handle_distance_mm");
+    let contours = cut_contours(&dir);
+    assert_eq!(contours.len(), 1);
+    let (area, per) = contours[0];
+    // The crease on the flat piece, against the arc (distance to its circle).
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let dev = d["surfaces"][0]["development"]["curves"]
+        .as_array()
+        .unwrap();
+    let flat: Vec<&serde_json::Value> = dev.iter().filter(|c| c["curve"] == 2).collect();
+    assert_eq!(flat.len(), 1);
+    let pts: Vec<(f64, f64)> = flat[0]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    // The piece lies in its own frame: place it by the crease's ends, (0, 120) and (210, 120).
+    let (p0, p1) = (pts[0], pts[pts.len() - 1]);
+    let (ux, uy) = ((p1.0 - p0.0) / 210.0, (p1.1 - p0.1) / 210.0);
+    let off = pts
+        .iter()
+        .map(|&(x, y)| {
+            let (dx, dy) = (x - p0.0, y - p0.1);
+            let (sx, sy) = (dx * ux + dy * uy, -dx * uy + dy * ux);
+            let (ax, ay) = (sx, 120.0 + sy);
+            (((ax - 105.0).powi(2) + (ay + 48.75).powi(2)).sqrt() - 198.75).abs()
+        })
+        .fold(0.0, f64::max);
+    eprintln!(
+        "a4: blank {area:.1} mm² (62370), perimeter {per:.2} mm (1014), development error {iso:.2e}, handles {lifted:.2e} mm from their goal, flat crease within {off:.4} mm of the arc"
+    );
+    assert!(rel(area, 62370.0) < 1e-3, "{area}");
+    assert!(rel(per, 1014.0) < 1e-3, "{per}");
+    assert!(iso < 1e-6, "{iso}");
+    assert!(lifted < 0.01, "{lifted}");
+    assert!(off < 0.1, "{off}");
     assert!(figure(&report, "largest_sine") <= 1e-6);
 }

@@ -36,7 +36,9 @@
 //!   be byte-identical between runs); `benches/spline.rs` measures them.
 //! - A final sine above 1e-6 is a warning.
 
+mod develop;
 pub mod solve;
+mod system;
 pub mod target;
 
 use super::strip::BendLines;
@@ -64,6 +66,9 @@ pub struct SplineSpec {
     pub target: Option<target::Target>,
     /// Handles (at, to): a point of the surface as given dragged towards a 3D position (mm).
     pub handles: Vec<(DVec3, DVec3)>,
+    /// A flat domain the surface stays isometric to (eq. 12), in the plane z = 0 where the
+    /// curves start.
+    pub outline: Option<Vec<glam::DVec2>>,
     pub options: SolveOptions,
     /// Chordal tolerance of the output sampling (mm).
     pub tolerance: f64,
@@ -222,6 +227,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         creases: spec.creases.clone(),
         target: spec.target.clone(),
         handles: spec.handles.clone(),
+        outline: spec.outline.clone(),
     };
     let straight = solve::STRAIGHT / diameter(&m);
     for (k, &kind) in spec.creases.iter().enumerate() {
@@ -345,6 +351,9 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     ];
     if !m.handles.is_empty() {
         figures.push(("handle_distance_mm", report.handle_distance));
+    }
+    if m.outline.is_some() {
+        figures.push(("outline_isometry_error", report.outline_isometry));
     }
     let dist = target_distances(&m);
     if !dist.is_empty() {

@@ -36,12 +36,11 @@
 //!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
 //!   nothing and is left out. Smooth: n_L − n_R = 0.
 
+use super::develop::Dev;
+use super::system::{eval, normal_equations, sparse_solve, Expr, Row};
 use super::target::{StripRef, Target};
-use crate::geom::bspline::{apply, BSpline};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Side};
+use crate::geom::bspline::BSpline;
+use faer::sparse::linalg::solvers::SymbolicLlt;
 use glam::DVec3;
 
 /// The solver's settings (spec keys of the same names).
@@ -109,8 +108,11 @@ pub struct Model {
     /// A shape to approximate (eq. 9–11); `None` for none.
     pub target: Option<Target>,
     /// Handles: a point on the surface as given (`at`) dragged towards a 3D position (`to`),
-    /// as (at, to), in millimetres.
+    /// as (at, to), in millimetres; a coordinate of `to` that is NaN is left free.
     pub handles: Vec<(DVec3, DVec3)>,
+    /// A flat domain (mm, in the plane z = 0 of the curves as given, which lie in it) that the
+    /// surface stays isometric to (eq. 12); `None` for none.
+    pub outline: Option<Vec<glam::DVec2>>,
 }
 
 impl Model {
@@ -136,6 +138,8 @@ pub struct Report {
     pub moved: f64,
     /// Largest distance of a handle from its goal at the end (mm); 0 without handles.
     pub handle_distance: f64,
+    /// Largest relative length error of the development (eq. 12); 0 without an outline.
+    pub outline_isometry: f64,
 }
 
 /// A solve that failed.
@@ -149,16 +153,6 @@ pub enum SolveError {
     NonFinite { iteration: usize },
     #[error("the sparse solve failed: {0}")]
     Sparse(String),
-}
-
-/// A point expression Σ w·P over the model's points (index into the flat point list).
-type Expr = Vec<(usize, f64)>;
-
-/// One linearised equation: entries · x ≈ rhs, with weight w.
-struct Row {
-    entries: Vec<(usize, f64)>,
-    rhs: f64,
-    w: f64,
 }
 
 /// The flat point list, the unknowns' layout and the samples.
@@ -181,6 +175,12 @@ struct Layout {
     strips: Vec<(usize, Option<usize>)>,
     /// Handles: where on the surface (found once, on the start) and the goal, scaled.
     handles: Vec<(Foot, DVec3)>,
+    /// Each handle's point at the start and the goal of the current iteration (moved from
+    /// the start to the goal over [`HANDLE_RAMP`] iterations).
+    handle_start: Vec<DVec3>,
+    handle_now: Vec<DVec3>,
+    /// The development kept isometric to the outline (eq. 12).
+    dev: Option<Dev>,
     /// Number of unknowns.
     n: usize,
 }
@@ -194,6 +194,11 @@ struct Foot {
     v: f64,
     n: DVec3,
 }
+
+/// Iterations over which a handle's goal moves from where it starts to where it is dragged
+/// (a drag in small steps, as in interactive use: one step of the whole way lifts a flat
+/// sheet by second-order length changes the isometry rows do not see).
+pub const HANDLE_RAMP: usize = 10;
 
 /// The weight of a handle's three rows (Fig. 17: user-defined constraints weigh 1).
 const W_HANDLE: f64 = 1.0;
@@ -224,10 +229,6 @@ struct CreaseSample {
     left: usize,
     right: usize,
     d2: Expr,
-}
-
-fn eval(e: &Expr, p: &[DVec3]) -> DVec3 {
-    apply(e, p)
 }
 
 /// Intrinsic sine of the angle between the tangent planes at the two ends of a ruling.
@@ -374,6 +375,9 @@ fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout 
         target,
         strips,
         handles: Vec::new(),
+        handle_start: Vec::new(),
+        handle_now: Vec::new(),
+        dev: None,
         n,
     }
 }
@@ -535,9 +539,12 @@ fn bilinear(l: &Layout, x: &[f64], s: &Sample, expr: &Expr, rows: &mut Vec<Row>)
 fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec<Row> {
     let mut rows = Vec::new();
     target_rows(l, basis, feet, &mut rows);
-    for (f, to) in &l.handles {
+    if let Some(d) = &l.dev {
+        d.rows(&l.points, &l.var, x, eps1, &mut rows);
+    }
+    for ((f, _), to) in l.handles.iter().zip(&l.handle_now) {
         let (s, _, _) = foot_exprs(l, basis, f);
-        for c in 0..3 {
+        for c in (0..3).filter(|&c| to[c].is_finite()) {
             rows.push(dot_row(l, &s, DVec3::AXES[c], to[c], W_HANDLE));
         }
     }
@@ -702,10 +709,17 @@ fn w9(l: &Layout, basis: &BSpline, f: &Foot) -> f64 {
 }
 
 /// The handles' weighted squared residual and their largest distance from the goal.
-fn handle_merit(l: &Layout, basis: &BSpline) -> (f64, f64) {
+fn handle_merit(l: &Layout, basis: &BSpline, now: bool) -> (f64, f64) {
     let (mut sum, mut worst) = (0.0, 0.0f64);
-    for (f, to) in &l.handles {
-        let d = eval(&foot_exprs(l, basis, f).0, &l.points).distance(*to);
+    for (k, (f, goal)) in l.handles.iter().enumerate() {
+        let to = if now { &l.handle_now[k] } else { goal };
+        let p = eval(&foot_exprs(l, basis, f).0, &l.points);
+        // A coordinate left free (NaN: a lift sets only the height) does not count.
+        let d = (0..3)
+            .filter(|&c| to[c].is_finite())
+            .map(|c| (p[c] - to[c]).powi(2))
+            .sum::<f64>()
+            .sqrt();
         sum += W_HANDLE * W_HANDLE * d * d;
         worst = worst.max(d);
     }
@@ -730,55 +744,6 @@ fn target_merit(l: &Layout, basis: &BSpline, feet: &[Foot]) -> (f64, f64) {
         }
     }
     (sum, dist / feet.len().max(1) as f64)
-}
-
-/// The normal equations' lower triangle and right-hand side.
-fn normal_equations(
-    n: usize,
-    rows: &[Row],
-    x: &[f64],
-    eps2: f64,
-) -> (Vec<Triplet<usize, usize, f64>>, Vec<f64>) {
-    let mut t = Vec::new();
-    let mut b: Vec<f64> = x.iter().map(|v| eps2 * eps2 * v).collect();
-    for i in 0..n {
-        t.push(Triplet::new(i, i, eps2 * eps2));
-    }
-    for r in rows {
-        let w2 = r.w * r.w;
-        for &(i, vi) in &r.entries {
-            b[i] += w2 * vi * r.rhs;
-            for &(j, vj) in &r.entries {
-                if i >= j {
-                    t.push(Triplet::new(i, j, w2 * vi * vj));
-                }
-            }
-        }
-    }
-    (t, b)
-}
-
-fn sparse_solve(
-    n: usize,
-    t: &[Triplet<usize, usize, f64>],
-    b: &[f64],
-    symbolic: &mut Option<SymbolicLlt<usize>>,
-) -> Result<Vec<f64>, SolveError> {
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, t)
-        .map_err(|e| SolveError::Sparse(format!("{e:?}")))?;
-    let sym = match symbolic {
-        Some(s) => s.clone(),
-        None => {
-            let s = SymbolicLlt::try_new(a.symbolic(), Side::Lower)
-                .map_err(|e| SolveError::Sparse(format!("{e:?}")))?;
-            *symbolic = Some(s.clone());
-            s
-        }
-    };
-    let llt = Llt::try_new_with_symbolic(sym, a.as_ref(), Side::Lower)
-        .map_err(|e| SolveError::Sparse(format!("not positive definite ({e:?})")))?;
-    let x = llt.solve(&Mat::<f64>::from_fn(n, 1, |i, _| b[i]));
-    Ok((0..n).map(|i| x[(i, 0)]).collect())
 }
 
 /// The model's points in one list (curves, then the apex).
@@ -809,7 +774,12 @@ impl Problem {
     pub fn new(m: &Model) -> Result<Problem, SolveError> {
         let pts = flat_points(m);
         let target: &[DVec3] = m.target.as_ref().map_or(&[], |t| &t.points);
-        let goals: Vec<DVec3> = m.handles.iter().map(|h| h.1).collect();
+        // A handle's free coordinates (NaN) count where the handle starts.
+        let goals: Vec<DVec3> = m
+            .handles
+            .iter()
+            .map(|&(at, to)| DVec3::select(to.is_finite_mask(), to, at))
+            .collect();
         let lo = pts
             .iter()
             .chain(&goals)
@@ -869,7 +839,28 @@ impl Problem {
                 (best.1, (to - centre) / diameter)
             })
             .collect();
+        l.handle_start = l
+            .handles
+            .iter()
+            .map(|(f, _)| eval(&foot_exprs(&l, &basis, f).0, &l.points))
+            .collect();
+        l.handle_now = l.handle_start.clone();
+        if let Some(outline) = &m.outline {
+            let flat = outline
+                .iter()
+                .map(|p| (*p - centre.truncate()) / diameter)
+                .collect();
+            let constrained: Vec<bool> = (0..m.curves.len())
+                .map(|c| m.crease(c) != Crease::Free)
+                .collect();
+            let d = Dev::new(&basis, &l.points, m.curves.len(), &constrained, flat, l.n);
+            l.n += d.unknowns();
+            l.dev = Some(d);
+        }
         let mut x = vec![0.0; l.n];
+        if let Some(d) = &l.dev {
+            d.init(&mut x);
+        }
         for (p, v) in l.var.iter().enumerate() {
             if let Some(o) = *v {
                 x[o..o + 3].copy_from_slice(&l.points[p].to_array());
@@ -910,19 +901,42 @@ impl Problem {
     /// Whether there are goals besides the constraints (a target, handles): the solve then
     /// goes on until they stop improving.
     pub fn has_goals(&self) -> bool {
-        self.has_target() || !self.l.handles.is_empty()
+        self.has_target() || !self.l.handles.is_empty() || self.l.dev.is_some()
+    }
+
+    /// The development's squared residual and largest relative length error (eq. 12); zero
+    /// without an outline.
+    fn dev_merit(&self) -> (f64, f64) {
+        self.l
+            .dev
+            .as_ref()
+            .map_or((0.0, 0.0), |d| d.merit(&self.l.points, &self.x))
+    }
+
+    /// The weighted squared residual of the goals: eq. 9–11 at the footpoints, the handles,
+    /// the development.
+    fn goals_merit(&self) -> f64 {
+        target_merit(&self.l, &self.basis, &self.feet).0
+            + handle_merit(&self.l, &self.basis, true).0
+            + self.dev_merit().0
+    }
+
+    /// The largest relative length error of the development (eq. 12).
+    pub fn outline_isometry_error(&self) -> f64 {
+        self.dev_merit().1
     }
 
     /// The goals' measure of progress: RMS target distance plus the largest handle distance
     /// (scaled).
     fn goal(&self) -> f64 {
         target_merit(&self.l, &self.basis, &self.feet).1.sqrt()
-            + handle_merit(&self.l, &self.basis).1
+            + handle_merit(&self.l, &self.basis, false).1
+            + self.dev_merit().1
     }
 
     /// The largest distance (mm) of a handle from its goal.
     pub fn handle_distance_mm(&self) -> f64 {
-        handle_merit(&self.l, &self.basis).1 * self.diameter
+        handle_merit(&self.l, &self.basis, false).1 * self.diameter
     }
 
     /// The root mean square distance (mm) of the target points from their footpoints.
@@ -932,18 +946,23 @@ impl Problem {
 
     /// One round of guided projection with fairness weight `eps1`.
     pub fn iterate(&mut self, eps1: f64, eps2: f64, iteration: usize) -> Result<(), SolveError> {
-        if self.has_target() {
-            // Footpoints found again every iteration (§4.2); the merit counts eq. 9–11 at them.
+        let f = (iteration as f64 / HANDLE_RAMP as f64).min(1.0);
+        for (k, (_, goal)) in self.l.handles.iter().enumerate() {
+            let start = self.l.handle_start[k];
+            self.l.handle_now[k] = start + (*goal - start) * f;
+        }
+        if self.has_goals() {
+            // Footpoints found again every iteration (§4.2); the merit counts the goals too.
             if !self.feet_fresh {
                 self.feet = feet(&self.l, &self.basis);
             }
             self.feet_fresh = false;
-            self.merit =
-                residual(&self.l, &self.x).0 + target_merit(&self.l, &self.basis, &self.feet).0;
+            self.merit = residual(&self.l, &self.x).0 + self.goals_merit();
         }
         let rows = rows(&self.l, &self.x, eps1, &self.basis, &self.feet);
         let (t, b) = normal_equations(self.l.n, &rows, &self.x, eps2);
-        let full = sparse_solve(self.l.n, &t, &b, &mut self.symbolic)?;
+        let full =
+            sparse_solve(self.l.n, &t, &b, &mut self.symbolic).map_err(SolveError::Sparse)?;
         if full.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite { iteration });
         }
@@ -959,9 +978,7 @@ impl Problem {
             self.l.points.clone_from(&old_points);
             unpack(&mut self.l, &self.x);
             let (merit, sine) = residual(&self.l, &self.x);
-            let merit = merit
-                + target_merit(&self.l, &self.basis, &self.feet).0
-                + handle_merit(&self.l, &self.basis).0;
+            let merit = merit + self.goals_merit();
             if merit <= self.merit || step < 0.01 {
                 self.merit = merit;
                 self.sine = sine;
@@ -992,10 +1009,15 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
     let mut converged = !pr.has_goals();
     let mut last_goal = f64::INFINITY;
     while it < o.max_iterations && (pr.sine() > o.stop_sine || !converged) {
-        let (eps1, eps2) = if it < o.iterations {
+        let fair_rounds = if m.handles.is_empty() {
+            o.iterations
+        } else {
+            o.iterations.max(HANDLE_RAMP)
+        };
+        let (eps1, eps2) = if it < fair_rounds {
             (o.epsilon1 * 0.9f64.powi(it as i32), o.epsilon2)
         } else {
-            let k = (it + 1 - o.iterations) as i32;
+            let k = (it + 1 - fair_rounds) as i32;
             (
                 0.0,
                 (o.epsilon2 * 0.1f64.powi(k)).max(EPS2_FLOOR.min(o.epsilon2)),
@@ -1038,5 +1060,6 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
         sines,
         moved,
         handle_distance: pr.handle_distance_mm(),
+        outline_isometry: pr.outline_isometry_error(),
     })
 }

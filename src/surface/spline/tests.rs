@@ -12,6 +12,7 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         creases: Vec::new(),
         target: None,
         handles: Vec::new(),
+        outline: None,
         options: SolveOptions::default(),
         tolerance: 0.05,
         bend_lines: BendLines::All,
