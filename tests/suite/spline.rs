@@ -615,6 +615,7 @@ fn spline_handle_drags_a_corner_and_the_fixed_edge_stays() {
 
 /// Control points (8, cubic, clamped) of the least-squares fit to `f(t)`, t in [0, 1] with
 /// t = u / spans.
+#[allow(clippy::needless_range_loop)] // rows and columns of one small matrix
 fn fit_curve(f: impl Fn(f64) -> DVec3) -> Vec<DVec3> {
     let basis = BSpline::new(3, 8, false).unwrap();
     let n = 8;
