@@ -153,21 +153,28 @@
 //! # Spline surfaces (issue 24)
 //!
 //! A `kind = "spline"` surface is a ruled surface between B-spline curves, made developable by
-//! guided projection (see `surface::spline`, Tang et al. 2016): `curves` (required: two or
-//! more curves, each an inline list of control points `[[x, y, z], ...]`, all of one count;
-//! or one curve and `apex = [x, y, z]` for a cone), `degree` (2 to 5, default 3), `closed`
-//! (periodic curves, default false), `creases` (one per interior curve of a chain of three or
-//! more: "fold" (the sheet folds along it), "geodesic" (a geodesic of both sides: it
-//! unfolds to a straight line), "smooth" (no crease) or "free" (no condition, the strips are cut apart); default
-//! all "free"), `fixed` (control points the solve keeps: curve numbers for whole curves,
-//! `[curve, point]` counted from 1, or "apex"), `iterations` (rounds with the fairness
-//! energy, default 5), `max_iterations` (default 50), `epsilon1` (fairness weight, default
-//! 0.1), `epsilon2` (step damping, default 0.01), `tolerance` (chordal tolerance of the
-//! output sampling, mm, default 0.05), `bend_lines` (which rulings are scored, as strips;
-//! creases are folds whatever it says) and `name`. Unequal control-point counts, a wrong
-//! number of `creases`, a "fold" or "geodesic" crease on a straight curve and a control point
-//! that does not exist are errors at the line of the key concerned; rulings that cross inside
-//! the surface (a curve of regression) and a solve that breaks down name `curves`.
+//! guided projection (see `surface::spline`, Tang et al. 2016): `curves` (two or more curves,
+//! each an inline list of control points `[[x, y, z], ...]`, all of one count; or one curve
+//! and `apex = [x, y, z]` for a cone), `degree` (2 to 5, default 3), `closed` (periodic
+//! curves, default false; the surface is opened along its first ruling, a seam with a tab),
+//! `creases` (one per interior curve of a chain of three or more: "fold" (the sheet folds
+//! along it), "geodesic" (a geodesic of both sides: it unfolds to a straight line), "smooth"
+//! (no crease) or "free" (no condition: the sides may not unfold in one piece); default all
+//! "free"), `fixed` (control points the solve keeps: curve numbers for whole curves,
+//! `[curve, point]` counted from 1, or "apex"), `target` (a shape to approximate: a mesh file
+//! or a CSV point cloud, as a path or `{ path, scale, units }`; without `curves` the start is
+//! the target's principal rectangle), `handles` (`[{ at = [x, y, z], to = [x, y, z] }]`: the
+//! surface's point nearest `at` dragged to `to`; `lift = H` instead of `to` raises it by H
+//! only), `outline` (the flat sheet the surface stays isometric to: `[width, height]` from the
+//! origin or a list of `[x, y]` points; the curves must start flat in it, z = 0), `iterations`
+//! (rounds with the fairness energy, default 5), `max_iterations` (default 50, 150 with a
+//! target), `epsilon1` (fairness weight, default 0.1), `epsilon2` (step damping, default
+//! 0.01), `tolerance` (chordal tolerance of the output sampling, mm, default 0.05),
+//! `bend_lines` (which rulings are scored, as strips; creases are folds whatever it says) and
+//! `name`. Unequal control-point counts, a wrong number of `creases`, a "fold" or "geodesic"
+//! crease on a straight curve, a control point that does not exist, an unreadable target and
+//! a curve off the outline are errors at the line of the key concerned; rulings that cross
+//! inside the surface (a curve of regression) and a solve that breaks down name `curves`.
 
 mod bent;
 mod boundary;

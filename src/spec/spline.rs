@@ -395,13 +395,15 @@ impl Ctx<'_> {
                 .into_iter()
                 .map(|p| p.truncate())
                 .collect(),
-            other => return Err(self.invalid(
-                line,
-                &ok,
-                format!(
+            other => {
+                return Err(self.invalid(
+                    line,
+                    &ok,
+                    format!(
                     "must be [width, height] or a list of three or more [x, y] points, got {other}"
                 ),
-            )),
+                ))
+            }
         };
         if curves.is_empty() {
             return Err(self.invalid(line, &ok, "needs `curves` drawn on the flat sheet".into()));

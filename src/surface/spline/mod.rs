@@ -1,8 +1,11 @@
 //! Spline developables (Tang, Bo, Wallner, Pottmann 2016, *Interactive design of developable
 //! surfaces*, §2 and §3.2; issue 24): the ruled surface s(u, v) = (1 − v) a(u) + v b(u)
 //! between B-spline curves of one degree and control-point count (or a cone: one curve and an
-//! apex), made developable by guided projection ([`solve`]), then sampled into a triangle mesh
-//! whose rulings are exact edges, for the exact unfolder.
+//! apex), made developable by guided projection ([`solve`]; its rows and sparse solve in
+//! `system`), then sampled into a triangle mesh whose rulings are exact edges, for the exact
+//! unfolder. Besides developability and creases the solve can approximate a target (§4.2,
+//! [`target`]), keep the surface isometric to a flat outline (§5, eq. 12, `develop`) and drag
+//! points by handles.
 //!
 //! Several curves make a chain of strips, curve k to curve k + 1, each with its own normals;
 //! each shared (interior) curve is a crease with a condition (§3.3): `fold` (eq. 7), `geodesic`
@@ -32,8 +35,12 @@
 //!   difference between a quad's second diagonal in 3D and in its two triangles unfolded),
 //!   `control_points_moved_mm`, `crease_sine` (the largest intrinsic crease sine at 64
 //!   parameters per span, [`solve::crease_sine`]) and `crease_angle_defect` (Fig. 17's crease
-//!   flatness |K|: the largest |angle sum − 2π| at the sampled mesh's vertices on creases). Seconds per iteration are not written there (the report must
-//!   be byte-identical between runs); `benches/spline.rs` measures them.
+//!   flatness |K|: the largest |angle sum − 2π| at the sampled mesh's vertices on creases);
+//!   with a target `approximation_rms_mm`, `approximation_max_mm`, `coverage` (the share of
+//!   target points within [`COVERAGE_MM`]) and `target_points`; with handles
+//!   `handle_distance_mm`; with an outline `outline_isometry_error` (eq. 12's largest relative
+//!   length error). Seconds per iteration are not written there (the report must be
+//!   byte-identical between runs); `benches/spline.rs` measures them.
 //! - A final sine above 1e-6 is a warning.
 
 mod develop;
