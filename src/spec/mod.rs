@@ -170,8 +170,9 @@
 //! (rounds with the fairness energy, default 5), `max_iterations` (default 50, 150 with a
 //! target), `epsilon1` (fairness weight, default 0.1), `epsilon2` (step damping, default
 //! 0.01), `tolerance` (chordal tolerance of the output sampling, mm, default 0.05),
-//! `bend_lines` (which rulings are scored, as strips; creases are folds whatever it says) and
-//! `name`. Unequal control-point counts, a wrong number of `creases`, a "fold" or "geodesic"
+//! `bend_lines` (which rulings are scored, as strips; creases are folds whatever it says),
+//! `side` and `k_factor` (metal: developed on the neutral surface, as strips) and `name`.
+//! Unequal control-point counts, a wrong number of `creases`, a "fold" or "geodesic"
 //! crease on a straight curve, a control point that does not exist, an unreadable target and
 //! a curve off the outline are errors at the line of the key concerned; rulings that cross
 //! inside the surface (a curve of regression) and a solve that breaks down name `curves`.

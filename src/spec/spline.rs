@@ -99,7 +99,17 @@ impl Ctx<'_> {
             .number(&s.tolerance, &k("tolerance"), MM_POSITIVE, |v| v > 0.0)?
             .map_or(0.05, |(v, _)| v);
         let bend_lines = self.bend_lines(&s.bend_lines, key)?;
+        let side = self
+            .choice(&s.side, &k("side"), &crate::surface::SheetSide::NAMES)?
+            .unwrap_or_default();
+        let k_factor = self
+            .number(&s.k_factor, &k("k_factor"), "a number from 0 to 1", |v| {
+                (0.0..=1.0).contains(&v)
+            })?
+            .map_or(0.4, |(v, _)| v);
         let spec = SplineSpec {
+            sheet: (side, k_factor),
+            neutral_offset: 0.0,
             curves,
             apex,
             degree,
@@ -568,10 +578,8 @@ impl Ctx<'_> {
                 ("p", span(&s.p)),
                 ("q", span(&s.q)),
                 ("method", span(&s.method)),
-                ("side", span(&s.side)),
-                ("k_factor", span(&s.k_factor)),
             ],
-            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
+            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `side`, `k_factor`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
         )?;
         self.refuse(
             key,

@@ -102,8 +102,8 @@ impl SheetSide {
 }
 
 impl SurfaceSpec {
-    /// This surface as it is developed in `material`: a strip from a spec file in metal moves
-    /// to its neutral surface (see [`StripSpec::sheet`]); paper and fabric are thin enough to
+    /// This surface as it is developed in `material`: a strip or a spline surface from a spec
+    /// file in metal moves to its neutral surface (see [`StripSpec::sheet`]); paper and fabric are thin enough to
     /// be developed as given.
     pub fn for_material(&self, material: &Material) -> SurfaceSpec {
         let mut s = self.clone();
@@ -114,6 +114,13 @@ impl SurfaceSpec {
                     _ => 0.0,
                 };
             }
+        }
+        if let Some(sp) = &mut s.spline {
+            let (side, k) = sp.sheet;
+            sp.neutral_offset = match material.kind {
+                MaterialKind::Metal => side.neutral_offset(k, material.thickness),
+                _ => 0.0,
+            };
         }
         s
     }

@@ -720,3 +720,53 @@ fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
     assert!(off < 0.1, "{off}");
     assert!(figure(&report, "largest_sine") <= 1e-6);
 }
+
+#[test]
+fn spline_metal_cylinder_is_developed_on_the_neutral_surface_of_its_side() {
+    let a: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let t = i as f64 * std::f64::consts::TAU / 8.0;
+            DVec3::new(100.0 * t.cos(), 70.0 * t.sin(), 0.0)
+        })
+        .collect();
+    let b: Vec<DVec3> = a.iter().map(|p| *p + 150.0 * DVec3::Z).collect();
+    let basis = BSpline::new(3, 8, true).unwrap();
+    let l = length(&basis, &a);
+    // A closed convex curve offset by d inward is 2πd shorter; K = 0.4, t = 2 mm.
+    let tau = std::f64::consts::TAU;
+    let mut areas = Vec::new();
+    for (side, want) in [
+        ("outside", l - tau * 0.6 * 2.0),
+        ("inside", l + tau * 0.4 * 2.0),
+        ("neutral", l),
+    ] {
+        let dir = scratch(&format!("spline-metal-{side}"));
+        let extra = format!(
+            "closed = true\nside = \"{side}\"\n[material]\nkind = \"metal\"\nthickness = 2"
+        );
+        let spec = spline_spec(&dir, &[a.clone(), b.clone()], &extra);
+        // `[sheet]` follows `extra` in the spec; the material table ends before it.
+        cut(&dir, &spec, &["--bend-lines", "none"]);
+        let contours = cut_contours(&dir);
+        let area = contours.iter().map(|c| c.0).fold(0.0, f64::max);
+        eprintln!("metal ({side}): blank {area:.1} mm² vs {:.1}", want * 150.0);
+        assert!(
+            rel(area, want * 150.0) < 1e-3,
+            "{side}: {area} vs {}",
+            want * 150.0
+        );
+        areas.push(area);
+    }
+    // The sampling's chord error cancels in the differences: the offsets themselves, to 1 %.
+    let (outside, inside, neutral) = (areas[0], areas[1], areas[2]);
+    assert!(
+        rel(neutral - outside, 150.0 * tau * 1.2) < 1e-2,
+        "{}",
+        neutral - outside
+    );
+    assert!(
+        rel(inside - neutral, 150.0 * tau * 0.8) < 1e-2,
+        "{}",
+        inside - neutral
+    );
+}

@@ -77,6 +77,13 @@ pub struct SplineSpec {
     /// curves start.
     pub outline: Option<Vec<glam::DVec2>>,
     pub options: SolveOptions,
+    /// Which surface of a metal sheet the curves describe and the K factor (`side`,
+    /// `k_factor`), from which [`crate::surface::SurfaceSpec::for_material`] sets
+    /// `neutral_offset`.
+    pub sheet: (super::SheetSide, f64),
+    /// How far (mm) the developed (neutral) surface lies inside the designed one, against the
+    /// mesh's face normals; 0 develops the design as it is.
+    pub neutral_offset: f64,
     /// Chordal tolerance of the output sampling (mm).
     pub tolerance: f64,
     pub bend_lines: BendLines,
@@ -316,6 +323,16 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     check_striction(&m, &params)?;
     let sampled = sample_mesh(&m, &params);
     let curve_verts = sampled.curve_verts;
+    let mut sampled_mesh = sampled.mesh;
+    if spec.neutral_offset != 0.0 {
+        offset_mesh(
+            &m,
+            &params,
+            &curve_verts,
+            &mut sampled_mesh,
+            spec.neutral_offset,
+        );
+    }
     let seam = if m.basis.closed() {
         let mut s: Vec<[usize; 2]> = curve_verts
             .windows(2)
@@ -326,7 +343,7 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     } else {
         Vec::new()
     };
-    let mesh = sampled.mesh;
+    let mesh = sampled_mesh;
     let mut bends = bends(&mesh, &sampled.rulings, spec.bend_lines);
     bends.extend(crease_bends(&mesh, &sampled.creases));
     let (delta, iso) = quad_figures(&m, &params);
@@ -602,6 +619,56 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
         creases,
         crease_verts,
         curve_verts,
+    }
+}
+
+/// Move the sampled mesh `delta` mm against its face normals (onto a metal sheet's neutral
+/// surface): each ruling's two ends move by the same vector, delta times the strip's unit
+/// normal there (constant along a ruling of a developable, so the moved surface is developable
+/// too); a vertex on a crease moves to where the two sides' moved planes meet (the mitre
+/// (n₁ + n₂)/(1 + n₁·n₂)), a cone's apex to the least-squares meet of its rulings' planes.
+fn offset_mesh(m: &Model, params: &[f64], curve_verts: &[Vec<usize>], mesh: &mut Mesh, delta: f64) {
+    let mut normals: Vec<Vec<DVec3>> = vec![Vec::new(); mesh.vertices.len()];
+    for (k, (a, b)) in strips(m).into_iter().enumerate() {
+        for (i, &u) in params.iter().enumerate() {
+            let (pa, ta) = at(m, Some(a), u);
+            let (pb, _) = at(m, b, u);
+            // Faces (a_i, a_i+1, b_i+1) face a′ × e; inward is e × a′.
+            let n = (pb - pa).cross(ta.unwrap_or_default()).normalize_or_zero();
+            if n == DVec3::ZERO {
+                continue;
+            }
+            for c in [k, k + 1] {
+                if let Some(&v) = curve_verts
+                    .get(c)
+                    .and_then(|row| row.get(i).or(row.first()))
+                {
+                    if !normals[v].iter().any(|q| q.dot(n) > 1.0 - 1e-12) {
+                        normals[v].push(n);
+                    }
+                }
+            }
+        }
+    }
+    for (v, ns) in normals.iter().enumerate() {
+        let shift = match ns.len() {
+            0 => continue,
+            1 => ns[0],
+            2 if ns[0].dot(ns[1]) > -0.9 => (ns[0] + ns[1]) / (1.0 + ns[0].dot(ns[1])),
+            _ => {
+                // Least squares: ⟨x, nᵢ⟩ = 1 for every normal.
+                let a = ns.iter().fold(glam::DMat3::ZERO, |acc, n| {
+                    acc + glam::DMat3::from_cols(*n * n.x, *n * n.y, *n * n.z)
+                });
+                let rhs: DVec3 = ns.iter().copied().sum();
+                if a.determinant().abs() > 1e-12 {
+                    a.inverse() * rhs
+                } else {
+                    rhs / ns.len() as f64
+                }
+            }
+        };
+        mesh.vertices[v] += shift * delta;
     }
 }
 

@@ -14,6 +14,8 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         handles: Vec::new(),
         outline: None,
         options: SolveOptions::default(),
+        sheet: (crate::surface::SheetSide::Outside, 0.4),
+        neutral_offset: 0.0,
         tolerance: 0.05,
         bend_lines: BendLines::All,
     }
