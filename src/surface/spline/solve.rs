@@ -37,10 +37,9 @@
 //!   nothing and is left out. Smooth: n_L − n_R = 0.
 
 use super::develop::Dev;
-use super::system::{eval, normal_equations, sparse_solve, Expr, Row};
+use super::system::{eval, normal_equations, sparse_solve, Expr, Pattern, Row};
 use super::target::{StripRef, Target};
 use crate::geom::bspline::BSpline;
-use faer::sparse::linalg::solvers::SymbolicLlt;
 use glam::DVec3;
 
 /// The solver's settings (spec keys of the same names).
@@ -764,7 +763,7 @@ pub struct Problem {
     x: Vec<f64>,
     centre: DVec3,
     diameter: f64,
-    symbolic: Option<SymbolicLlt<usize>>,
+    pattern: Option<Pattern>,
     merit: f64,
     sine: f64,
 }
@@ -877,7 +876,7 @@ impl Problem {
             x,
             centre,
             diameter,
-            symbolic: None,
+            pattern: None,
             merit,
             sine,
         })
@@ -960,9 +959,9 @@ impl Problem {
             self.merit = residual(&self.l, &self.x).0 + self.goals_merit();
         }
         let rows = rows(&self.l, &self.x, eps1, &self.basis, &self.feet);
-        let (t, b) = normal_equations(self.l.n, &rows, &self.x, eps2);
+        let (idx, val, b) = normal_equations(self.l.n, &rows, &self.x, eps2);
         let full =
-            sparse_solve(self.l.n, &t, &b, &mut self.symbolic).map_err(SolveError::Sparse)?;
+            sparse_solve(self.l.n, idx, &val, &b, &mut self.pattern).map_err(SolveError::Sparse)?;
         if full.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite { iteration });
         }
