@@ -6,8 +6,8 @@
 //! splitting a piece too large for the sheet), sheets (size, pieces, utilisation; on a
 //! roll the length used, on sheets the rectangle left free on the last sheet),
 //! surfaces (source, faces, pieces, repairs made on import, and the source's own `figures` when
-//! it measured some, to 6 significant digits) and the files written. Pieces and surfaces laid out from charts of a
-//! smooth mesh (issue 7) carry `stretch`: `{l2, linf, flipped}` (1 = isometric); it is `null`
+//! it measured some, to 6 significant digits) and the files written. Pieces and surfaces laid
+//! out from charts of a smooth mesh (issue 7) carry `stretch`: `{l2, linf, flipped}` (1 = isometric); it is `null`
 //! for exact unfoldings. Those whose seams were simplified (thesis §5.3) also carry `simplify`:
 //! `{tolerance_mm, vertices_before, vertices_after, max_deviation_mm, max_seam_mismatch_mm}`
 //! (border vertices of all its rings; the largest distance of an original border vertex from

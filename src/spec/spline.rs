@@ -72,8 +72,8 @@ impl Ctx<'_> {
             self.number(
                 v,
                 &k(name),
-                &format!("a whole number from {min} to 10000"),
-                |x| x.fract() == 0.0 && (min..=10_000.0).contains(&x),
+                &format!("a whole number from {min} to 1000"),
+                |x| x.fract() == 0.0 && (min..=1000.0).contains(&x),
             )
         };
         let iterations = count(&s.iterations, "iterations", 0.0)?.map(|(v, _)| v as usize);

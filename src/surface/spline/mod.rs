@@ -277,8 +277,11 @@ pub const COVERAGE_MM: f64 = 0.5;
 /// Control points per curve of a start from a target's principal rectangle.
 pub const RECTANGLE_POINTS: usize = 8;
 
+/// Most vertices of the sampled mesh.
+pub const MAX_SAMPLED_VERTICES: usize = 2_000_000;
+
 /// Most control points of one surface (all curves and the apex).
-pub const MAX_CONTROL_POINTS: usize = 20_000;
+pub const MAX_CONTROL_POINTS: usize = 5_000;
 
 /// The diagonal of the model's control points' bounding box (mm), at least 1e-300.
 fn diameter(m: &Model) -> f64 {
@@ -320,6 +323,16 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     let mut m = model(spec)?;
     let report = solve::solve(&mut m, &spec.options)?;
     let params = sample_params(&m, spec.tolerance);
+    let verts = params.len().saturating_mul(m.curves.len() + 1);
+    if verts > MAX_SAMPLED_VERTICES {
+        return Err(SplineError::Shape {
+            key: "tolerance".into(),
+            message: format!(
+                "{} mm samples the surface into {verts} vertices, over {MAX_SAMPLED_VERTICES}; raise it",
+                spec.tolerance
+            ),
+        });
+    }
     check_striction(&m, &params)?;
     let sampled = sample_mesh(&m, &params);
     let curve_verts = sampled.curve_verts;
@@ -351,6 +364,14 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     let crease_sine = dense_crease_sine(&m, 64, false);
     let sine = dense_sine(&m, 64);
     let mut warnings = Vec::new();
+    if let Some(b) = report.budget {
+        if report.iterations >= b {
+            warnings.push(format!(
+                "the design is large: its work budget allowed {b} of `max_iterations` = {} iterations; split it into several surfaces or thin the target",
+                spec.options.max_iterations
+            ));
+        }
+    }
     if sine > 1e-6 {
         warnings.push(format!(
             "the solve stopped at a developability sine of {sine:.2e} (above 1e-6) after {} iterations: the blank will need some stretching; raise `max_iterations` or free some control points",
