@@ -123,6 +123,7 @@
 //!     state.rs                 The state of one search
 //! output/
 //!   mod.rs                     Output stage
+//!   design.rs                  `--spline-json`: the solved spline designs as JSON
 //!   dxf.rs                     DXF output for sheet-metal shops (issue 4, item 6)
 //!   files.rs                   Writing a run's files
 //!   gpgl.rs                    GP-GL programs for Graphtec cutting plotters (CE6000 / CE7000 / FC series) in their native …
@@ -156,6 +157,7 @@
 //!   mesh.rs                    The reader of `kind = "mesh"` surfaces
 //!   names.rs                   The names a user writes for the stages' enums
 //!   spanned.rs                 The spanned-value machinery of the spec reader
+//!   spline.rs                  The reader of `kind = "spline"` surfaces (Tang et al. 2016)
 //!   strip.rs                   The reader of `kind = "strip"` surfaces
 //!   tests.rs                   Tests of the spec reader
 //! surface/
@@ -202,6 +204,13 @@
 //!     path.rs                  The curve drawn on the flat sheet (§5: a line for a geodesic, else a planar curve whose signed …
 //!     sheet.rs                 The flat sheet (§3.3)
 //!     spline.rs                Control curves as something to evaluate
+//!   spline/
+//!     mod.rs                   Spline developables (Tang, Bo, Wallner, Pottmann 2016, *Interactive design of developable surf…
+//!     develop.rs               Isometry to a prescribed flat domain (Tang et al. 2016, §5, eq. 12)
+//!     solve.rs                 Guided projection (Tang et al. 2016, §3.2 eq. 6) for spline developables
+//!     system.rs                The linear algebra of guided projection (Tang et al. 2016, eq. 6)
+//!     target.rs                Approximation of a target shape (Tang et al. 2016, §4.2, eq. 9–11)
+//!     tests.rs                 Spline developables with exact answers (issue 24's acceptance shapes, at the library level)
 //!   strip/
 //!     mod.rs                   Developable triangulations of a strip (Wang & Tang, seed 003)
 //!     global.rs                The global searches (§5)
