@@ -605,34 +605,43 @@ fn strip_ref<'a>(l: &'a Layout, basis: &'a BSpline, k: usize) -> StripRef<'a> {
     }
 }
 
+/// The footpoint of `q` on its nearest strip (of those whose search `grids` are given), with
+/// the surface normal there.
+fn nearest_foot(l: &Layout, basis: &BSpline, grids: &[Vec<(f64, f64, DVec3)>], q: DVec3) -> Foot {
+    let mut best = (
+        f64::INFINITY,
+        Foot {
+            strip: 0,
+            u: 0.0,
+            v: 0.0,
+            n: DVec3::ZERO,
+        },
+    );
+    for (k, grid) in grids.iter().enumerate() {
+        let st = strip_ref(l, basis, k);
+        let (u, v, d) = st.footpoint(grid, q);
+        if d < best.0 {
+            let (_, su, sv) = st.eval(u, v);
+            let n = su.cross(sv).normalize_or_zero();
+            best = (d, Foot { strip: k, u, v, n });
+        }
+    }
+    best.1
+}
+
+/// The search grids of every strip.
+fn grids(l: &Layout, basis: &BSpline) -> Vec<Vec<(f64, f64, DVec3)>> {
+    (0..l.strips.len())
+        .map(|k| strip_ref(l, basis, k).grid())
+        .collect()
+}
+
 /// The footpoint of every target point on its nearest strip, with the surface normal there.
 fn feet(l: &Layout, basis: &BSpline) -> Vec<Foot> {
-    let grids: Vec<_> = (0..l.strips.len())
-        .map(|k| strip_ref(l, basis, k).grid())
-        .collect();
+    let grids = grids(l, basis);
     l.target
         .iter()
-        .map(|&(q, _)| {
-            let mut best = (
-                f64::INFINITY,
-                Foot {
-                    strip: 0,
-                    u: 0.0,
-                    v: 0.0,
-                    n: DVec3::ZERO,
-                },
-            );
-            for (k, grid) in grids.iter().enumerate() {
-                let st = strip_ref(l, basis, k);
-                let (u, v, d) = st.footpoint(grid, q);
-                if d < best.0 {
-                    let (_, su, sv) = st.eval(u, v);
-                    let n = su.cross(sv).normalize_or_zero();
-                    best = (d, Foot { strip: k, u, v, n });
-                }
-            }
-            best.1
-        })
+        .map(|&(q, _)| nearest_foot(l, basis, &grids, q))
         .collect()
 }
 
@@ -811,38 +820,16 @@ impl Problem {
         });
         let mut l = layout(m, scaled, target);
         let basis = m.basis.clone();
-        let grids: Vec<_> = (0..l.strips.len())
-            .map(|k| strip_ref(&l, &basis, k).grid())
-            .collect();
+        let grids = grids(&l, &basis);
         l.handles = m
             .handles
             .iter()
             .map(|&(at, to)| {
                 let q = (at - centre) / diameter;
-                let mut best = (
-                    f64::INFINITY,
-                    Foot {
-                        strip: 0,
-                        u: 0.0,
-                        v: 0.0,
-                        n: DVec3::ZERO,
-                    },
-                );
-                for (k, g) in grids.iter().enumerate() {
-                    let (u, v, d) = strip_ref(&l, &basis, k).footpoint(g, q);
-                    if d < best.0 {
-                        best = (
-                            d,
-                            Foot {
-                                strip: k,
-                                u,
-                                v,
-                                n: DVec3::ZERO,
-                            },
-                        );
-                    }
-                }
-                (best.1, (to - centre) / diameter)
+                (
+                    nearest_foot(&l, &basis, &grids, q),
+                    (to - centre) / diameter,
+                )
             })
             .collect();
         l.handle_start = l
