@@ -9,7 +9,7 @@
 //!
 //! - The sheet starts flat: the curves as given lie in the plane z = 0 of the outline's
 //!   coordinates, and V̄ starts as V's (x, y). The flat creases are the creases as given.
-//! - V samples every curve at 8 parameters per span (ends included); a vertex is a linear
+//! - V samples every curve at 4 parameters per span (ends included); a vertex is a linear
 //!   expression in the control points (the paper's relation (5)).
 //! - Eq. 12 is divided by 2‖vᵢ − vⱼ‖ at the current iterate, so its residual is a length
 //!   difference; the outline and crease rows are distances; all weigh 1.
@@ -23,7 +23,7 @@ use crate::geom::bspline::BSpline;
 use glam::{DVec2, DVec3};
 
 /// Parameters per span of the development mesh.
-const PER_SPAN: usize = 8;
+const PER_SPAN: usize = 4;
 
 /// The development's unknowns and conditions (in the solver's scaled frame).
 pub(super) struct Dev {
