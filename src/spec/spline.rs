@@ -7,7 +7,8 @@
 //! (the whole curve), `[curve, point]` (1-based) or `"apex"`; the shape checks of
 //! [`crate::surface::spline::model`] (counts, degree, creases on straight curves) run here, so
 //! their messages name the line of the key concerned. Mesh, strip and bent-sheet keys are
-//! refused; `max_iterations` is shared with boundaries (the same meaning).
+//! refused, except `outline` and `handles` (with their spline meanings) and `side` and
+//! `k_factor` (as strips); `max_iterations` is shared with boundaries (the same meaning).
 
 use super::context::{Ctx, MM_POSITIVE};
 use super::spanned::{span, List, RawSurface};
@@ -19,8 +20,8 @@ use glam::DVec3;
 use std::path::Path;
 use toml::{Spanned, Value};
 
-/// The default `max_iterations` with a `target`: a fit converges linearly at the end (a
-/// half cylinder of radius 100 from its rectangle: 0.22 mm RMS after 50, 0.05 after 150).
+/// The default `max_iterations` with a `target`: a fit converges linearly at the end, so it
+/// gets more rounds than a solve of constraints alone.
 const TARGET_MAX_ITERATIONS: usize = 150;
 
 impl Ctx<'_> {

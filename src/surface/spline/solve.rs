@@ -15,12 +15,16 @@
 //! - Fairness K: second differences of each control polygon (cyclic when closed), with s their
 //!   values in the input, not 0: the paper's Σ‖aᵢ₊₁ − 2aᵢ + aᵢ₋₁‖² pulls a closed polygon
 //!   towards one point, where every ruled surface is trivially "developable" (a loft between
-//!   two rims collapsed to a double cone in our first trials); measured against the input it
-//!   keeps the designed shape without shrinking it. Schedule
-//!   ε₁ = `epsilon1`·0.9ⁱ for the first `iterations` rounds and 0 after (Fig. 17's schedule);
+//!   two rims can collapse to a double cone); measured against the input it keeps the
+//!   designed shape without shrinking it. Schedule ε₁ = `epsilon1`·0.9ⁱ for the first
+//!   `iterations` rounds (at least [`HANDLE_RAMP`] with handles) and 0 after (Fig. 17's);
 //!   ε₂ = `epsilon2` while the fairness acts, then divided by 10 per round down to 1e-4 (held
 //!   at ε₂ it damps the last rounds into linear convergence; much below 1e-4 the normal
 //!   equations lose the digits the last rounds need).
+//! - Goals besides the constraints — a target (eq. 9–11, rows in this file, footpoints from
+//!   `target`), handles (weight 1, their goal moved there over [`HANDLE_RAMP`] rounds) and an
+//!   outline (eq. 12, `develop`) — keep the solve going past the sine test until their
+//!   measure stops changing; a deterministic work budget bounds the rounds of any design.
 //! - The model is moved to its bounding box centre and scaled to diameter 1 inside.
 //! - A step whose squared constraint residual is larger than the current one is halved, up to
 //!   8 times (then taken as it is).

@@ -17,8 +17,9 @@
 //!   fit (so a cylinder's rulings start along its axis), the curves across them at the
 //!   extremes of the points' projections, each with evenly spaced control points lifted onto
 //!   the fit's profile across the middle ruling: both curves are that profile translated along
-//!   the rulings, so the start is a general cylinder, developable (the paper starts from a
-//!   flat rectangle; a flat start needs hundreds of iterations to bend onto a half cylinder).
+//!   the rulings, so the start is a general cylinder, developable and already bent like the
+//!   target (the paper starts from the flat rectangle, which guided projection bends only
+//!   slowly: the developability rows see bending at second order).
 //! - Footpoints: the nearest of a grid of 8 parameters per span by 9 across the strip, then
 //!   Gauss–Newton steps on |s(u, v) − q|², with u and v clamped to the strip (a point beyond
 //!   its edge is pulled by eq. 9 towards that edge: the strip grows to cover the target).
