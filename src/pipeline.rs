@@ -499,7 +499,7 @@ pub fn cut(
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    files.extend(write_pictures(&mut run, &spec.name, &job, extras.dpi)?);
+    files.extend(write_pictures(&mut run, &spec.name, &job, extras)?);
     files.extend(write_dxf(&mut run, &spec.name, &layout)?);
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
@@ -563,7 +563,7 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
     let mut run = RunFiles::begin(&dir)?;
-    let mut files = write_pictures(&mut run, &spec.name, &job, extras.dpi)?;
+    let mut files = write_pictures(&mut run, &spec.name, &job, extras)?;
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
@@ -813,14 +813,16 @@ fn write_alternatives(
     Ok(files)
 }
 
-/// Write `<name>.svg`, `<name>.pdf` and `<name>-<k>.png` per sheet (at `dpi`, else the
-/// preview resolution); returns the file names.
+/// Write `<name>.svg`, `<name>.pdf` and `<name>-<k>.png` per sheet (at `--dpi`, else the
+/// preview resolution; a sheet too large for that is drawn coarser, with a warning unless
+/// quiet); returns the file names.
 fn write_pictures(
     run: &mut RunFiles,
     name: &str,
     job: &Job,
-    dpi: Option<f64>,
+    extras: &Extras,
 ) -> Result<Vec<String>, Error> {
+    let dpi = extras.dpi;
     let mut files = Vec::new();
     let svg = format!("{name}.svg");
     run.write(&svg, crate::output::svg::render(job).as_bytes())?;
@@ -832,6 +834,18 @@ fn write_pictures(
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
         let bytes = crate::output::png::render(sheet, i + 1, px_per_mm)?;
+        let drawn = crate::output::png::drawn_px_per_mm(sheet, px_per_mm);
+        if let (Some(d), false) = (dpi, extras.quiet) {
+            if drawn < px_per_mm {
+                eprintln!(
+                    "flatcut: warning: --dpi {d}: {png} ({:.0} x {:.0} mm) is drawn at {:.0} dpi, the most a {} px picture holds; print from {name}.pdf, which is 1:1 at any size",
+                    sheet.width,
+                    sheet.height,
+                    drawn * 25.4,
+                    crate::output::png::MAX_SIDE_PX
+                );
+            }
+        }
         run.write(&png, &bytes)?;
         files.push(png);
     }

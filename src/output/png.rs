@@ -33,7 +33,7 @@ use crate::toolpath::SheetJob;
 pub const DEFAULT_PX_PER_MM: f64 = 4.0;
 
 /// Longest side of a picture, px; larger pictures are drawn at a reduced scale.
-pub(crate) const MAX_SIDE_PX: u32 = 6000;
+pub const MAX_SIDE_PX: u32 = 6000;
 
 /// White border around the sheet, mm.
 pub(crate) const BORDER_MM: f64 = 2.0;
@@ -46,6 +46,18 @@ const SHEET_OUTLINE_MM: f64 = 0.2;
 
 /// Sheet outline colour, light grey.
 const SHEET_GREY: u8 = 0xc0;
+
+/// The scale (px per mm) a sheet is drawn at when `px_per_mm` is asked for: that, or less so
+/// that the picture (the sheet and its border) fits [`MAX_SIDE_PX`] on its longer side.
+pub fn drawn_px_per_mm(sheet: &SheetJob, px_per_mm: f64) -> f64 {
+    let longer = (sheet.width + 2.0 * BORDER_MM).max(sheet.height + 2.0 * BORDER_MM);
+    let max_side = f64::from(MAX_SIDE_PX);
+    if longer * px_per_mm > max_side {
+        max_side / longer
+    } else {
+        px_per_mm
+    }
+}
 
 /// Renders sheet `index` of a job (the index is only used in errors) as PNG bytes at
 /// `px_per_mm`, reduced if needed so that neither side exceeds `MAX_SIDE_PX`.
@@ -66,12 +78,7 @@ pub fn render(sheet: &SheetJob, index: usize, px_per_mm: f64) -> Result<Vec<u8>,
     let w_mm = sheet.width + 2.0 * BORDER_MM;
     let h_mm = sheet.height + 2.0 * BORDER_MM;
     let max_side = f64::from(MAX_SIDE_PX);
-    let longer = w_mm.max(h_mm);
-    let scale = if longer * px_per_mm > max_side {
-        max_side / longer
-    } else {
-        px_per_mm
-    };
+    let scale = drawn_px_per_mm(sheet, px_per_mm);
     let w_px = (w_mm * scale).ceil().min(max_side);
     let h_px = (h_mm * scale).ceil().min(max_side);
     let mut pixmap = Pixmap::new(to_px(w_px), to_px(h_px)).ok_or(picture_error(w_px, h_px))?;

@@ -622,6 +622,29 @@ fn png_dpi_sets_phys_and_size() {
     assert_eq!(phys, Some((5906, 5906, 1)));
     assert!(dir.join("house.pdf").is_file());
 
+    // 1200 dpi of the 424 mm tall picture (the A3 sheet and its borders) is over 6000 px:
+    // drawn coarser, said on stderr, and pHYs says the scale drawn at.
+    let dir = scratch("pdf-png-capped");
+    let o = flatcut(&[
+        "cut",
+        "patterns/house.toml",
+        "--dry-run",
+        "--dpi",
+        "1200",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning: --dpi 1200: house-1.png") && e.contains("house.pdf"),
+        "{e}"
+    );
+    let (phys, width) = png_phys(&std::fs::read(dir.join("house-1.png")).unwrap());
+    assert!(width <= 6000, "{width}");
+    let want = (6000.0 / (420.0 + 2.0 * border) * 1000.0).round() as u32;
+    assert_eq!(phys, Some((want, want, 1)), "{e}");
+
     for bad in ["0", "abc", "-3", "1201", "nan"] {
         let dir = scratch("pdf-png-bad");
         let o = flatcut(&[
