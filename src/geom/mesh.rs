@@ -45,6 +45,13 @@ pub struct Topology {
 /// Newell normal of a closed polygon: the sum of `p[i] × p[i + 1]` (indices cyclic). Its
 /// direction is the polygon's normal (counter-clockwise seen from its tip), its length twice
 /// the area of the (possibly non-planar) polygon's projection on the plane across it.
+/// Axis-aligned bounding box (min, max) of 3D points; `None` for none.
+pub fn bounds3<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Option<(DVec3, DVec3)> {
+    let mut it = points.into_iter();
+    let first = *it.next()?;
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+}
+
 pub fn newell(p: &[DVec3]) -> DVec3 {
     let mut n = DVec3::ZERO;
     for i in 0..p.len() {
@@ -122,11 +129,7 @@ impl Mesh {
 
     /// Axis-aligned bounding box (min, max); zero for an empty mesh.
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut it = self.vertices.iter();
-        let Some(first) = it.next() else {
-            return (DVec3::ZERO, DVec3::ZERO);
-        };
-        it.fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        bounds3(&self.vertices).unwrap_or((DVec3::ZERO, DVec3::ZERO))
     }
 
     /// Signed bend angle (radians) at the edge of corner `i` of face `f`, shared with face

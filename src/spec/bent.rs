@@ -38,9 +38,15 @@ use std::path::Path;
 use toml::Value;
 
 impl Ctx<'_> {
-    /// Keys only a bent sheet takes are errors on other kinds.
-    pub(super) fn no_bent_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
-        self.refuse(
+    /// Keys only a bent sheet takes are errors on other kinds (but those in `except`, which
+    /// the kind takes with its own meaning).
+    pub(super) fn no_bent_keys(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        except: &[&str],
+    ) -> Result<(), SpecError> {
+        self.refuse_except(
             key,
             &[
                 ("outline", span(&s.outline)),
@@ -53,9 +59,9 @@ impl Ctx<'_> {
                 ("length_fit", span(&s.length_fit)),
                 ("pieces", span(&s.pieces)),
             ],
+            except,
             "is for bent sheets (kind = \"bent-sheet\")",
-        )?;
-        Ok(())
+        )
     }
 
     /// A 2D point `[x, y]`.

@@ -372,8 +372,15 @@ impl Ctx<'_> {
         Ok((rulings, rulings_line))
     }
 
-    pub(super) fn no_boundary_keys(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
-        self.refuse(
+    /// Keys only a boundary takes are errors on other kinds (but those in `except`, which the
+    /// kind takes with its own meaning).
+    pub(super) fn no_boundary_keys(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        except: &[&str],
+    ) -> Result<(), SpecError> {
+        self.refuse_except(
             key,
             &[
                 ("loop", span(&s.loop_)),
@@ -388,6 +395,7 @@ impl Ctx<'_> {
                 ("good_interior", span(&s.good_interior)),
                 ("good_fairness", span(&s.good_fairness)),
             ],
+            except,
             "is for boundary surfaces (kind = \"boundary\")",
         )
     }

@@ -98,6 +98,23 @@ impl Ctx<'_> {
         }
     }
 
+    /// [`Ctx::refuse`] but for the keys in `except`, which the kind takes with its own
+    /// meaning.
+    pub(super) fn refuse_except(
+        &self,
+        key: &str,
+        keys: &[(&str, Option<Range<usize>>)],
+        except: &[&str],
+        why: &str,
+    ) -> Result<(), SpecError> {
+        let kept: Vec<_> = keys
+            .iter()
+            .filter(|(k, _)| !except.contains(k))
+            .cloned()
+            .collect();
+        self.refuse(key, &kept, why)
+    }
+
     pub(super) fn invalid(&self, line: usize, key: &str, message: String) -> SpecError {
         SpecError::Invalid {
             path: self.path.to_path_buf(),

@@ -20,7 +20,7 @@
 //! (`iterations` 1 to 100, `fixed` entries "boundary" or a vertex number from 1).
 
 use super::context::Ctx;
-use super::spanned::RawSurface;
+use super::spanned::{span, RawSurface};
 use super::{stem_or, SpecError};
 use crate::surface::{
     ApproximateSpec, Fixed, Segment, SegmentSpec, SurfaceKind, SurfaceSpec, Units,
@@ -192,5 +192,30 @@ impl Ctx<'_> {
             }
         }
         Ok(out)
+    }
+}
+
+impl Ctx<'_> {
+    /// Keys only a mesh surface takes are errors on other kinds, with `why`.
+    pub(super) fn no_mesh_keys(
+        &self,
+        s: &RawSurface,
+        key: &str,
+        why: &str,
+    ) -> Result<(), SpecError> {
+        self.refuse(
+            key,
+            &[
+                ("path", span(&s.path)),
+                ("scale", span(&s.scale)),
+                ("units", span(&s.units)),
+                ("segment", span(&s.segment)),
+                ("charts", span(&s.charts)),
+                ("f_max", span(&s.f_max)),
+                ("approximate", span(&s.approximate)),
+                ("simplify", span(&s.simplify)),
+            ],
+            why,
+        )
     }
 }

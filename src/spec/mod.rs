@@ -473,10 +473,10 @@ impl Ctx<'_> {
                     )
                 })?;
             if !matches!(kind, SurfaceKind::BentSheet | SurfaceKind::Spline) {
-                self.no_bent_keys(s, &key)?;
+                self.no_bent_keys(s, &key, &[])?;
             }
             if !matches!(kind, SurfaceKind::Boundary | SurfaceKind::Spline) {
-                self.no_boundary_keys(s, &key)?;
+                self.no_boundary_keys(s, &key, &[])?;
             }
             if kind != SurfaceKind::Spline {
                 self.no_spline_keys(s, &key)?;

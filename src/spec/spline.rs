@@ -563,54 +563,23 @@ impl Ctx<'_> {
         }
     }
 
-    /// Keys of other kinds on a spline are mistakes.
+    /// Keys of other kinds on a spline are mistakes (`outline` and `handles` of bent sheets
+    /// and `max_iterations` of boundaries are the spline's own, `side` and `k_factor` as
+    /// strips).
     fn no_other_keys_on_spline(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
+        const WHY: &str = "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `side`, `k_factor`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`";
+        self.no_mesh_keys(s, key, WHY)?;
         self.refuse(
             key,
             &[
-                ("path", span(&s.path)),
-                ("scale", span(&s.scale)),
-                ("units", span(&s.units)),
-                ("segment", span(&s.segment)),
-                ("charts", span(&s.charts)),
-                ("f_max", span(&s.f_max)),
-                ("approximate", span(&s.approximate)),
-                ("simplify", span(&s.simplify)),
                 ("p", span(&s.p)),
                 ("q", span(&s.q)),
                 ("method", span(&s.method)),
             ],
-            "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `side`, `k_factor`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`",
+            WHY,
         )?;
-        self.refuse(
-            key,
-            &[
-                ("holes", span(&s.holes)),
-                ("line", span(&s.line)),
-                ("arc", span(&s.arc)),
-                ("flat_curve", span(&s.flat_curve)),
-                ("control_points", span(&s.control_points)),
-                ("length_fit", span(&s.length_fit)),
-                ("pieces", span(&s.pieces)),
-            ],
-            "is for bent sheets (kind = \"bent-sheet\")",
-        )?;
-        self.refuse(
-            key,
-            &[
-                ("loop", span(&s.loop_)),
-                ("loop_csv", span(&s.loop_csv)),
-                ("loops", span(&s.loops)),
-                ("darts", span(&s.darts)),
-                ("rulings", span(&s.rulings)),
-                ("max_dihedral", span(&s.max_dihedral)),
-                ("min_chart_area", span(&s.min_chart_area)),
-                ("smooth", span(&s.smooth)),
-                ("good_interior", span(&s.good_interior)),
-                ("good_fairness", span(&s.good_fairness)),
-            ],
-            "is for boundary surfaces (kind = \"boundary\")",
-        )
+        self.no_bent_keys(s, key, &["outline", "handles"])?;
+        self.no_boundary_keys(s, key, &["max_iterations"])
     }
 }
 
@@ -636,20 +605,9 @@ impl Ctx<'_> {
     }
 }
 
-/// Whether `p` lies inside or on the polygon (even-odd rule, edges within 1e-6 count).
+/// Whether `p` lies inside or on the polygon (edges within 1e-6 count).
 fn inside(poly: &[glam::DVec2], p: glam::DVec2) -> bool {
+    use crate::geom::polygon::{contains, segment_distance};
     let n = poly.len();
-    let mut odd = false;
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        let ab = b - a;
-        let t = ((p - a).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
-        if (a + ab * t).distance(p) <= 1e-6 {
-            return true;
-        }
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            odd = !odd;
-        }
-    }
-    odd
+    (0..n).any(|i| segment_distance(p, poly[i], poly[(i + 1) % n]) <= 1e-6) || contains(poly, p)
 }

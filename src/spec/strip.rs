@@ -10,7 +10,7 @@
 //! the flags that may change it) is known only later.
 
 use super::context::{Ctx, MM_POSITIVE};
-use super::spanned::{span, RawSurface};
+use super::spanned::RawSurface;
 use super::SpecError;
 use crate::surface::{SegmentSpec, SheetSide, StripSpec, SurfaceKind, SurfaceSpec, Units};
 use std::path::Path;
@@ -25,18 +25,9 @@ impl Ctx<'_> {
         dir: &Path,
     ) -> Result<SurfaceSpec, SpecError> {
         use crate::surface::strip::Method;
-        self.refuse(
+        self.no_mesh_keys(
+            s,
             key,
-            &[
-                ("path", span(&s.path)),
-                ("scale", span(&s.scale)),
-                ("units", span(&s.units)),
-                ("segment", span(&s.segment)),
-                ("charts", span(&s.charts)),
-                ("f_max", span(&s.f_max)),
-                ("approximate", span(&s.approximate)),
-                ("simplify", span(&s.simplify)),
-            ],
             "is for mesh surfaces; a strip takes the curves `p` and `q`",
         )?;
         let tolerance = self

@@ -91,3 +91,29 @@ macro_rules! require_shared {
         }
     };
 }
+
+/// Each pen-1 (cut) contour of an HP-GL program at 40 units/mm, as its points in mm.
+pub fn hpgl_cut_contours(plt: &str) -> Vec<Vec<(f64, f64)>> {
+    flatcut::output::hpgl::parse(plt)
+        .expect("valid HPGL")
+        .iter()
+        .filter(|s| s.pen == 1)
+        .map(|s| {
+            s.points
+                .iter()
+                .map(|&(x, y)| (x as f64 / 40.0, y as f64 / 40.0))
+                .collect()
+        })
+        .collect()
+}
+
+/// Area (mm², by the shoelace formula) and length (mm) of a polyline taken as a ring.
+pub fn area_and_length(pts: &[(f64, f64)]) -> (f64, f64) {
+    let mut area = 0.0;
+    let mut per = 0.0;
+    for w in pts.windows(2) {
+        area += w[0].0 * w[1].1 - w[1].0 * w[0].1;
+        per += ((w[1].0 - w[0].0).powi(2) + (w[1].1 - w[0].1).powi(2)).sqrt();
+    }
+    (0.5 * area.abs(), per)
+}

@@ -6,7 +6,6 @@
 
 use crate::common::*;
 use flatcut::geom::bspline::BSpline;
-use flatcut::output::hpgl;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
@@ -48,29 +47,36 @@ fn cut(dir: &Path, spec: &Path, extra: &[&str]) -> serde_json::Value {
     args.extend_from_slice(extra);
     let o = flatcut(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
+    read_json(&out.join("report.json"))
 }
 
 /// Area (mm²) and perimeter (mm) of each pen-1 (cut) contour of the run's HP-GL (40 units/mm).
 fn cut_contours(dir: &Path) -> Vec<(f64, f64)> {
     let plt = std::fs::read_to_string(dir.join("out/spline.plt")).unwrap();
-    let strokes = hpgl::parse(&plt).expect("valid HPGL");
-    strokes
+    hpgl_cut_contours(&plt)
         .iter()
-        .filter(|s| s.pen == 1)
-        .map(|s| {
-            let pts: Vec<(f64, f64)> = s
-                .points
+        .map(|c| area_and_length(c))
+        .collect()
+}
+
+/// A JSON file read.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The control points of every curve of the first surface of a `--spline-json` document.
+fn design_curves(d: &serde_json::Value) -> Vec<Vec<DVec3>> {
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    d["surfaces"][0]["curves"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            c.as_array()
+                .unwrap()
                 .iter()
-                .map(|&(x, y)| (x as f64 / 40.0, y as f64 / 40.0))
-                .collect();
-            let mut area = 0.0;
-            let mut per = 0.0;
-            for w in pts.windows(2) {
-                area += w[0].0 * w[1].1 - w[1].0 * w[0].1;
-                per += ((w[1].0 - w[0].0).powi(2) + (w[1].1 - w[0].1).powi(2)).sqrt();
-            }
-            (0.5 * area.abs(), per)
+                .map(|p| DVec3::new(num(&p[0]), num(&p[1]), num(&p[2])))
+                .collect()
         })
         .collect()
 }
@@ -262,21 +268,16 @@ fn spline_fold_by_reflection_gives_one_piece_with_the_crease_length() {
         .all(|f| f["angle_deg"].as_f64().unwrap() > 10.0));
     // The design as JSON: the curves as solved (here as given), the crease, and the crease
     // on the flat piece with its 3D length.
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let d = read_json(&json);
     let s = &d["surfaces"][0];
     assert_eq!(s["degree"], 3);
     assert_eq!(s["knots"].as_array().unwrap().len(), 8 + 3 + 1);
     assert_eq!(s["creases"][0]["condition"], "fold");
     assert_eq!(s["strips"], serde_json::json!([[1, 2], [2, 3]]));
+    let solved = design_curves(&d);
     for (c, curve) in curves.iter().enumerate() {
         for (k, p) in curve.iter().enumerate() {
-            let q = &s["curves"][c][k];
-            let q = DVec3::new(
-                q[0].as_f64().unwrap(),
-                q[1].as_f64().unwrap(),
-                q[2].as_f64().unwrap(),
-            );
+            let q = solved[c][k];
             assert!(
                 p.distance(q) < 1e-8,
                 "curve {} point {}: {q} vs {p}",
@@ -471,8 +472,7 @@ fn spline_lamp_pattern_is_one_sheet_folded_on_its_circle_with_a_glued_seam() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = read_json(&out.join("report.json"));
     let pieces = report["pieces"].as_array().unwrap();
     assert_eq!(pieces.len(), 1);
     assert_eq!(pieces[0]["tabs"], 1, "a glue tab on the seam");
@@ -505,27 +505,8 @@ fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
     .unwrap();
     let json = dir.join("design.json");
     let report = cut(&dir, &spec, &["--spline-json", json.to_str().unwrap()]);
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let s = &d["surfaces"][0];
-    let curves: Vec<Vec<DVec3>> = s["curves"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| {
-            c.as_array()
-                .unwrap()
-                .iter()
-                .map(|p| {
-                    DVec3::new(
-                        p[0].as_f64().unwrap(),
-                        p[1].as_f64().unwrap(),
-                        p[2].as_f64().unwrap(),
-                    )
-                })
-                .collect()
-        })
-        .collect();
+    let d = read_json(&json);
+    let curves = design_curves(&d);
     assert_eq!(curves.len(), 2);
     let basis = BSpline::new(3, curves[0].len(), false).unwrap();
     // Rulings along the cylinder's axis (x).
@@ -582,25 +563,11 @@ fn spline_handle_drags_a_corner_and_the_fixed_edge_stays() {
     );
     let json = dir.join("design.json");
     let report = cut(&dir, &spec, &["--spline-json", json.to_str().unwrap()]);
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let curve = |c: usize| -> Vec<DVec3> {
-        d["surfaces"][0]["curves"][c]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| {
-                DVec3::new(
-                    p[0].as_f64().unwrap(),
-                    p[1].as_f64().unwrap(),
-                    p[2].as_f64().unwrap(),
-                )
-            })
-            .collect()
-    };
-    assert_eq!(curve(0), a, "the fixed edge stays");
+    let d = read_json(&json);
+    let curves = design_curves(&d);
+    assert_eq!(curves[0], a, "the fixed edge stays");
     // The corner is the last control point of the clamped curve 2.
-    let corner = *curve(1).last().unwrap();
+    let corner = *curves[1].last().unwrap();
     let goal = DVec3::new(190.0, 100.0, 50.0);
     eprintln!(
         "handle: corner at {corner} ({:.2e} mm from the goal) after {} iterations, sine {:.2e}",
@@ -685,8 +652,7 @@ fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
     assert_eq!(contours.len(), 1);
     let (area, per) = contours[0];
     // The crease on the flat piece, against the arc (distance to its circle).
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let d = read_json(&json);
     let dev = d["surfaces"][0]["development"]["curves"]
         .as_array()
         .unwrap();

@@ -23,22 +23,10 @@ fn fitting_spec(args: &[&str]) -> flatcut::spec::Spec {
 
 /// Area (mm²) and perimeter (mm) of the pen-1 (cut) contour of an HP-GL program at 40 units/mm.
 fn cut_contour(plt: &str) -> (f64, f64) {
-    let strokes = hpgl::parse(plt).expect("valid HPGL");
-    let cut: Vec<_> = strokes.iter().filter(|s| s.pen == 1).collect();
+    let cut = hpgl_cut_contours(plt);
     assert_eq!(cut.len(), 1, "one cut contour");
-    let pts: Vec<(f64, f64)> = cut[0]
-        .points
-        .iter()
-        .map(|&(x, y)| (x as f64 / 40.0, y as f64 / 40.0))
-        .collect();
-    assert_eq!(pts.first(), pts.last(), "closed");
-    let mut area = 0.0;
-    let mut per = 0.0;
-    for w in pts.windows(2) {
-        area += w[0].0 * w[1].1 - w[1].0 * w[0].1;
-        per += ((w[1].0 - w[0].0).powi(2) + (w[1].1 - w[0].1).powi(2)).sqrt();
-    }
-    (0.5 * area.abs(), per)
+    assert_eq!(cut[0].first(), cut[0].last(), "closed");
+    area_and_length(&cut[0])
 }
 
 #[test]

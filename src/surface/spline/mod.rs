@@ -286,11 +286,9 @@ pub const MAX_CONTROL_POINTS: usize = 5_000;
 /// The diagonal of the model's control points' bounding box (mm), at least 1e-300.
 fn diameter(m: &Model) -> f64 {
     let pts = m.curves.iter().flatten().chain(m.apex.iter());
-    let (lo, hi) = pts.fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    (hi - lo).length().max(1e-300)
+    crate::geom::mesh::bounds3(pts)
+        .map_or(0.0, |(lo, hi)| (hi - lo).length())
+        .max(1e-300)
 }
 
 /// The largest intrinsic crease sine at `per` parameters per span over the creases with a

@@ -25,7 +25,7 @@
 //!   its edge is pulled by eq. 9 towards that edge: the strip grows to cover the target).
 
 use crate::geom::bspline::BSpline;
-use crate::geom::mesh::Mesh;
+use crate::geom::mesh::{bounds3, Mesh};
 use glam::{DMat3, DVec3};
 
 /// Most target points kept after thinning.
@@ -74,7 +74,7 @@ impl Target {
         if self.points.len() <= MAX_TARGET_POINTS {
             return self;
         }
-        let (lo, hi) = bounds(&self.points);
+        let (lo, hi) = bounds3(&self.points).unwrap_or_default();
         let mut cell = (hi - lo).max_element().max(1e-300) / 64.0;
         loop {
             let mut seen = std::collections::HashSet::new();
@@ -177,13 +177,6 @@ impl Target {
     }
 }
 
-fn bounds(p: &[DVec3]) -> (DVec3, DVec3) {
-    p.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), q| (lo.min(*q), hi.max(*q)),
-    )
-}
-
 /// Least squares h = αx² + βxy + γy² + δx + εy + ζ (normal equations, Gaussian elimination
 /// with partial pivoting); `None` when singular.
 #[allow(clippy::needless_range_loop)] // rows and columns of one small matrix
@@ -225,7 +218,7 @@ fn cloud_normals(points: &[DVec3]) -> Vec<DVec3> {
     if n < 3 {
         return vec![DVec3::Z; n];
     }
-    let (lo, hi) = bounds(points);
+    let (lo, hi) = bounds3(points).unwrap_or_default();
     let cell = ((hi - lo).max_element() / (n as f64).cbrt()).max(1e-300);
     let key = |p: DVec3| {
         let c = ((p - lo) / cell).floor();

@@ -40,11 +40,18 @@
 //!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
 //!   nothing and is left out. Smooth: n_L − n_R = 0.
 
+mod goals;
+
 use super::develop::Dev;
 use super::system::{eval, normal_equations, sparse_solve, Expr, Pattern, Row};
-use super::target::{StripRef, Target};
+use super::target::Target;
 use crate::geom::bspline::BSpline;
 use glam::DVec3;
+pub use goals::HANDLE_RAMP;
+use goals::{
+    feet, foot_exprs, grids, handle_merit, handle_rows, nearest_foot, target_merit, target_rows,
+    Foot,
+};
 
 /// The solver's settings (spec keys of the same names).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -190,24 +197,6 @@ struct Layout {
     n: usize,
 }
 
-/// A target point's footpoint at the current iterate: strip, parameters and the surface's
-/// unit normal there (held fixed within the iteration, as Fig. 16 does).
-#[derive(Debug, Clone, Copy)]
-struct Foot {
-    strip: usize,
-    u: f64,
-    v: f64,
-    n: DVec3,
-}
-
-/// Iterations over which a handle's goal moves from where it starts to where it is dragged
-/// (a drag in small steps, as in interactive use: one step of the whole way lifts a flat
-/// sheet by second-order length changes the isometry rows do not see).
-pub const HANDLE_RAMP: usize = 10;
-
-/// The weight of a handle's three rows (Fig. 17: user-defined constraints weigh 1).
-const W_HANDLE: f64 = 1.0;
-
 /// The work budget of one solve: the sum over its iterations of the unknowns plus ten per
 /// footpoint search (a 270-control-point chain gets 2,800 iterations, a 4,000-point target on
 /// one strip 250).
@@ -217,11 +206,6 @@ const WORK_BUDGET: usize = 10_000_000;
 /// the largest handle distance, relative to the model's diameter) changes by less than this
 /// in one iteration.
 const TARGET_CONVERGED: f64 = 1e-7;
-
-/// Weights of eq. 9, 10 and 11 (Fig. 17's footnote: 1e-3, 1e-4, 1e-2).
-const W9: f64 = 1e-3;
-const W10: f64 = 1e-4;
-const W11: f64 = 1e-2;
 
 struct Sample {
     u: f64,
@@ -505,19 +489,33 @@ fn crease_rows(l: &Layout, x: &[f64], c: &CreaseSample, rows: &mut Vec<Row>) {
         entries.push((sl.normal + k, d[k] / perp));
         entries.push((sr.normal + k, sigma * d[k] / perp));
     }
-    for &(p, w) in &c.d2 {
-        if let Some(o) = l.var[p] {
-            for k in 0..3 {
-                entries.push((o + k, w * n0[k] / perp));
-            }
-            rhs += w * n0.dot(l.points[p]) / perp;
-        }
-    }
+    point_part(l, &c.d2, n0, perp, &mut entries, &mut rhs);
     rows.push(Row {
         entries,
         rhs,
         w: 1.0,
     });
+}
+
+/// The point part of a bilinear ⟨n, Σ w·P⟩ / `scale` linearised at the iterate (n held at
+/// its value there): the entries w·n/scale of the free points, and their value at the iterate
+/// added to `rhs`, as first-order linearisation asks.
+fn point_part(
+    l: &Layout,
+    expr: &Expr,
+    n: DVec3,
+    scale: f64,
+    entries: &mut Vec<(usize, f64)>,
+    rhs: &mut f64,
+) {
+    for &(p, w) in expr {
+        if let Some(o) = l.var[p] {
+            for c in 0..3 {
+                entries.push((o + c, w * n[c] / scale));
+            }
+            *rhs += w * n.dot(l.points[p]) / scale;
+        }
+    }
 }
 
 /// The rows of one bilinear constraint ⟨n, Σ w·P⟩ / |d| at the current iterate.
@@ -530,14 +528,7 @@ fn bilinear(l: &Layout, x: &[f64], s: &Sample, expr: &Expr, rows: &mut Vec<Row>)
     for c in 0..3 {
         entries.push((s.normal + c, d[c] / len));
     }
-    for &(p, w) in expr {
-        if let Some(o) = l.var[p] {
-            for c in 0..3 {
-                entries.push((o + c, w * n[c] / len));
-            }
-            rhs += w * n.dot(l.points[p]) / len;
-        }
-    }
+    point_part(l, expr, n, len, &mut entries, &mut rhs);
     rows.push(Row {
         entries,
         rhs,
@@ -552,12 +543,7 @@ fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec
     if let Some(d) = &l.dev {
         d.rows(&l.points, &l.var, x, eps1, &mut rows);
     }
-    for ((f, _), to) in l.handles.iter().zip(&l.handle_now) {
-        let (s, _, _) = foot_exprs(l, basis, f);
-        for c in (0..3).filter(|&c| to[c].is_finite()) {
-            rows.push(dot_row(l, &s, DVec3::AXES[c], to[c], W_HANDLE));
-        }
-    }
+    handle_rows(l, basis, &mut rows);
     for s in &l.samples {
         bilinear(l, x, s, &s.e, &mut rows);
         bilinear(l, x, s, &s.ta, &mut rows);
@@ -594,177 +580,6 @@ fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec
     rows
 }
 
-/// The strip `k` of the layout's points as the footpoint search sees it.
-fn strip_ref<'a>(l: &'a Layout, basis: &'a BSpline, k: usize) -> StripRef<'a> {
-    let count = basis.count();
-    let (a, b) = l.strips[k];
-    let curve = |c: usize| &l.points[c * count..(c + 1) * count];
-    StripRef {
-        basis,
-        a: curve(a),
-        b: match b {
-            Some(b) => Ok(curve(b)),
-            None => Err(l.points[l.points.len() - 1]),
-        },
-    }
-}
-
-/// The footpoint of `q` on its nearest strip (of those whose search `grids` are given), with
-/// the surface normal there.
-fn nearest_foot(l: &Layout, basis: &BSpline, grids: &[Vec<(f64, f64, DVec3)>], q: DVec3) -> Foot {
-    let mut best = (
-        f64::INFINITY,
-        Foot {
-            strip: 0,
-            u: 0.0,
-            v: 0.0,
-            n: DVec3::ZERO,
-        },
-    );
-    for (k, grid) in grids.iter().enumerate() {
-        let st = strip_ref(l, basis, k);
-        let (u, v, d) = st.footpoint(grid, q);
-        if d < best.0 {
-            let (_, su, sv) = st.eval(u, v);
-            let n = su.cross(sv).normalize_or_zero();
-            best = (d, Foot { strip: k, u, v, n });
-        }
-    }
-    best.1
-}
-
-/// The search grids of every strip.
-fn grids(l: &Layout, basis: &BSpline) -> Vec<Vec<(f64, f64, DVec3)>> {
-    (0..l.strips.len())
-        .map(|k| strip_ref(l, basis, k).grid())
-        .collect()
-}
-
-/// The footpoint of every target point on its nearest strip, with the surface normal there.
-fn feet(l: &Layout, basis: &BSpline) -> Vec<Foot> {
-    let grids = grids(l, basis);
-    l.target
-        .iter()
-        .map(|&(q, _)| nearest_foot(l, basis, &grids, q))
-        .collect()
-}
-
-/// Expressions of s(u, v), e = b(u) − a(u) and a′(u) on strip `k`.
-fn foot_exprs(l: &Layout, basis: &BSpline, f: &Foot) -> (Expr, Expr, Expr) {
-    let count = basis.count();
-    let (a, b) = l.strips[f.strip];
-    let r = basis.rows(f.u);
-    let on = |c: usize, row: &[(usize, f64)], k: f64| -> Expr {
-        row.iter().map(|&(j, w)| (c * count + j, k * w)).collect()
-    };
-    let apex = l.points.len() - 1;
-    let (mut s, mut e) = (on(a, &r.point, 1.0 - f.v), on(a, &r.point, -1.0));
-    match b {
-        Some(b) => {
-            s.extend(on(b, &r.point, f.v));
-            e.extend(on(b, &r.point, 1.0));
-        }
-        None => {
-            s.push((apex, f.v));
-            e.push((apex, 1.0));
-        }
-    }
-    (s, e, on(a, &r.d1, 1.0))
-}
-
-/// The row ⟨d, Σ w·P⟩ = rhs with weight `w`, fixed points moved to the right-hand side.
-fn dot_row(l: &Layout, expr: &Expr, d: DVec3, rhs: f64, w: f64) -> Row {
-    let mut entries = Vec::with_capacity(3 * expr.len());
-    let mut rhs = rhs;
-    for &(p, k) in expr {
-        match l.var[p] {
-            Some(o) => {
-                for c in 0..3 {
-                    if d[c] != 0.0 {
-                        entries.push((o + c, k * d[c]));
-                    }
-                }
-            }
-            None => rhs -= k * d.dot(l.points[p]),
-        }
-    }
-    Row { entries, rhs, w }
-}
-
-/// Eq. 9–11 at the footpoints: s(u, v) = q (three rows), ⟨m, e⟩/|e| = ⟨m, a′⟩/|a′| = 0 and
-/// ⟨s(u, v) − q, n⟩ = 0 with n held fixed.
-fn target_rows(l: &Layout, basis: &BSpline, feet: &[Foot], rows: &mut Vec<Row>) {
-    for (f, &(q, m)) in feet.iter().zip(&l.target) {
-        let (s, e, ta) = foot_exprs(l, basis, f);
-        for c in 0..3 {
-            rows.push(dot_row(l, &s, DVec3::AXES[c], q[c], w9(l, basis, f)));
-        }
-        for d in [&e, &ta] {
-            let len = eval(d, &l.points).length();
-            if len > 1e-12 {
-                rows.push(dot_row(l, d, m / len, 0.0, W10));
-            }
-        }
-        if f.n != DVec3::ZERO {
-            rows.push(dot_row(l, &s, f.n, f.n.dot(q), W11));
-        }
-    }
-}
-
-/// The weight of eq. 9 at a footpoint: [`W9`] inside the strip, [`W11`] on its edge (where
-/// the target goes on beyond the strip, eq. 9 is what makes it grow).
-fn w9(l: &Layout, basis: &BSpline, f: &Foot) -> f64 {
-    let spans = basis.spans() as f64;
-    let on_end = !basis.closed() && (f.u <= 1e-9 || f.u >= spans - 1e-9);
-    let (a, b) = l.strips[f.strip];
-    // An edge curve: the first curve of the chain at v = 0, the last at v = 1.
-    let first = a == 0 && f.v <= 1e-9;
-    let last = b == Some(l.strips.len()) && f.v >= 1.0 - 1e-9;
-    if on_end || first || last {
-        W11
-    } else {
-        W9
-    }
-}
-
-/// The handles' weighted squared residual and their largest distance from the goal.
-fn handle_merit(l: &Layout, basis: &BSpline, now: bool) -> (f64, f64) {
-    let (mut sum, mut worst) = (0.0, 0.0f64);
-    for (k, (f, goal)) in l.handles.iter().enumerate() {
-        let to = if now { &l.handle_now[k] } else { goal };
-        let p = eval(&foot_exprs(l, basis, f).0, &l.points);
-        // A coordinate left free (NaN: a lift sets only the height) does not count.
-        let d = (0..3)
-            .filter(|&c| to[c].is_finite())
-            .map(|c| (p[c] - to[c]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        sum += W_HANDLE * W_HANDLE * d * d;
-        worst = worst.max(d);
-    }
-    (sum, worst)
-}
-
-/// The weighted squared residual of eq. 9–11 at `feet` and the mean squared distance.
-fn target_merit(l: &Layout, basis: &BSpline, feet: &[Foot]) -> (f64, f64) {
-    let (mut sum, mut dist) = (0.0, 0.0);
-    for (f, &(q, m)) in feet.iter().zip(&l.target) {
-        let (s, e, ta) = foot_exprs(l, basis, f);
-        let r = eval(&s, &l.points) - q;
-        dist += r.length_squared();
-        let w = w9(l, basis, f);
-        sum += w * w * r.length_squared() + W11 * W11 * r.dot(f.n).powi(2);
-        for d in [&e, &ta] {
-            let d = eval(d, &l.points);
-            let len = d.length();
-            if len > 1e-12 {
-                sum += W10 * W10 * (m.dot(d) / len).powi(2);
-            }
-        }
-    }
-    (sum, dist / feet.len().max(1) as f64)
-}
-
 /// The model's points in one list (curves, then the apex).
 fn flat_points(m: &Model) -> Vec<DVec3> {
     let mut p: Vec<DVec3> = m.curves.iter().flatten().copied().collect();
@@ -799,16 +614,8 @@ impl Problem {
             .iter()
             .map(|&(at, to)| DVec3::select(to.is_finite_mask(), to, at))
             .collect();
-        let lo = pts
-            .iter()
-            .chain(&goals)
-            .chain(target)
-            .fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
-        let hi = pts
-            .iter()
-            .chain(&goals)
-            .chain(target)
-            .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
+        let (lo, hi) = crate::geom::mesh::bounds3(pts.iter().chain(&goals).chain(target))
+            .unwrap_or((DVec3::ZERO, DVec3::ZERO));
         let diameter = (hi - lo).length();
         if !(diameter > 0.0 && diameter.is_finite()) {
             return Err(SolveError::Degenerate);
