@@ -207,7 +207,9 @@
 //!   spline/
 //!     mod.rs                   Spline developables (Tang, Bo, Wallner, Pottmann 2016, *Interactive design of developable surf…
 //!     develop.rs               Isometry to a prescribed flat domain (Tang et al. 2016, §5, eq. 12)
-//!     solve.rs                 Guided projection (Tang et al. 2016, §3.2 eq. 6) for spline developables
+//!     solve/
+//!       mod.rs                 Guided projection (Tang et al. 2016, §3.2 eq. 6) for spline developables
+//!       goals.rs               The goals of a spline solve besides its constraints (Tang et al. 2016)
 //!     system.rs                The linear algebra of guided projection (Tang et al. 2016, eq. 6)
 //!     target.rs                Approximation of a target shape (Tang et al. 2016, §4.2, eq. 9–11)
 //!     tests.rs                 Spline developables with exact answers (issue 24's acceptance shapes, at the library level)
