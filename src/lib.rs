@@ -130,6 +130,7 @@
 //!   gcode.rs                   GRBL 1.1 G-code programs (dialect `grbl`) for a drag knife on Z, a servo-lifted pen or a laser,…
 //!   obj.rs                     Wavefront OBJ writer
 //!   pdf.rs                     PDF output: 1:1, a page per sheet, stroke kinds as switchable layers, test squares
+//!   print.rs                   tiled printing (--print): sheets onto printer pages with overlaps, match lines, assembly maps
 //!   png.rs                     PNG output
 //!   report.rs                  `report.json`
 //!   svg.rs                     SVG output

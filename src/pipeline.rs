@@ -405,6 +405,8 @@ pub struct Extras {
     /// Resolution of the PNG pictures in dots per inch (`--dpi`); `None`: the preview's
     /// [`crate::output::png::DEFAULT_PX_PER_MM`].
     pub dpi: Option<f64>,
+    /// Also write `<name>-print.pdf`, the sheets tiled onto printer pages (`--print`).
+    pub print: Option<crate::output::print::PrintOptions>,
 }
 
 /// What the operator does before a program of a run is sent (`cli::link` waits for it).
@@ -499,13 +501,15 @@ pub fn cut(
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    files.extend(write_pictures(&mut run, &spec.name, &job, extras)?);
+    let (pictures, print) = write_pictures(&mut run, &spec.name, &job, extras)?;
+    files.extend(pictures);
     files.extend(write_dxf(&mut run, &spec.name, &layout)?);
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
         dropped: dropped.clone(),
         warnings: cuttable(&layout, profile.knife_offset, spec, extras.quiet),
+        print,
         ..run_info(spec, &profile.name, &files)
     };
     write_report(&mut run, &info, &flats, &layout)?;
@@ -563,11 +567,12 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
     let mut run = RunFiles::begin(&dir)?;
-    let mut files = write_pictures(&mut run, &spec.name, &job, extras)?;
+    let (mut files, print) = write_pictures(&mut run, &spec.name, &job, extras)?;
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
         warnings: cuttable(&layout, 0.0, spec, extras.quiet),
+        print,
         ..run_info(spec, "", &files)
     };
     write_report(&mut run, &info, &flats, &layout)?;
@@ -710,6 +715,7 @@ fn run_info(spec: &Spec, device: &str, files: &[String]) -> RunInfo {
         files: files.to_vec(),
         warnings: Vec::new(),
         dropped: Vec::new(),
+        print: None,
     }
 }
 
@@ -813,15 +819,15 @@ fn write_alternatives(
     Ok(files)
 }
 
-/// Write `<name>.svg`, `<name>.pdf` and `<name>-<k>.png` per sheet (at `--dpi`, else the
+/// Write `<name>.svg`, `<name>.pdf`, `<name>-<k>.png` per sheet (at `--dpi`, else the
 /// preview resolution; a sheet too large for that is drawn coarser, with a warning unless
-/// quiet); returns the file names.
+/// quiet) and, with `--print`, `<name>-print.pdf`; returns the file names and the tiling.
 fn write_pictures(
     run: &mut RunFiles,
     name: &str,
     job: &Job,
     extras: &Extras,
-) -> Result<Vec<String>, Error> {
+) -> Result<(Vec<String>, Option<crate::output::print::Tiling>), Error> {
     let dpi = extras.dpi;
     let mut files = Vec::new();
     let svg = format!("{name}.svg");
@@ -830,6 +836,14 @@ fn write_pictures(
     let pdf = format!("{name}.pdf");
     run.write(&pdf, &crate::output::pdf::render(job))?;
     files.push(pdf);
+    let mut tiling = None;
+    if let Some(opts) = &extras.print {
+        let plan = crate::output::print::plan(job, opts)?;
+        let file = format!("{name}-print.pdf");
+        run.write(&file, &crate::output::print::render(job, &plan))?;
+        files.push(file);
+        tiling = Some(plan);
+    }
     let px_per_mm = dpi.map_or(crate::output::png::DEFAULT_PX_PER_MM, |d| d / 25.4);
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
@@ -849,7 +863,7 @@ fn write_pictures(
         run.write(&png, &bytes)?;
         files.push(png);
     }
-    Ok(files)
+    Ok((files, tiling))
 }
 
 /// Write `<name>.dxf` (or `<name>-<k>.dxf` per sheet); returns the file names.

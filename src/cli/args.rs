@@ -400,13 +400,67 @@ impl SheetArgs {
 pub const MAX_DPI: f64 = 1200.0;
 
 /// Picture flags (`cut`, `flatten`).
-#[derive(Debug, Clone, Copy, Default, Args)]
+#[derive(Debug, Clone, Default, Args)]
 pub struct PictureArgs {
     /// Resolution of the PNG pictures in dots per inch, more than 0 and at most 1200, written
     /// into each PNG (`pHYs`); default: the preview's 4 px/mm (101.6 dpi). A picture whose
     /// longer side would pass 6000 px is drawn coarser and says so in its `pHYs`.
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_dpi)]
     pub dpi: Option<f64>,
+    /// Also write `<name>-print.pdf`: each sheet tiled 1:1 onto printer pages (a4, a3, letter,
+    /// legal, tabloid or WxH in mm or inches) with overlaps, match lines and an assembly map
+    /// per sheet, for a home printer.
+    #[arg(long, value_name = "PAPER", value_parser = parse_paper)]
+    pub print: Option<(String, f64, f64)>,
+    /// The printer's unprintable margin at each page edge for `--print`, mm (default 6.35,
+    /// rounded up to 0.254 mm).
+    #[arg(long, value_name = "MM", requires = "print", allow_negative_numbers = true, value_parser = parse_non_negative)]
+    pub print_margin: Option<f64>,
+    /// How far neighbouring `--print` pages overlap, mm (default 10.16, rounded to 0.254 mm).
+    #[arg(long, value_name = "MM", requires = "print", allow_negative_numbers = true, value_parser = parse_non_negative)]
+    pub overlap: Option<f64>,
+}
+
+impl PictureArgs {
+    /// The tiling asked for with `--print`, if any.
+    pub fn print_options(&self) -> Option<crate::output::print::PrintOptions> {
+        let (paper, width, height) = self.print.clone()?;
+        let d = crate::output::print::PrintOptions::default();
+        Some(crate::output::print::PrintOptions {
+            paper,
+            width,
+            height,
+            margin_mm: self.print_margin.unwrap_or(d.margin_mm),
+            overlap_mm: self.overlap.unwrap_or(d.overlap_mm),
+        })
+    }
+}
+
+/// A printer paper: a name of [`crate::output::print::PAPERS`] or `WxH` as for `--sheet`;
+/// (name as given, width, height) in mm.
+pub fn parse_paper(s: &str) -> Result<(String, f64, f64), String> {
+    let t = s.trim().to_ascii_lowercase();
+    if let Some(&(n, w, h)) = crate::output::print::PAPERS.iter().find(|p| p.0 == t) {
+        return Ok((n.to_string(), w, h));
+    }
+    let names: Vec<&str> = crate::output::print::PAPERS.iter().map(|p| p.0).collect();
+    match parse_sheet(&t) {
+        Ok((w, h)) if !SHEETS.iter().any(|p| p.0 == t) && w <= 2000.0 && h <= 2000.0 => {
+            Ok((t, w, h))
+        }
+        _ => Err(format!(
+            "expected a printer paper ({}) or WIDTHxHEIGHT in mm (200x250) or inches (8.5x11in) up to 2000 mm, got {s:?}",
+            names.join(", ")
+        )),
+    }
+}
+
+/// A number of millimetres, 0 or more.
+pub fn parse_non_negative(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("expected a number of mm, 0 or more, got {s:?}")),
+    }
 }
 
 /// A resolution in dots per inch: more than 0, at most [`MAX_DPI`] (`--dpi`).

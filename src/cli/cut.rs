@@ -2,7 +2,8 @@
 //! applies the device profile and the flags (flags win), and runs [`crate::pipeline::cut`],
 //! which writes into `-o DIR`: the program for the device (`<name>.plt`, or `<name>-<k>.plt`
 //! per sheet when there are several), `<name>.svg`, `<name>.pdf` (1:1, a page per sheet),
-//! `<name>-<k>.png` per sheet (at `--dpi`), `<name>.dxf`
+//! `<name>-<k>.png` per sheet (at `--dpi`), with `--print` `<name>-print.pdf` (the sheets tiled
+//! onto printer pages, [`crate::output::print`]), `<name>.dxf`
 //! (or `<name>-<k>.dxf`) per sheet and `report.json`, each written whole or not at all. Then,
 //! unless `--dry-run`, the program is streamed to the device: the simulated cutter for `sim`
 //! (the default) or with `--simulate`, else the serial port given by `--port` (see
@@ -101,6 +102,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         spline_json: super::args::spline_json(&spec, &a.spline_json)?,
         quiet: a.quiet,
         dpi: a.pictures.dpi,
+        print: a.pictures.print_options(),
     };
     let search = a.search.search()?;
     let choices = crate::pipeline::Toolpath {

@@ -67,6 +67,7 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
         spline_json: super::args::spline_json(&spec, &a.spline_json)?,
         quiet: a.quiet,
         dpi: a.pictures.dpi,
+        print: a.pictures.print_options(),
     };
     let run = crate::pipeline::flatten(&spec, &search, &extras)?;
     if !a.quiet {

@@ -33,6 +33,7 @@ pub mod hpgl;
 pub mod obj;
 pub mod pdf;
 pub mod png;
+pub mod print;
 pub mod report;
 pub mod svg;
 
@@ -48,6 +49,9 @@ pub enum OutputError {
         width_px: u32,
         height_px: u32,
     },
+    /// Tiled printing (`--print`) cannot lay the job out on the paper.
+    #[error("--print {paper}: {message}")]
+    Print { paper: String, message: String },
     /// The PNG encoder refused the picture.
     #[error("sheet {sheet}: PNG encoding failed: {message}")]
     Encode { sheet: usize, message: String },

@@ -68,11 +68,13 @@ pub enum Layer {
     Grain,
     Weed,
     TestSquares,
+    /// Tiled printing's match lines, diamonds and page labels ([`super::print`]).
+    Tiling,
 }
 
 impl Layer {
     /// Every layer, in the order of the viewer's layer panel.
-    pub const ALL: [Layer; 8] = [
+    pub const ALL: [Layer; 9] = [
         Layer::Cut,
         Layer::Folds,
         Layer::Marks,
@@ -81,6 +83,7 @@ impl Layer {
         Layer::Grain,
         Layer::Weed,
         Layer::TestSquares,
+        Layer::Tiling,
     ];
 
     /// The layer a stroke of `role` is drawn in.
@@ -107,6 +110,7 @@ impl Layer {
             Layer::Grain => "Grain",
             Layer::Weed => "Weed",
             Layer::TestSquares => "Test squares",
+            Layer::Tiling => "Tiling",
         }
     }
 }
@@ -232,7 +236,7 @@ impl Obstacles {
 }
 
 /// Whether segment `p`–`q` meets the box `lo`..`hi` (Liang–Barsky clipping).
-fn segment_meets_box(p: DVec2, q: DVec2, lo: DVec2, hi: DVec2) -> bool {
+pub(crate) fn segment_meets_box(p: DVec2, q: DVec2, lo: DVec2, hi: DVec2) -> bool {
     let d = q - p;
     let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
     for (dp, lo_gap, hi_gap) in [(d.x, p.x - lo.x, hi.x - p.x), (d.y, p.y - lo.y, hi.y - p.y)] {
@@ -275,7 +279,7 @@ const MAX_COORD_MM: f64 = 1e7;
 /// The points of a stroke to draw: none with a non-finite coordinate or one beyond
 /// `MAX_COORD_MM`, a closed stroke without its repeated end point; `None` for a stroke with
 /// nothing to draw.
-fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
+pub(crate) fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
     let bad = |p: &DVec2| !(p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM);
     if s.points.is_empty() || s.points.iter().any(bad) {
         return None;
@@ -289,18 +293,18 @@ fn drawable(s: &Stroke) -> Option<Vec<DVec2>> {
 
 /// The page size of a sheet, mm: its own, or 1 mm for a side that is not a positive number
 /// up to `MAX_COORD_MM`.
-fn page_size_mm(sheet: &SheetJob) -> (f64, f64) {
+pub(crate) fn page_size_mm(sheet: &SheetJob) -> (f64, f64) {
     let ok = |v: f64| if v > 0.0 && v <= MAX_COORD_MM { v } else { 1.0 };
     (ok(sheet.width), ok(sheet.height))
 }
 
 /// A coordinate in mm, rounded to 0.001 mm, for the content stream.
-fn mm(v: f64) -> f32 {
+pub(crate) fn mm(v: f64) -> f32 {
     ((v * 1000.0).round() / 1000.0) as f32
 }
 
 /// The layers the job uses, in panel order: those of its strokes' roles and the test squares.
-fn layers_used(job: &Job) -> Vec<Layer> {
+pub(crate) fn layers_used(job: &Job) -> Vec<Layer> {
     let mut used: Vec<Layer> = job
         .sheets
         .iter()
@@ -333,34 +337,10 @@ pub fn render(job: &Job) -> Vec<u8> {
     };
 
     let mut pdf = Pdf::new();
-    let mut catalog = pdf.catalog(catalog_id);
-    catalog.pages(pages_id).page_mode(PageMode::UseOC);
-    let mut props = catalog.insert(Name(b"OCProperties")).dict();
-    props
-        .insert(Name(b"OCGs"))
-        .array()
-        .items(layer_ids.iter().copied());
-    let mut config = props.insert(Name(b"D")).dict();
-    config.pair(Name(b"Name"), TextStr("Layers"));
-    config.pair(Name(b"BaseState"), Name(b"ON"));
-    config
-        .insert(Name(b"Order"))
-        .array()
-        .items(layer_ids.iter().copied());
-    config.finish();
-    props.finish();
-    catalog.finish();
-
+    write_catalog(&mut pdf, catalog_id, pages_id, &layers, &layer_ids);
     pdf.pages(pages_id)
         .kids(page_ids.iter().copied())
         .count(page_ids.len() as i32);
-    for (layer, id) in layers.iter().zip(&layer_ids) {
-        pdf.indirect(*id)
-            .dict()
-            .pair(Name(b"Type"), Name(b"OCG"))
-            .pair(Name(b"Name"), TextStr(layer.name()));
-    }
-
     for (sheet, &page_id) in job.sheets.iter().zip(&page_ids) {
         let content_id = Ref::new(page_id.get() + 1);
         let (w, h) = page_size_mm(sheet);
@@ -387,11 +367,95 @@ pub fn render(job: &Job) -> Vec<u8> {
     pdf.finish()
 }
 
+/// The catalog with the layers (optional content groups `layer_ids`, all on, the viewer's
+/// layer panel open) and the layers' dictionaries.
+pub(crate) fn write_catalog(
+    pdf: &mut Pdf,
+    catalog_id: Ref,
+    pages_id: Ref,
+    layers: &[Layer],
+    layer_ids: &[Ref],
+) {
+    let mut catalog = pdf.catalog(catalog_id);
+    catalog.pages(pages_id).page_mode(PageMode::UseOC);
+    let mut props = catalog.insert(Name(b"OCProperties")).dict();
+    props
+        .insert(Name(b"OCGs"))
+        .array()
+        .items(layer_ids.iter().copied());
+    let mut config = props.insert(Name(b"D")).dict();
+    config.pair(Name(b"Name"), TextStr("Layers"));
+    config.pair(Name(b"BaseState"), Name(b"ON"));
+    config
+        .insert(Name(b"Order"))
+        .array()
+        .items(layer_ids.iter().copied());
+    config.finish();
+    props.finish();
+    catalog.finish();
+    for (layer, id) in layers.iter().zip(layer_ids) {
+        pdf.indirect(*id)
+            .dict()
+            .pair(Name(b"Type"), Name(b"OCG"))
+            .pair(Name(b"Name"), TextStr(layer.name()));
+    }
+}
+
 /// The content stream of one sheet's page; `oc_name` gives the resource name of a layer.
 fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Vec<u8> {
     let mut c = Content::new();
     let k = PT_PER_MM as f32;
     c.transform([k, 0.0, 0.0, k, 0.0, 0.0]);
+    draw_strokes(&mut c, sheet, oc_name, &|_| true, Frame::MM);
+    let (squares, _) = test_squares(sheet);
+    draw_test_squares(&mut c, &squares, oc_name(Layer::TestSquares));
+    c.finish().to_vec()
+}
+
+/// How sheet millimetres are written into a content stream.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Frame {
+    /// Whole micrometres (the user space is µm), shifted by this many µm; else millimetres
+    /// rounded to 0.001 mm. f32 holds every whole number of µm up to 16 m exactly, so a
+    /// point written on two pages with whole-µm shifts lands at the same sub-pixel phase on
+    /// both ([`super::print`]).
+    pub micrometres: Option<(f64, f64)>,
+}
+
+impl Frame {
+    /// Millimetres, unshifted.
+    pub const MM: Frame = Frame { micrometres: None };
+
+    /// A point as written.
+    pub fn at(self, p: DVec2) -> (f32, f32) {
+        match self.micrometres {
+            Some((sx, sy)) => (
+                ((p.x * 1000.0).round() + sx) as f32,
+                ((p.y * 1000.0).round() + sy) as f32,
+            ),
+            None => (mm(p.x), mm(p.y)),
+        }
+    }
+
+    /// A length in mm as written (line widths, dashes).
+    pub fn len(self, v: f64) -> f32 {
+        match self.micrometres {
+            Some(_) => (v * 1000.0).round() as f32,
+            None => v as f32,
+        }
+    }
+}
+
+/// Draws the strokes of a sheet for which `keep` holds (given their drawable points), in
+/// `frame`, each role in its layer (`oc_name`) and style, in `DRAW_ORDER`; sets round caps and
+/// joins.
+pub(crate) fn draw_strokes<'a>(
+    c: &mut Content,
+    sheet: &SheetJob,
+    oc_name: &dyn Fn(Layer) -> &'a [u8],
+    keep: &dyn Fn(&[DVec2]) -> bool,
+    frame: Frame,
+) {
     c.set_line_cap(LineCapStyle::RoundCap);
     c.set_line_join(LineJoinStyle::RoundJoin);
     for role in DRAW_ORDER {
@@ -400,6 +464,7 @@ fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Ve
             .iter()
             .filter(|s| s.role == role)
             .filter_map(|s| drawable(s).map(|p| (p, s.closed)))
+            .filter(|(p, _)| keep(p))
             .collect();
         if strokes.is_empty() {
             continue;
@@ -410,25 +475,27 @@ fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Ve
             .properties_named(Name(oc_name(Layer::of(role))));
         c.save_state();
         c.set_stroke_rgb(r, g, b);
-        c.set_line_width(super::svg::stroke_width_mm(role) as f32);
+        c.set_line_width(frame.len(super::svg::stroke_width_mm(role)));
         if !style.dash_mm.is_empty() {
-            c.set_dash_pattern(style.dash_mm.iter().map(|&d| d as f32), 0.0);
+            c.set_dash_pattern(style.dash_mm.iter().map(|&d| frame.len(d)), 0.0);
         }
         for (pts, closed) in &strokes {
-            path(&mut c, pts, *closed);
+            path_in(c, pts, *closed, frame);
         }
         c.stroke();
         c.restore_state();
         c.end_marked_content();
     }
+}
 
-    let (squares, _) = test_squares(sheet);
+/// Draws the test squares with their captions in the layer named `oc`.
+pub(crate) fn draw_test_squares(c: &mut Content, squares: &[TestSquare], oc: &[u8]) {
     c.begin_marked_content_with_properties(Name(b"OC"))
-        .properties_named(Name(oc_name(Layer::TestSquares)));
+        .properties_named(Name(oc));
     c.save_state();
     c.set_stroke_rgb(0.0, 0.0, 0.0);
     c.set_line_width(SQUARE_LINE_MM as f32);
-    for sq in &squares {
+    for sq in squares {
         let p = sq.corner;
         c.rect(mm(p.x), mm(p.y), mm(sq.side), mm(sq.side));
         let text = if sq.side == TEST_SQUARE_SIDES_MM[0] {
@@ -440,24 +507,30 @@ fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Ve
         let at = p + DVec2::splat(CAPTION_MM);
         for g in glyphs {
             let pts: Vec<DVec2> = g.iter().map(|q| at + *q).collect();
-            path(&mut c, &pts, false);
+            path(c, &pts, false);
         }
     }
     c.stroke();
     c.restore_state();
     c.end_marked_content();
-    c.finish().to_vec()
 }
 
 /// Appends one subpath through `pts` (a dot for a single point), closed with `h` if `closed`.
-fn path(c: &mut Content, pts: &[DVec2], closed: bool) {
+pub(crate) fn path(c: &mut Content, pts: &[DVec2], closed: bool) {
+    path_in(c, pts, closed, Frame::MM);
+}
+
+/// [`path`] in `frame`.
+pub(crate) fn path_in(c: &mut Content, pts: &[DVec2], closed: bool, frame: Frame) {
     let Some(first) = pts.first() else { return };
-    c.move_to(mm(first.x), mm(first.y));
+    let (x, y) = frame.at(*first);
+    c.move_to(x, y);
     if pts.len() == 1 {
-        c.line_to(mm(first.x), mm(first.y));
+        c.line_to(x, y);
     }
     for p in &pts[1..] {
-        c.line_to(mm(p.x), mm(p.y));
+        let (x, y) = frame.at(*p);
+        c.line_to(x, y);
     }
     if closed {
         c.close_path();

@@ -40,6 +40,8 @@ pub struct RunInfo {
     /// What the job left out for want of a tool, per piece (`dropped`, and one `warnings`
     /// entry each, only when there is something).
     pub dropped: Vec<crate::toolpath::passes::Dropped>,
+    /// The tiled print document's pages (`--print`), as `print`; none: no key.
+    pub print: Option<super::print::Tiling>,
 }
 
 /// `v` to 6 significant digits: the sources' figures range from residuals of 1e-12 to
@@ -167,6 +169,9 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
     );
     if !info.dropped.is_empty() {
         rep["dropped"] = json!(info.dropped);
+    }
+    if let Some(p) = &info.print {
+        rep["print"] = json!(p);
     }
     if !warnings.is_empty() {
         rep["warnings"] = json!(warnings);

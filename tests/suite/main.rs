@@ -21,6 +21,7 @@ mod nest;
 mod param;
 mod pattern;
 mod pdf;
+mod print;
 mod resume;
 mod robust;
 mod simplify;

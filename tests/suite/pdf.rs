@@ -11,7 +11,7 @@ use std::path::Path;
 use std::process::Command;
 
 /// Whether `pdfinfo` and `pdftoppm` are there; panics under CI when they are not.
-fn poppler() -> bool {
+pub(crate) fn poppler() -> bool {
     let have = |tool: &str| Command::new(tool).arg("-v").output().is_ok();
     if have("pdfinfo") && have("pdftoppm") {
         return true;
@@ -25,7 +25,7 @@ fn poppler() -> bool {
 }
 
 /// `flatcut cut ARGS --dry-run -q -o DIR`, which must succeed.
-fn cut(dir: &Path, args: &[&str]) {
+pub(crate) fn cut(dir: &Path, args: &[&str]) {
     let mut all = vec!["cut"];
     all.extend_from_slice(args);
     all.extend(["--dry-run", "-q", "-o", dir.to_str().unwrap()]);
@@ -51,7 +51,7 @@ fn report_sheets(dir: &Path) -> Vec<(f64, f64)> {
 }
 
 /// `pdfinfo -f 1 -l N FILE`: the page sizes in mm, page by page.
-fn pdfinfo_pages(pdf: &Path) -> Vec<(f64, f64)> {
+pub(crate) fn pdfinfo_pages(pdf: &Path) -> Vec<(f64, f64)> {
     let o = Command::new("pdfinfo").arg(pdf).output().unwrap();
     assert!(o.status.success(), "pdfinfo: {}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout).into_owned();
@@ -227,7 +227,7 @@ fn read_content(stream: &str, layers: &[(String, String)]) -> Page {
 }
 
 /// 8-bit grey raster of page `page` (1-based) at `dpi`: (width, height, pixels).
-fn raster(pdf: &Path, page: usize, dpi: u32, out: &Path) -> (usize, usize, Vec<u8>) {
+pub(crate) fn raster(pdf: &Path, page: usize, dpi: u32, out: &Path) -> (usize, usize, Vec<u8>) {
     let root = out.join(format!("page-{page}"));
     let o = Command::new("pdftoppm")
         .args(["-r", &dpi.to_string(), "-gray", "-singlefile"])
@@ -399,7 +399,7 @@ fn library_cut(
 }
 
 /// The HP-GL's pen-down strokes with pen 1 (the cut pen of `sim`), in mm (40 units per mm).
-fn hpgl_cuts(plt: &str) -> Vec<Vec<[f64; 2]>> {
+pub(crate) fn hpgl_cuts(plt: &str) -> Vec<Vec<[f64; 2]>> {
     let mut strokes: Vec<Vec<[f64; 2]>> = Vec::new();
     let (mut pen, mut at) = (0, [0.0, 0.0]);
     for cmd in plt.split(';').map(str::trim) {
