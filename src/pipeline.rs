@@ -501,7 +501,8 @@ pub fn cut(
         files.push(name.clone());
         programs.push((name, bytes));
     }
-    let (pictures, print) = write_pictures(&mut run, &spec.name, &job, extras)?;
+    let paint = crate::output::texture::paint(&flats, &layout);
+    let (pictures, print) = write_pictures(&mut run, &spec.name, &job, paint.as_ref(), extras)?;
     files.extend(pictures);
     files.extend(write_dxf(&mut run, &spec.name, &layout)?);
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
@@ -567,7 +568,8 @@ pub fn flatten(spec: &Spec, search: &Search, extras: &Extras) -> Result<FlattenR
         .clone()
         .unwrap_or_else(|| default_dir(&spec.name));
     let mut run = RunFiles::begin(&dir)?;
-    let (mut files, print) = write_pictures(&mut run, &spec.name, &job, extras)?;
+    let paint = crate::output::texture::paint(&flats, &layout);
+    let (mut files, print) = write_pictures(&mut run, &spec.name, &job, paint.as_ref(), extras)?;
     files.extend(write_alternatives(&mut run, &flats, extras.alternatives)?);
     files.push("report.json".into());
     let info = RunInfo {
@@ -821,11 +823,13 @@ fn write_alternatives(
 
 /// Write `<name>.svg`, `<name>.pdf`, `<name>-<k>.png` per sheet (at `--dpi`, else the
 /// preview resolution; a sheet too large for that is drawn coarser, with a warning unless
-/// quiet) and, with `--print`, `<name>-print.pdf`; returns the file names and the tiling.
+/// quiet) and, with `--print`, `<name>-print.pdf`, the textured faces of `paint` under the
+/// strokes of the PDFs and PNGs; returns the file names and the tiling.
 fn write_pictures(
     run: &mut RunFiles,
     name: &str,
     job: &Job,
+    paint: Option<&crate::output::texture::Paint>,
     extras: &Extras,
 ) -> Result<(Vec<String>, Option<crate::output::print::Tiling>), Error> {
     let dpi = extras.dpi;
@@ -834,20 +838,22 @@ fn write_pictures(
     run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);
     let pdf = format!("{name}.pdf");
-    run.write(&pdf, &crate::output::pdf::render(job))?;
+    run.write(&pdf, &crate::output::pdf::render_painted(job, paint))?;
     files.push(pdf);
     let mut tiling = None;
     if let Some(opts) = &extras.print {
         let plan = crate::output::print::plan(job, opts)?;
         let file = format!("{name}-print.pdf");
-        run.write(&file, &crate::output::print::render(job, &plan))?;
+        run.write(&file, &crate::output::print::render(job, &plan, paint))?;
         files.push(file);
         tiling = Some(plan);
     }
     let px_per_mm = dpi.map_or(crate::output::png::DEFAULT_PX_PER_MM, |d| d / 25.4);
     for (i, sheet) in job.sheets.iter().enumerate() {
         let png = format!("{name}-{}.png", i + 1);
-        let bytes = crate::output::png::render(sheet, i + 1, px_per_mm)?;
+        let images: Vec<_> = paint.map_or(Vec::new(), |p| p.images().collect());
+        let faces = paint.map_or(&[][..], |p| p.sheet(i));
+        let bytes = crate::output::png::render_painted(sheet, i + 1, px_per_mm, faces, &images)?;
         let drawn = crate::output::png::drawn_px_per_mm(sheet, px_per_mm);
         if let (Some(d), false) = (dpi, extras.quiet) {
             if drawn < px_per_mm {

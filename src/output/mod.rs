@@ -36,6 +36,7 @@ pub mod png;
 pub mod print;
 pub mod report;
 pub mod svg;
+pub mod texture;
 
 /// Errors of the output stage. Those about a sheet name it by its number as the user sees it
 /// (1-based) when known: [`program`] does not know which sheet of the job it encodes, so the

@@ -33,6 +33,7 @@ use glam::DVec2;
 use pdf_writer::types::{LineCapStyle, LineJoinStyle, PageMode};
 use pdf_writer::{Content, Finish, Name, Pdf, Rect, Ref, TextStr};
 
+use super::texture::{Paint, TexturedFace};
 use super::{role_style, DRAW_ORDER};
 use crate::toolpath::{Job, SheetJob, Stroke, StrokeRole};
 
@@ -60,6 +61,8 @@ const CAPTION_MM: f64 = 3.0;
 /// A switchable layer of the document (an optional content group).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Layer {
+    /// The faces' texture (textured papercraft), under everything else.
+    Texture,
     Cut,
     Folds,
     Marks,
@@ -74,7 +77,8 @@ pub enum Layer {
 
 impl Layer {
     /// Every layer, in the order of the viewer's layer panel.
-    pub const ALL: [Layer; 9] = [
+    pub const ALL: [Layer; 10] = [
+        Layer::Texture,
         Layer::Cut,
         Layer::Folds,
         Layer::Marks,
@@ -102,6 +106,7 @@ impl Layer {
     /// The name a viewer shows.
     pub fn name(self) -> &'static str {
         match self {
+            Layer::Texture => "Texture",
             Layer::Cut => "Cut",
             Layer::Folds => "Folds",
             Layer::Marks => "Marks",
@@ -320,7 +325,15 @@ pub(crate) fn layers_used(job: &Job) -> Vec<Layer> {
 
 /// Renders the whole job as one PDF document, a page per sheet.
 pub fn render(job: &Job) -> Vec<u8> {
-    let layers = layers_used(job);
+    render_painted(job, None)
+}
+
+/// [`render`] with the textured faces of `paint` under the strokes of each sheet.
+pub fn render_painted(job: &Job, paint: Option<&Paint>) -> Vec<u8> {
+    let mut layers = layers_used(job);
+    if paint.is_some_and(|p| !p.is_empty()) {
+        layers.insert(0, Layer::Texture);
+    }
     let catalog_id = Ref::new(1);
     let pages_id = Ref::new(2);
     let layer_ids: Vec<Ref> = (0..layers.len()).map(|k| Ref::new(3 + k as i32)).collect();
@@ -341,7 +354,12 @@ pub fn render(job: &Job) -> Vec<u8> {
     pdf.pages(pages_id)
         .kids(page_ids.iter().copied())
         .count(page_ids.len() as i32);
-    for (sheet, &page_id) in job.sheets.iter().zip(&page_ids) {
+    let image_ids = paint.map_or(Vec::new(), |p| {
+        super::texture::pdf_images(&mut pdf, p, first_page + 2 * job.sheets.len() as i32)
+    });
+    let images: Vec<&crate::surface::texture::Image> =
+        paint.map_or(Vec::new(), |p| p.images().collect());
+    for (k, (sheet, &page_id)) in job.sheets.iter().zip(&page_ids).enumerate() {
         let content_id = Ref::new(page_id.get() + 1);
         let (w, h) = page_size_mm(sheet);
         let mut page = pdf.page(page_id);
@@ -359,9 +377,11 @@ pub fn render(job: &Job) -> Vec<u8> {
             named.pair(Name(oc_name(*layer)), *id);
         }
         named.finish();
+        image_resources(&mut resources, &image_ids);
         resources.finish();
         page.finish();
-        let content = page_content(sheet, &oc_name);
+        let faces = paint.map_or(&[][..], |p| p.sheet(k));
+        let content = page_content(sheet, &oc_name, faces, &images);
         pdf.stream(content_id, &content);
     }
     pdf.finish()
@@ -401,11 +421,47 @@ pub(crate) fn write_catalog(
     }
 }
 
+/// The page resources naming the texture images `/Tx1`, `/Tx2`, … (none: no entry).
+pub(crate) fn image_resources(resources: &mut pdf_writer::writers::Resources, ids: &[Ref]) {
+    if ids.is_empty() {
+        return;
+    }
+    let mut x = resources.x_objects();
+    for (k, id) in ids.iter().enumerate() {
+        let name = format!("Tx{}", k + 1);
+        x.pair(Name(name.as_bytes()), *id);
+    }
+    x.finish();
+}
+
+/// Draws textured faces in the texture layer (nothing for none).
+pub(crate) fn draw_faces<'a>(
+    c: &mut Content,
+    faces: &[TexturedFace],
+    images: &[&crate::surface::texture::Image],
+    oc_name: &dyn Fn(Layer) -> &'a [u8],
+    frame: Frame,
+) {
+    if faces.is_empty() {
+        return;
+    }
+    c.begin_marked_content_with_properties(Name(b"OC"))
+        .properties_named(Name(oc_name(Layer::Texture)));
+    super::texture::pdf_faces(c, faces, images, frame);
+    c.end_marked_content();
+}
+
 /// The content stream of one sheet's page; `oc_name` gives the resource name of a layer.
-fn page_content<'a>(sheet: &SheetJob, oc_name: &dyn Fn(Layer) -> &'a [u8]) -> Vec<u8> {
+fn page_content<'a>(
+    sheet: &SheetJob,
+    oc_name: &dyn Fn(Layer) -> &'a [u8],
+    faces: &[TexturedFace],
+    images: &[&crate::surface::texture::Image],
+) -> Vec<u8> {
     let mut c = Content::new();
     let k = PT_PER_MM as f32;
     c.transform([k, 0.0, 0.0, k, 0.0, 0.0]);
+    draw_faces(&mut c, faces, images, oc_name, Frame::MM);
     draw_strokes(&mut c, sheet, oc_name, &|_| true, Frame::MM);
     let (squares, _) = test_squares(sheet);
     draw_test_squares(&mut c, &squares, oc_name(Layer::TestSquares));

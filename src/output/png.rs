@@ -7,7 +7,8 @@
 //!   drawn, just coarser, rather than failing or allocating gigabytes.
 //! - A sheet with a zero, negative or non-finite size, a scale that is not a positive finite
 //!   number, or a canvas that cannot be allocated gives [`OutputError::Picture`].
-//! - White background, sheet outline light grey, then the strokes in `DRAW_ORDER` (labels,
+//! - White background, sheet outline light grey, the textured faces of a textured model
+//!   ([`super::texture`]), then the strokes in `DRAW_ORDER` (labels,
 //!   marks, valley folds, mountain folds, cuts on top), colours and dash patterns as in the SVG
 //!   (see `role_style` in the module root). Lines are `LINE_MM` wide but at least 1 px,
 //!   anti-aliased, round caps and joins. Dash lengths are the mm values times the scale; when a
@@ -62,6 +63,17 @@ pub fn drawn_px_per_mm(sheet: &SheetJob, px_per_mm: f64) -> f64 {
 /// Renders sheet `index` of a job (the index is only used in errors) as PNG bytes at
 /// `px_per_mm`, reduced if needed so that neither side exceeds `MAX_SIDE_PX`.
 pub fn render(sheet: &SheetJob, index: usize, px_per_mm: f64) -> Result<Vec<u8>, OutputError> {
+    render_painted(sheet, index, px_per_mm, &[], &[])
+}
+
+/// [`render`] with textured faces (of the images `images`) under the strokes.
+pub fn render_painted(
+    sheet: &SheetJob,
+    index: usize,
+    px_per_mm: f64,
+    faces: &[super::texture::TexturedFace],
+    images: &[&crate::surface::texture::Image],
+) -> Result<Vec<u8>, OutputError> {
     let picture_error = |w: f64, h: f64| OutputError::Picture {
         sheet: index,
         width_px: to_px(w),
@@ -102,6 +114,12 @@ pub fn render(sheet: &SheetJob, index: usize, px_per_mm: f64) -> Result<Vec<u8>,
         };
         let paint = solid([SHEET_GREY; 3]);
         pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+    }
+
+    if !faces.is_empty() {
+        let pictures = super::texture::pictures(images);
+        let to_px = (scale, BORDER_MM * scale, (sheet.height + BORDER_MM) * scale);
+        super::texture::png_faces(&mut pixmap, faces, images, &pictures, to_px);
     }
 
     let line_px = px_width(LINE_MM, scale);

@@ -35,7 +35,9 @@ use pdf_writer::{Content, Finish, Name, Pdf, Rect, Ref, Str};
 use serde::Serialize;
 
 use super::pdf::{self, Frame, Layer, TestSquare, PT_PER_MM, TEST_SQUARE_SIDES_MM};
+use super::texture::{Paint, TexturedFace};
 use super::OutputError;
+use crate::surface::texture::Image;
 use crate::toolpath::{Job, SheetJob, StrokeRole};
 
 /// The grid every length of the tiling is rounded to, mm (1/100 in).
@@ -328,10 +330,14 @@ fn r3(v: f64) -> f64 {
     (v * 1000.0).round() / 1000.0
 }
 
-/// Renders the tiled document planned by `tiling` (from [`plan`] on the same `job`).
-pub fn render(job: &Job, tiling: &Tiling) -> Vec<u8> {
+/// Renders the tiled document planned by `tiling` (from [`plan`] on the same `job`), with the
+/// textured faces of `paint` under the strokes.
+pub fn render(job: &Job, tiling: &Tiling, paint: Option<&Paint>) -> Vec<u8> {
     let mut layers = pdf::layers_used(job);
     layers.push(Layer::Tiling);
+    if paint.is_some_and(|p| !p.is_empty()) {
+        layers.push(Layer::Texture);
+    }
     layers.sort();
     layers.dedup();
     let catalog_id = Ref::new(1);
@@ -357,6 +363,10 @@ pub fn render(job: &Job, tiling: &Tiling) -> Vec<u8> {
         .base_font(Name(b"Helvetica"))
         .encoding_predefined(Name(b"WinAnsiEncoding"));
 
+    let image_ids = paint.map_or(Vec::new(), |p| {
+        super::texture::pdf_images(&mut doc, p, first_page + 2 * tiling.pages as i32)
+    });
+    let images: Vec<&Image> = paint.map_or(Vec::new(), |p| p.images().collect());
     let mut contents: Vec<(DVec2, Vec<u8>)> = Vec::new();
     for st in &tiling.sheets {
         let Some(sheet) = job.sheets.get(st.sheet - 1) else {
@@ -364,8 +374,10 @@ pub fn render(job: &Job, tiling: &Tiling) -> Vec<u8> {
         };
         let size = DVec2::new(st.page_mm[0], st.page_mm[1]);
         contents.push((size, map_content(job, sheet, st, tiling, &oc_name)));
+        let faces = paint.map_or(&[][..], |p| p.sheet(st.sheet - 1));
         for t in &st.tiles {
-            contents.push((size, tile_content(sheet, st, t, tiling, &oc_name)));
+            let drawing = (sheet, faces, &images[..]);
+            contents.push((size, tile_content(drawing, st, t, tiling, &oc_name)));
         }
     }
     for ((size, content), &page_id) in contents.iter().zip(&page_ids) {
@@ -386,6 +398,7 @@ pub fn render(job: &Job, tiling: &Tiling) -> Vec<u8> {
         }
         named.finish();
         resources.fonts().pair(Name(b"F1"), font_id);
+        pdf::image_resources(&mut resources, &image_ids);
         resources.finish();
         page.finish();
         doc.stream(content_id, content);
@@ -469,7 +482,7 @@ fn alignment(c: &mut Content, sheet: &SheetJob, st: &SheetTiling, tiling: &Tilin
 /// One printed page: the sheet's window, clipped to the printable area, and its label. The
 /// sheet is written in whole micrometres shifted by whole micrometres (see [`Frame`]).
 fn tile_content<'a>(
-    sheet: &SheetJob,
+    (sheet, faces, images): (&SheetJob, &[TexturedFace], &[&Image]),
     st: &SheetTiling,
     t: &Tile,
     tiling: &Tiling,
@@ -495,12 +508,22 @@ fn tile_content<'a>(
     c.rect(x0, y0, um(size.x) as f32, um(size.y) as f32);
     c.clip_nonzero();
     c.end_path();
-    // The match lines under the pattern, then the strokes that come within 2 mm of the
-    // window (their width and caps reach past it).
+    // The textured faces whose bounds meet the window (grown by the bleed and more), the
+    // match lines over them and under the pattern, then the strokes that come within 2 mm of
+    // the window (their width and caps reach past it).
+    let (glo, ghi) = (lo - DVec2::splat(2.0), hi + DVec2::splat(2.0));
+    let near: Vec<TexturedFace> = faces
+        .iter()
+        .filter(|f| {
+            crate::geom::polygon::bounds(f.pts.iter().copied())
+                .is_some_and(|(a, b)| a.cmple(ghi).all() && b.cmpge(glo).all())
+        })
+        .cloned()
+        .collect();
+    pdf::draw_faces(&mut c, &near, images, oc_name, frame);
     begin_layer(&mut c, oc_name(Layer::Tiling));
     alignment(&mut c, sheet, st, tiling, frame);
     c.end_marked_content();
-    let (glo, ghi) = (lo - DVec2::splat(2.0), hi + DVec2::splat(2.0));
     pdf::draw_strokes(
         &mut c,
         sheet,
@@ -791,12 +814,12 @@ mod tests {
         // Neighbouring windows overlap by the overlap.
         let step = (w[2] - w[0]) - t.overlap_mm;
         assert!(on_grid(step));
-        let doc = render(&job, &t);
+        let doc = render(&job, &t, None);
         let text = String::from_utf8_lossy(&doc);
         assert!(text.contains("/Count 3"));
         assert!(text.contains("(E3) Tj"), "invisible label");
         assert!(text.contains("/BaseFont /Helvetica"));
-        assert_eq!(render(&job, &t), doc, "deterministic");
+        assert_eq!(render(&job, &t, None), doc, "deterministic");
     }
 
     #[test]

@@ -41,6 +41,7 @@ pub mod source;
 pub mod spline;
 pub mod stl;
 pub mod strip;
+pub mod texture;
 mod weld;
 
 use crate::geom::mesh::Mesh;
@@ -85,6 +86,9 @@ pub struct Surface {
     /// The solved design of a spline surface (curves, creases; `--spline-json`), in the
     /// surface's millimetres; `None` for other kinds.
     pub spline: Option<Box<spline::Design>>,
+    /// The textures of a mesh read from an OBJ with materials and `vt` (printed onto the
+    /// flat faces by the output stage); `None` for none.
+    pub texture: Option<std::sync::Arc<texture::Texture>>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -167,12 +171,15 @@ pub fn build(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
 fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
     match spec.kind {
         SurfaceKind::Mesh => {
-            let raw = import::read(&spec.path)?;
+            let mut raw = import::read(&spec.path)?;
+            let texture = raw.texture.take().map(std::sync::Arc::new);
+            let texture_warnings = std::mem::take(&mut raw.texture_warnings);
             let scale = match spec.size {
                 Some(s) => size::factor_for(size::extent(&raw.mesh), s),
                 None => spec.scale * spec.units.mm(),
             };
-            let (mesh, warnings) = obj::validate(raw, scale)?;
+            let (mesh, mut warnings) = obj::validate(raw, scale)?;
+            warnings.extend(texture_warnings);
             let mut surface = Surface {
                 name: spec.name.clone(),
                 source: spec.path.clone(),
@@ -180,6 +187,7 @@ fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
                 warnings,
                 bends: None,
                 charts: None,
+                texture,
                 ..Default::default()
             };
             // Smooth meshes (issue 7): DCS approximation and D-Charts segmentation.

@@ -33,6 +33,10 @@ pub struct RawMesh {
     pub mesh: Mesh,
     /// Vertices welded because they had identical coordinates.
     pub welded: usize,
+    /// The model's textures (OBJ `mtllib` / `usemtl` / `vt`), if it has any that could be
+    /// read, and what could not be read ([`super::texture`]).
+    pub texture: Option<super::texture::Texture>,
+    pub texture_warnings: Vec<String>,
 }
 
 fn parse_err(path: &Path, line: Option<usize>, message: impl Into<String>) -> SurfaceError {
@@ -90,10 +94,13 @@ pub fn parse(text: &str, path: &Path) -> Result<RawMesh, SurfaceError> {
             f.line = Some(*l);
         }
     }
+    let (texture, texture_warnings) = super::texture::read(text, path, &mesh);
     Ok(RawMesh {
         path: path.to_path_buf(),
         mesh,
         welded,
+        texture,
+        texture_warnings,
     })
 }
 

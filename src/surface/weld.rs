@@ -62,6 +62,8 @@ impl Welder {
             path: path.to_path_buf(),
             mesh: self.mesh,
             welded: self.welded,
+            texture: None,
+            texture_warnings: Vec::new(),
         })
     }
 }
