@@ -6,9 +6,10 @@
 //! [`png_faces`] draw them under the strokes.
 //!
 //! Choices:
-//! - A face is drawn as a fan of triangles from its first corner, each the affine image of
-//!   its triangle of texture coordinates (a planar polygon's texture is affine when its
-//!   exporter made it so; a fan keeps every corner where the model put it otherwise).
+//! - A face is drawn whole, as the affine image of its texture coordinates, when one affine
+//!   map carries all its corners (every triangle, and the quads of most exporters); else as a
+//!   fan of triangles from its first corner, each the affine image of its own, which keeps
+//!   every corner where the model put it. Drawn whole, a face shows no seam inside it.
 //! - Each triangle is clipped to itself grown outwards: by [`BLEED_MM`] past a cut edge of the
 //!   piece, so that a cut a little off the line shows no white edge, and by [`JOIN_MM`] past
 //!   a fold, a glue tab's fold or a fan diagonal, so that neighbouring triangles meet without
@@ -145,11 +146,12 @@ pub fn paint(flats: &[Flat], layout: &Layout) -> Option<Paint> {
     (!out.is_empty()).then_some(out)
 }
 
-/// One triangle to draw: the clip polygon (sheet mm) and the affine map from texture
-/// coordinates to the sheet (`[a, b, c, d, e, f]`: x = a·u + c·v + e, y = b·u + d·v + f), or
-/// the colour to fill it with when its texture coordinates enclose no area.
+/// One patch to draw (a face, or a triangle of one): the clip polygon (sheet mm) and the
+/// affine map from texture coordinates to the sheet (`[a, b, c, d, e, f]`: x = a·u + c·v + e,
+/// y = b·u + d·v + f), or the colour to fill it with when its texture coordinates enclose no
+/// area.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Triangle {
+pub struct Patch {
     pub image: usize,
     pub clip: Vec<DVec2>,
     pub fill: Fill,
@@ -161,8 +163,48 @@ pub enum Fill {
     Colour([u8; 3]),
 }
 
-/// The triangles of a face, ready to draw.
-pub fn triangles(face: &TexturedFace, images: &[&Image]) -> Vec<Triangle> {
+/// How a face's corners `idx` map from texture coordinates to the sheet: the affine map of its
+/// first three, or the image's colour at their centre when they enclose no area.
+fn fill_of(face: &TexturedFace, idx: [usize; 3], images: &[&Image]) -> Fill {
+    let p = idx.map(|i| face.pts[i]);
+    let t = idx.map(|i| face.uv[i]);
+    let (du, dv) = (t[1] - t[0], t[2] - t[0]);
+    let det = du.perp_dot(dv);
+    if det.abs() > 1e-12 && det.is_finite() {
+        // M·du = p1 − p0, M·dv = p2 − p0: M = [e1 e2] · inverse([du dv]).
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let inv = [dv.y / det, -dv.x / det, -du.y / det, du.x / det];
+        let m00 = e1.x * inv[0] + e2.x * inv[2];
+        let m01 = e1.x * inv[1] + e2.x * inv[3];
+        let m10 = e1.y * inv[0] + e2.y * inv[2];
+        let m11 = e1.y * inv[1] + e2.y * inv[3];
+        let e = p[0].x - (m00 * t[0].x + m01 * t[0].y);
+        let f = p[0].y - (m10 * t[0].x + m11 * t[0].y);
+        let m = [m00, m10, m01, m11, e, f];
+        if m.iter().all(|v| v.is_finite()) {
+            return Fill::Map(m);
+        }
+    }
+    let c = (t[0] + t[1] + t[2]) / 3.0;
+    Fill::Colour(
+        images
+            .get(face.image)
+            .map_or([255; 3], |img| sample(img, c)),
+    )
+}
+
+/// How far (mm) a map puts a texture coordinate from where the face has its corner.
+fn miss(m: &[f64; 6], uv: DVec2, p: DVec2) -> f64 {
+    let q = DVec2::new(
+        m[0] * uv.x + m[2] * uv.y + m[4],
+        m[1] * uv.x + m[3] * uv.y + m[5],
+    );
+    q.distance(p)
+}
+
+/// The patches of a face, ready to draw: the whole face when one affine map carries all its
+/// corners (within 0.001 mm), else a fan of triangles from its first corner.
+pub fn triangles(face: &TexturedFace, images: &[&Image]) -> Vec<Patch> {
     let n = face.pts.len();
     let mut out = Vec::new();
     if n < 3 || face.uv.len() != n || face.grow.len() != n {
@@ -173,10 +215,27 @@ pub fn triangles(face: &TexturedFace, images: &[&Image]) -> Vec<Triangle> {
         .map(|i| face.pts[i].perp_dot(face.pts[(i + 1) % n]))
         .sum();
     let sign = if area < 0.0 { -1.0 } else { 1.0 };
+    let mut push = |clip: Vec<DVec2>, fill: Fill| {
+        if clip.iter().all(|q| q.is_finite()) {
+            out.push(Patch {
+                image: face.image,
+                clip,
+                fill,
+            });
+        }
+    };
+    let whole = fill_of(face, [0, 1, 2], images);
+    let affine = match whole {
+        Fill::Map(m) => (3..n).all(|k| miss(&m, face.uv[k], face.pts[k]) <= 1e-3),
+        Fill::Colour(_) => n == 3,
+    };
+    if affine {
+        push(grown(&face.pts, &face.grow, sign), whole);
+        return out;
+    }
     for k in 1..n - 1 {
         let idx = [0, k, k + 1];
         let p = idx.map(|i| face.pts[i]);
-        let t = idx.map(|i| face.uv[i]);
         let g = [
             if k == 1 { face.grow[0] } else { JOIN_MM },
             face.grow[k],
@@ -186,68 +245,30 @@ pub fn triangles(face: &TexturedFace, images: &[&Image]) -> Vec<Triangle> {
                 JOIN_MM
             },
         ];
-        let clip = grown(&p, &g, sign);
-        let (du, dv) = (t[1] - t[0], t[2] - t[0]);
-        let det = du.perp_dot(dv);
-        let fill = if det.abs() > 1e-12 && det.is_finite() {
-            // M·du = p1 − p0, M·dv = p2 − p0.
-            let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-            let inv = [dv.y / det, -dv.x / det, -du.y / det, du.x / det];
-            // M = [e1 e2] · inv([du dv]); inv as rows [[inv0, inv1], [inv2, inv3]].
-            let m00 = e1.x * inv[0] + e2.x * inv[2];
-            let m01 = e1.x * inv[1] + e2.x * inv[3];
-            let m10 = e1.y * inv[0] + e2.y * inv[2];
-            let m11 = e1.y * inv[1] + e2.y * inv[3];
-            let e = p[0].x - (m00 * t[0].x + m01 * t[0].y);
-            let f = p[0].y - (m10 * t[0].x + m11 * t[0].y);
-            Fill::Map([m00, m10, m01, m11, e, f])
-        } else {
-            let c = (t[0] + t[1] + t[2]) / 3.0;
-            Fill::Colour(
-                images
-                    .get(face.image)
-                    .map_or([255; 3], |img| sample(img, c)),
-            )
-        };
-        if clip.iter().all(|q| q.is_finite()) {
-            if let Fill::Map(m) = fill {
-                if !m.iter().all(|v| v.is_finite()) {
-                    continue;
-                }
-            }
-            out.push(Triangle {
-                image: face.image,
-                clip,
-                fill,
-            });
-        }
+        push(grown(&p, &g, sign), fill_of(face, idx, images));
     }
     out
 }
 
-/// The triangle `p` with edge `i` (from `p[i]` to `p[i + 1]`) moved outwards by `g[i]`
+/// The polygon `p` with edge `i` (from `p[i]` to `p[i + 1]`) moved outwards by `g[i]`
 /// (`sign`: 1 for counter-clockwise); corners past the miter limit bevelled.
-fn grown(p: &[DVec2; 3], g: &[f64; 3], sign: f64) -> Vec<DVec2> {
+fn grown(p: &[DVec2], g: &[f64], sign: f64) -> Vec<DVec2> {
+    let n = p.len();
     let normal = |i: usize| {
-        let d = (p[(i + 1) % 3] - p[i]).normalize_or_zero();
+        let d = (p[(i + 1) % n] - p[i]).normalize_or_zero();
         DVec2::new(d.y, -d.x) * sign
     };
     let mut out = Vec::new();
     for (i, &corner) in p.iter().enumerate() {
         // Corner i between edge i-1 (into it) and edge i (out of it).
-        let (a, b) = ((i + 2) % 3, i);
+        let (a, b) = ((i + n - 1) % n, i);
         let (na, nb) = (normal(a), normal(b));
         let (ga, gb) = (g[a], g[b]);
-        // The point q with q·na = p·na + ga and q·nb = p·nb + gb.
+        // The point q with (q − p)·na = ga and (q − p)·nb = gb.
         let det = na.perp_dot(nb);
         let limit = MITER * ga.max(gb);
         let q = if det.abs() > 1e-9 {
-            let rhs = DVec2::new(ga, gb);
-            // Solve [na; nb] (q - p) = rhs.
-            let d = DVec2::new(
-                (rhs.x * nb.y - rhs.y * na.y) / det,
-                (na.x * rhs.y - nb.x * rhs.x) / det,
-            );
+            let d = DVec2::new((ga * nb.y - gb * na.y) / det, (na.x * gb - nb.x * ga) / det);
             Some(corner + d).filter(|_| d.length() <= limit)
         } else {
             None
@@ -495,24 +516,39 @@ mod tests {
         };
         let i = img();
         let t = triangles(&face, &[&i]);
-        assert_eq!(t.len(), 2);
-        for tri in &t {
-            let Fill::Map([a, b, c, d, e, f]) = tri.fill else {
-                panic!("a map")
-            };
-            let at = |u: f64, v: f64| DVec2::new(a * u + c * v + e, b * u + d * v + f);
-            assert!(at(0.0, 0.0).distance(DVec2::new(10.0, 10.0)) < 1e-12);
-            assert!(at(1.0, 1.0).distance(DVec2::new(40.0, 30.0)) < 1e-12);
-        }
-        // The first triangle's bottom edge grows by the bleed, its diagonal by the join.
-        let lo = t[0].clip.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+        assert_eq!(t.len(), 1, "one affine map: the face whole");
+        let check = |t: &[Patch], far: DVec2| {
+            for tri in t {
+                let Fill::Map([a, b, c, d, e, f]) = tri.fill else {
+                    panic!("a map")
+                };
+                let at = |u: f64, v: f64| DVec2::new(a * u + c * v + e, b * u + d * v + f);
+                assert!(at(0.0, 0.0).distance(DVec2::new(10.0, 10.0)) < 1e-12);
+                assert!(at(1.0, 1.0).distance(far) < 1e-12);
+            }
+        };
+        check(&t, DVec2::new(40.0, 30.0));
+        // The bottom edge grows by the bleed, the others by the join.
+        let (lo, hi) = t[0]
+            .clip
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p.y), h.max(p.y))
+            });
         assert!((lo - (10.0 - BLEED_MM)).abs() < 1e-9, "{:?}", t[0].clip);
+        assert!((hi - (30.0 + JOIN_MM)).abs() < 1e-9, "{:?}", t[0].clip);
         // Mirrored (clockwise) the growth still goes outwards.
         let mut m = face.clone();
         m.pts.iter_mut().for_each(|p| p.x = -p.x);
         let t = triangles(&m, &[&i]);
         let lo = t[0].clip.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
         assert!((lo - (10.0 - BLEED_MM)).abs() < 1e-9);
+        // A corner off the affine map: two triangles, each through its own corners.
+        let mut k = face.clone();
+        k.pts[2] = DVec2::new(45.0, 32.0);
+        let t = triangles(&k, &[&i]);
+        assert_eq!(t.len(), 2);
+        check(&t[..1], DVec2::new(45.0, 32.0));
         // Degenerate texture coordinates: a plain fill of the colour there.
         let mut d = face;
         d.uv = vec![DVec2::new(0.25, 0.75); 4];
@@ -524,6 +560,11 @@ mod tests {
     fn sharp_corners_are_bevelled() {
         let p = [DVec2::ZERO, DVec2::new(100.0, 0.0), DVec2::new(100.0, 1.0)];
         let g = grown(&p, &[1.0, 1.0, 1.0], 1.0);
+        // A square grown by 1: its corners move by (1, 1).
+        let sq = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let gs = grown(&sq, &[1.0; 4], 1.0);
+        assert!(gs[0].distance(DVec2::splat(-1.0)) < 1e-12, "{gs:?}");
+        assert!(gs[2].distance(DVec2::splat(2.0)) < 1e-12, "{gs:?}");
         assert!(g.len() > 3);
         assert!(g
             .iter()

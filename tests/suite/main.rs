@@ -29,5 +29,6 @@ mod sizing;
 mod spline;
 mod split;
 mod strip;
+mod texture;
 mod toolchange;
 mod toolpath;
