@@ -403,7 +403,8 @@ pub const MAX_DPI: f64 = 1200.0;
 #[derive(Debug, Clone, Default, Args)]
 pub struct PictureArgs {
     /// Resolution of the PNG pictures in dots per inch, more than 0 and at most 1200, written
-    /// into each PNG (`pHYs`); default: the preview's 4 px/mm (101.6 dpi). A picture whose
+    /// into each PNG (`pHYs`); default: 300 with `--print`, else the preview's 4 px/mm
+    /// (101.6 dpi). A picture whose
     /// longer side would pass 6000 px is drawn coarser and says so in its `pHYs`.
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_dpi)]
     pub dpi: Option<f64>,
@@ -421,7 +422,15 @@ pub struct PictureArgs {
     pub overlap: Option<f64>,
 }
 
+/// The PNGs' resolution when printing (`--print` without `--dpi`), dots per inch.
+pub const PRINT_DPI: f64 = 300.0;
+
 impl PictureArgs {
+    /// The PNGs' resolution: `--dpi`, else [`PRINT_DPI`] with `--print`, else the preview's.
+    pub fn dpi(&self) -> Option<f64> {
+        self.dpi.or(self.print.as_ref().map(|_| PRINT_DPI))
+    }
+
     /// The tiling asked for with `--print`, if any.
     pub fn print_options(&self) -> Option<crate::output::print::PrintOptions> {
         let (paper, width, height) = self.print.clone()?;

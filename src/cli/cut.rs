@@ -101,7 +101,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         uv_obj: a.smooth.uv_obj.clone(),
         spline_json: super::args::spline_json(&spec, &a.spline_json)?,
         quiet: a.quiet,
-        dpi: a.pictures.dpi,
+        dpi: a.pictures.dpi(),
         print: a.pictures.print_options(),
     };
     let search = a.search.search()?;

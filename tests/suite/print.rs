@@ -286,7 +286,15 @@ fn a_610_by_900_sheet_tiled_on_a4() {
 #[test]
 fn tiled_print_is_deterministic_and_bad_papers_are_refused() {
     let (a, b) = (scratch("print-same-a"), scratch("print-same-b"));
-    let args = ["patterns/cube.toml", "--print", "letter", "--overlap", "5"];
+    let args = [
+        "patterns/cube.toml",
+        "--sheet",
+        "a4",
+        "--print",
+        "letter",
+        "--overlap",
+        "5",
+    ];
     cut(&a, &args);
     cut(&b, &args);
     let (pa, pb) = (
@@ -299,6 +307,11 @@ fn tiled_print_is_deterministic_and_bad_papers_are_refused() {
     assert_eq!(rep["print"]["paper"], "letter");
     // 5 mm on the 0.254 mm grid.
     assert_eq!(rep["print"]["overlap_mm"].as_f64(), Some(5.08));
+    // PNGs at print resolution with --print: 300 dpi is 11811 px/m in pHYs.
+    let png = std::fs::read(a.join("cube-1.png")).unwrap();
+    let at = png.windows(4).position(|w| w == b"pHYs").unwrap();
+    let ppm = u32::from_be_bytes(png[at + 4..at + 8].try_into().unwrap());
+    assert_eq!(ppm, 11811);
 
     let dir = scratch("print-bad");
     let out = dir.join("out");
