@@ -11,8 +11,10 @@
 //!   what Acrobat shows; tiling (issue 25, item 2) is the way to print such a sheet.
 //! - Layers: the stroke roles are grouped into optional content groups (`/OCProperties` in the
 //!   catalog, all on, the viewer's layer panel opened with `/PageMode /UseOC`) that a viewer
-//!   or printer can switch: `Cut` (cuts and notches), `Folds` (mountain and valley), `Marks`,
-//!   `Labels`, `Seams`, `Grain`, `Weed`, and `Test squares`. A group exists only if the job
+//!   or printer can switch: `Texture` (a textured model's faces, [`super::texture`], under
+//!   everything), `Cut` (cuts and notches), `Folds` (mountain and valley), `Marks`,
+//!   `Labels`, `Seams`, `Grain`, `Weed`, and `Test squares` (and `Tiling` in the tiled
+//!   document, [`super::print`]). A group exists only if the job
 //!   has a stroke of it (the test squares always). Each role's strokes on a page are one
 //!   `/OC /ocN BDC … EMC` section, drawn in `DRAW_ORDER` (cuts on top), with the SVG's
 //!   colours, widths and dash patterns (in mm). Labels and edge ids are the single-stroke
@@ -355,7 +357,7 @@ pub fn render_painted(job: &Job, paint: Option<&Paint>) -> Vec<u8> {
         .kids(page_ids.iter().copied())
         .count(page_ids.len() as i32);
     let image_ids = paint.map_or(Vec::new(), |p| {
-        super::texture::pdf_images(&mut pdf, p, first_page + 2 * job.sheets.len() as i32)
+        pdf_images(&mut pdf, p, first_page + 2 * job.sheets.len() as i32)
     });
     let images: Vec<&crate::surface::texture::Image> =
         paint.map_or(Vec::new(), |p| p.images().collect());
@@ -447,8 +449,76 @@ pub(crate) fn draw_faces<'a>(
     }
     c.begin_marked_content_with_properties(Name(b"OC"))
         .properties_named(Name(oc_name(Layer::Texture)));
-    super::texture::pdf_faces(c, faces, images, frame);
+    pdf_faces(c, faces, images, frame);
     c.end_marked_content();
+}
+
+/// Draws the textured faces of a sheet into a PDF content stream, in `frame`; image `k` of
+/// the paint is the XObject `/Tx{k+1}`.
+fn pdf_faces(
+    c: &mut pdf_writer::Content,
+    faces: &[TexturedFace],
+    images: &[&crate::surface::texture::Image],
+    frame: Frame,
+) {
+    use pdf_writer::Name;
+    let s = f64::from(frame.len(1.0));
+    let (sx, sy) = frame.micrometres.unwrap_or((0.0, 0.0));
+    for face in faces {
+        for t in super::texture::triangles(face, images) {
+            c.save_state();
+            path_in(c, &t.clip, true, frame);
+            match t.fill {
+                super::texture::Fill::Map([a, b, cc, d, e, f]) => {
+                    c.clip_nonzero();
+                    c.end_path();
+                    c.transform([
+                        (a * s) as f32,
+                        (b * s) as f32,
+                        (cc * s) as f32,
+                        (d * s) as f32,
+                        (e * s + sx) as f32,
+                        (f * s + sy) as f32,
+                    ]);
+                    let name = format!("Tx{}", t.image + 1);
+                    c.x_object(Name(name.as_bytes()));
+                }
+                super::texture::Fill::Colour([r, g, b]) => {
+                    c.set_fill_rgb(
+                        f32::from(r) / 255.0,
+                        f32::from(g) / 255.0,
+                        f32::from(b) / 255.0,
+                    );
+                    c.fill_nonzero();
+                }
+            }
+            c.restore_state();
+        }
+    }
+}
+
+/// Writes the paint's images as image XObjects with ids from `first` on; returns the ids.
+pub(crate) fn pdf_images(
+    pdf: &mut pdf_writer::Pdf,
+    paint: &Paint,
+    first: i32,
+) -> Vec<pdf_writer::Ref> {
+    let mut ids = Vec::new();
+    for (k, img) in paint.images().enumerate() {
+        let id = pdf_writer::Ref::new(first + k as i32);
+        let data =
+            miniz_oxide::deflate::compress_to_vec_zlib(&super::texture::rgb_over_white(img), 6);
+        let mut x = pdf.image_xobject(id, &data);
+        x.filter(pdf_writer::Filter::FlateDecode);
+        x.width(img.width as i32);
+        x.height(img.height as i32);
+        x.color_space().device_rgb();
+        x.bits_per_component(8);
+        x.interpolate(true);
+        drop(x);
+        ids.push(id);
+    }
+    ids
 }
 
 /// The content stream of one sheet's page; `oc_name` gives the resource name of a layer.

@@ -364,7 +364,7 @@ pub fn render(job: &Job, tiling: &Tiling, paint: Option<&Paint>) -> Vec<u8> {
         .encoding_predefined(Name(b"WinAnsiEncoding"));
 
     let image_ids = paint.map_or(Vec::new(), |p| {
-        super::texture::pdf_images(&mut doc, p, first_page + 2 * tiling.pages as i32)
+        pdf::pdf_images(&mut doc, p, first_page + 2 * tiling.pages as i32)
     });
     let images: Vec<&Image> = paint.map_or(Vec::new(), |p| p.images().collect());
     let mut contents: Vec<(DVec2, Vec<u8>)> = Vec::new();

@@ -2,8 +2,8 @@
 //! triangle of the texture image, in the PDFs (1:1 and tiled) and the PNGs.
 //!
 //! [`paint`] takes the layout and the flats and gives, per sheet, every textured face in sheet
-//! millimetres with its texture coordinates ([`TexturedFace`]); [`pdf_faces`] and
-//! [`png_faces`] draw them under the strokes.
+//! millimetres with its texture coordinates ([`TexturedFace`]); [`triangles`] cuts them into
+//! the patches that `pdf` and [`png_faces`] draw under the strokes.
 //!
 //! Choices:
 //! - A face is drawn whole, as the affine image of its texture coordinates, when one affine
@@ -306,73 +306,6 @@ pub fn over_white(px: &[u8]) -> [u8; 3] {
 /// The RGB bytes of an image over white, rows from the top (for the PDF).
 pub fn rgb_over_white(img: &Image) -> Vec<u8> {
     img.rgba.chunks_exact(4).flat_map(over_white).collect()
-}
-
-/// Draws the textured faces of a sheet into a PDF content stream, in `frame`; image `k` of
-/// the paint is the XObject `/Tx{k+1}`.
-pub(crate) fn pdf_faces(
-    c: &mut pdf_writer::Content,
-    faces: &[TexturedFace],
-    images: &[&Image],
-    frame: super::pdf::Frame,
-) {
-    use pdf_writer::Name;
-    let s = f64::from(frame.len(1.0));
-    let (sx, sy) = frame.micrometres.unwrap_or((0.0, 0.0));
-    for face in faces {
-        for t in triangles(face, images) {
-            c.save_state();
-            super::pdf::path_in(c, &t.clip, true, frame);
-            match t.fill {
-                Fill::Map([a, b, cc, d, e, f]) => {
-                    c.clip_nonzero();
-                    c.end_path();
-                    c.transform([
-                        (a * s) as f32,
-                        (b * s) as f32,
-                        (cc * s) as f32,
-                        (d * s) as f32,
-                        (e * s + sx) as f32,
-                        (f * s + sy) as f32,
-                    ]);
-                    let name = format!("Tx{}", t.image + 1);
-                    c.x_object(Name(name.as_bytes()));
-                }
-                Fill::Colour([r, g, b]) => {
-                    c.set_fill_rgb(
-                        f32::from(r) / 255.0,
-                        f32::from(g) / 255.0,
-                        f32::from(b) / 255.0,
-                    );
-                    c.fill_nonzero();
-                }
-            }
-            c.restore_state();
-        }
-    }
-}
-
-/// Writes the paint's images as image XObjects with ids from `first` on; returns the ids.
-pub(crate) fn pdf_images(
-    pdf: &mut pdf_writer::Pdf,
-    paint: &Paint,
-    first: i32,
-) -> Vec<pdf_writer::Ref> {
-    let mut ids = Vec::new();
-    for (k, img) in paint.images().enumerate() {
-        let id = pdf_writer::Ref::new(first + k as i32);
-        let data = miniz_oxide::deflate::compress_to_vec_zlib(&rgb_over_white(img), 6);
-        let mut x = pdf.image_xobject(id, &data);
-        x.filter(pdf_writer::Filter::FlateDecode);
-        x.width(img.width as i32);
-        x.height(img.height as i32);
-        x.color_space().device_rgb();
-        x.bits_per_component(8);
-        x.interpolate(true);
-        drop(x);
-        ids.push(id);
-    }
-    ids
 }
 
 /// Draws the textured faces of a sheet onto a picture; `to_px` maps sheet mm to pixels by
