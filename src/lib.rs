@@ -269,6 +269,8 @@ pub enum Error {
     Stream(Box<device::stream::StreamError>),
     #[error(transparent)]
     Sim(#[from] device::sim::SimError),
+    #[error(transparent)]
+    Register(#[from] device::register::RegisterError),
     #[error("{}: {source}", file.display())]
     In {
         file: std::path::PathBuf,
