@@ -39,7 +39,9 @@ pub enum RegisterError {
         y: f64,
         search: f64,
     },
-    #[error("{port}: cannot read the answer `{answer}` to `{asked}` for mark {mark} (nothing was cut)")]
+    #[error(
+        "{port}: cannot read the answer `{answer}` to `{asked}` for mark {mark} (nothing was cut)"
+    )]
     Garbled {
         port: String,
         asked: String,
@@ -85,10 +87,7 @@ pub fn digitize(
             answer: answer.into(),
             mark,
         };
-        let bits: u32 = status
-            .trim()
-            .parse()
-            .map_err(|_| garbled("OS;", &status))?;
+        let bits: u32 = status.trim().parse().map_err(|_| garbled("OS;", &status))?;
         if bits & 4 == 0 {
             return Err(RegisterError::NotFound {
                 port: port.clone(),

@@ -1,0 +1,399 @@
+//! Print-and-cut on the command line (issue 25 item 4): the flags (`--print-and-cut`,
+//! `--marks`, `--mark-inset`, `--square-corner`, `--sheet-offset`) and the send after the files
+//! are written: measure each sheet's marks, fit, refuse or make the registered program
+//! (`<name>-registered.plt`, per sheet `<name>-registered-<k>.plt`), record the registration
+//! in report.json, and stream the program.
+//!
+//! Where the marks' positions come from: `--marks X1,Y1:X2,Y2:X3,Y3[:X4,Y4]` (machine mm, read
+//! off the machine after jogging to each mark: mark 1 the square, then the Ls
+//! counter-clockwise; one sheet per run), else the device's sensor (`[registration] sensor`;
+//! HP-GL digitizing, which the simulated cutter has). A device with neither is an error that
+//! says how to measure. On the simulator the printed sheet is placed with `--sheet-offset
+//! DX,DY,DEG[,SX[,SY]]` (mm, degrees counter-clockwise about the machine's origin, scale along
+//! X and Y; default 0,0,0) and the sensor finds its marks. With `--dry-run` nothing is
+//! measured or sent: the files (the PDF to print, the nominal program) are written and the
+//! steps are printed. Every refusal comes before the first byte of a cut; report.json keeps
+//! the registration of the sheets that were measured.
+
+use super::link::{self, LinkArgs};
+use crate::device::sim::sensor::{PrintedSheet, SheetPlacement};
+use crate::device::sim::SimConfig;
+use crate::pipeline::printcut::{self, PrintCut, Registered};
+use crate::pipeline::{Before, CutRun};
+use crate::profile::registration::{Corner, Sensor};
+use crate::profile::{Language, Profile};
+use crate::Error;
+use clap::Args;
+use glam::DVec2;
+
+#[derive(Debug, Clone, Default, Args)]
+pub struct PrintCutArgs {
+    /// Print-and-cut: registration marks on each sheet, everything drawn (labels, ids, folds)
+    /// in the PDF to print, only the cut (and score) sent, after the marks are found on the
+    /// machine (its sensor, or --marks).
+    #[arg(long)]
+    pub print_and_cut: bool,
+    /// The marks' positions on the machine, mm in its own axes, read off it after jogging to
+    /// each mark: `X1,Y1:X2,Y2:X3,Y3[:X4,Y4]`, mark 1 the square, then the Ls
+    /// counter-clockwise.
+    #[arg(long, value_name = "X1,Y1:X2,Y2:X3,Y3")]
+    pub marks: Option<String>,
+    /// Registration marks this far in from the sheet's edges, mm (overrides the profile's
+    /// `[registration] inset`).
+    #[arg(long, value_name = "MM")]
+    pub mark_inset: Option<f64>,
+    /// The corner of the square mark (overrides the profile's).
+    #[arg(long, value_enum)]
+    pub square_corner: Option<Corner>,
+    /// Simulator: the printed sheet lies DX, DY mm off and turned DEG degrees
+    /// (counter-clockwise about the origin), printed SX (and SY) times true size.
+    #[arg(long, value_name = "DX,DY,DEG[,SX[,SY]]", allow_hyphen_values = true)]
+    pub sheet_offset: Option<String>,
+}
+
+impl PrintCutArgs {
+    /// Check the flags before any work, and put the mark flags into the job's profile.
+    pub fn apply(&self, profile: &mut Profile) -> Result<(), Error> {
+        let used = self.marks.is_some()
+            || self.mark_inset.is_some()
+            || self.square_corner.is_some()
+            || self.sheet_offset.is_some();
+        if used && !self.print_and_cut {
+            return Err(Error::Usage(
+                "--marks, --mark-inset, --square-corner and --sheet-offset are for print-and-cut: add --print-and-cut".into(),
+            ));
+        }
+        if let Some(v) = self.mark_inset {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Usage(format!(
+                    "--mark-inset must be 0 or a distance in mm, got {v}"
+                )));
+            }
+            profile.registration.inset = v;
+        }
+        if let Some(c) = self.square_corner {
+            profile.registration.square_corner = c;
+        }
+        if let Some(m) = &self.marks {
+            parse_marks(m)?;
+        }
+        if let Some(s) = &self.sheet_offset {
+            parse_placement("--sheet-offset", s)?;
+        }
+        Ok(())
+    }
+}
+
+/// `--marks X1,Y1:X2,Y2:…`: the points, mm.
+pub fn parse_marks(text: &str) -> Result<Vec<DVec2>, Error> {
+    let bad = |why: String| Error::Usage(format!("--marks {text}: {why}"));
+    let mut out = Vec::new();
+    for (k, part) in text.split(':').enumerate() {
+        let v: Vec<&str> = part.split(',').map(str::trim).collect();
+        let num = |t: &str| t.parse::<f64>().ok().filter(|v| v.is_finite());
+        match v.as_slice() {
+            [x, y] => match (num(x), num(y)) {
+                (Some(x), Some(y)) => out.push(DVec2::new(x, y)),
+                _ => {
+                    return Err(bad(format!(
+                        "mark {}: `{part}` is not two numbers X,Y (mm)",
+                        k + 1
+                    )))
+                }
+            },
+            _ => {
+                return Err(bad(format!(
+                    "mark {}: `{part}` is not X,Y; marks are separated by `:`",
+                    k + 1
+                )))
+            }
+        }
+    }
+    if out.len() < 3 {
+        return Err(bad(format!(
+            "{} marks given; the fit needs at least 3",
+            out.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// `DX,DY,DEG[,SX[,SY]]` of `flag`.
+pub fn parse_placement(flag: &str, text: &str) -> Result<SheetPlacement, Error> {
+    let v: Option<Vec<f64>> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect();
+    let bad = || {
+        Error::Usage(format!(
+            "{flag} {text}: expected DX,DY,DEG (mm, mm, degrees), optionally ,SX or ,SX,SY (scale, e.g. 1.03)"
+        ))
+    };
+    let v = v.ok_or_else(bad)?;
+    let (sx, sy) = match v.len() {
+        3 => (1.0, 1.0),
+        4 => (v[3], v[3]),
+        5 => (v[3], v[4]),
+        _ => return Err(bad()),
+    };
+    if !(sx > 0.0 && sy > 0.0) {
+        return Err(bad());
+    }
+    Ok(SheetPlacement {
+        offset: DVec2::new(v[0], v[1]),
+        angle_deg: v[2],
+        scale: DVec2::new(sx, sy),
+    })
+}
+
+fn sheet_name(name: &str, i: usize, n: usize, ext: &str) -> String {
+    if n == 1 {
+        format!("{name}-registered.{ext}")
+    } else {
+        format!("{name}-registered-{}.{ext}", i + 1)
+    }
+}
+
+/// report.json with the registration of the sheets `done`.
+fn record(run: &CutRun, pc: &PrintCut, profile: &Profile, done: &[Registered]) {
+    let path = run.dir.join("report.json");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return;
+    };
+    let Ok(mut v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return;
+    };
+    v["registration"] = printcut::report(pc, profile, done);
+    let text = serde_json::to_string_pretty(&v).unwrap_or_default() + "\n";
+    if let Err(e) = crate::pipeline::write_atomic(&path, text.as_bytes()) {
+        eprintln!("flatcut: warning: {e}");
+    }
+}
+
+fn say_fit(reg: &Registered) -> String {
+    let t = &reg.fit.transform;
+    format!(
+        "sheet {}: marks found by {}: sheet at ({:.3}, {:.3}) mm, turned {:.3}°, scale {:.5}; residual {:.3} mm RMS, {:.3} mm max (mark {})",
+        reg.sheet + 1,
+        reg.source,
+        t.translation.x,
+        t.translation.y,
+        t.angle.to_degrees(),
+        t.scale,
+        reg.fit.rms,
+        reg.fit.max,
+        reg.fit.worst + 1
+    )
+}
+
+/// Measure, fit and send each chosen sheet of a print-and-cut run (see the module docs).
+pub fn deliver(
+    run: &CutRun,
+    profile: &Profile,
+    link: &LinkArgs,
+    args: &PrintCutArgs,
+    quiet: bool,
+    dry_run: bool,
+) -> Result<(), Error> {
+    let Some(pc) = &run.print_cut else {
+        return link::deliver_run(run, profile, link, quiet, dry_run);
+    };
+    let say = |s: String| {
+        if !quiet {
+            println!("{s}");
+        }
+    };
+    let pdf = format!("{}.pdf", run.job.name);
+    if dry_run {
+        if let Err(e) = link::check_media(profile, &pc.cutter) {
+            eprintln!("flatcut: warning: {e}");
+        }
+        say(format!(
+            "print-and-cut, dry run: nothing measured or sent. Print {} at 100 % (marks included), load the sheet with its lower-left corner at the machine's origin, then run again without --dry-run{}",
+            run.dir.join(&pdf).display(),
+            if profile.registration.sensor == Sensor::None {
+                " and with --marks (jog to each mark, read its position)"
+            } else {
+                ""
+            }
+        ));
+        return Ok(());
+    }
+    link::check_media(profile, &pc.cutter)?;
+    let sim = link::simulated(profile, link);
+    if args.sheet_offset.is_some() && !sim {
+        return Err(Error::Usage(
+            "--sheet-offset places the printed sheet on the simulated cutter: add --simulate"
+                .into(),
+        ));
+    }
+    let n = pc.marks.len();
+    let chosen = link::chosen_sheets(link.sheets.as_deref(), n)?;
+    let given = args.marks.as_deref().map(parse_marks).transpose()?;
+    if given.is_some() && chosen.len() > 1 {
+        return Err(Error::Usage(format!(
+            "--marks: the job has {n} sheets, each with its own marks; measure and send one at a time with --sheets K --marks …"
+        )));
+    }
+    if given.is_none() && profile.registration.sensor == Sensor::None {
+        return Err(Error::Usage(format!(
+            "device `{}` has no registration sensor ([registration] sensor = \"none\", {}): jog to each printed mark and give the positions the machine shows with --marks X1,Y1:X2,Y2:X3,Y3[:X4,Y4] (mm; mark 1 the square, then the Ls counter-clockwise); {pdf} is written",
+            profile.name, profile.source
+        )));
+    }
+    let placement = args
+        .sheet_offset
+        .as_deref()
+        .map(|s| parse_placement("--sheet-offset", s))
+        .transpose()?
+        .unwrap_or_default();
+    let ext = profile.language.extension();
+    let mut done: Vec<Registered> = Vec::new();
+    let opts = link::stream_options(link, quiet)?;
+    for (t, &k) in chosen.iter().enumerate() {
+        let i = k - 1;
+        let name = sheet_name(&run.job.name, i, n, ext);
+        let path = run.dir.join(&name);
+        if t > 0 && !sim {
+            let left: Vec<String> = chosen[t..]
+                .iter()
+                .map(|k| sheet_name(&run.job.name, k - 1, n, ext))
+                .collect();
+            link::wait_for_operator(&format!("load printed sheet {k} of {n}"), &left, &opts)?;
+        }
+        // Fit, refuse or make and write the program.
+        let prepare = |measured_mm: &[DVec2], source: &str| -> Result<_, Error> {
+            let reg = printcut::register(pc, i, measured_mm, profile, source)?;
+            let bytes = printcut::registered_program(pc, &reg, profile)?;
+            crate::pipeline::write_atomic(&path, &bytes)?;
+            Ok((reg, bytes))
+        };
+        if let Some(measured) = &given {
+            let result = prepare(measured, "--marks");
+            let (reg, bytes) = match result {
+                Ok(r) => r,
+                Err(e) => {
+                    record(run, pc, profile, &done);
+                    return Err(e);
+                }
+            };
+            say(say_fit(&reg));
+            done.push(reg);
+            record(run, pc, profile, &done);
+            let one = LinkArgs {
+                sheets: None,
+                ..link.clone()
+            };
+            link::deliver_and_print(
+                &[(name.clone(), bytes)],
+                &[path.clone()],
+                &[Before::Start],
+                profile,
+                &one,
+                &run.dir,
+                quiet,
+            )?;
+            continue;
+        }
+        if profile.language != Language::Hpgl {
+            return Err(Error::Usage(format!(
+                "device `{}`: its sensor ({}) is driven by HP-GL digitizing, and the device speaks {}; give the marks with --marks",
+                profile.name,
+                profile.registration.sensor.name(),
+                profile.language.label()
+            )));
+        }
+        let marks = &pc.marks[i];
+        let upm = profile.units_per_mm;
+        let nominal: Vec<DVec2> = marks
+            .references()
+            .iter()
+            .map(|p| crate::output::to_device(profile, marks.width, marks.height, *p))
+            .collect();
+        let mut reg_out = None;
+        let mut fit_and_make = |m: &[DVec2]| -> Result<Vec<u8>, Error> {
+            let mm: Vec<DVec2> = m.iter().map(|p| *p / upm).collect();
+            let (reg, bytes) = prepare(&mm, "the sensor")?;
+            reg_out = Some(reg);
+            Ok(bytes)
+        };
+        if sim {
+            let mut cfg = SimConfig::new(profile.clone());
+            if let Some(b) = link.baud {
+                cfg.profile.serial.baud = b;
+            }
+            cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
+            cfg.printed = Some(PrintedSheet {
+                marks: marks.clone(),
+                placement,
+            });
+            let (outcome, report) = crate::device::register::sim_job(
+                cfg,
+                &nominal,
+                &opts,
+                link::SIM_FINISH_CAP,
+                fit_and_make,
+            )?;
+            let stem = if n > 1 {
+                format!("sim-{k}")
+            } else {
+                "sim".into()
+            };
+            let (png, json) = crate::device::sim::write_outputs(&report, profile, &run.dir, &stem)?;
+            if let Some(reg) = reg_out.take() {
+                say(say_fit(&reg));
+                done.push(reg);
+            }
+            record(run, pc, profile, &done);
+            let rep = outcome??;
+            say(format!(
+                "sent {name} to the simulated {} ({} bytes, {} strokes, {:.1} s)",
+                profile.name, rep.bytes, rep.strokes, rep.seconds
+            ));
+            if report.violations() > 0 {
+                return Err(Error::Usage(format!(
+                    "the simulated {} lost data: {} bytes overran its buffer (see {})",
+                    profile.name,
+                    report.violations(),
+                    json.display()
+                )));
+            }
+            say(format!(
+                "the simulated {} cut {} paths, {:.0} mm; picture {} (report {})",
+                profile.name,
+                report.paths.len(),
+                report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
+                png.display(),
+                json.display()
+            ));
+        } else {
+            let Some(port) = link.port.as_deref() else {
+                return Err(Error::Usage(format!(
+                    "device `{}` is a real machine: give its serial port with --port",
+                    profile.name
+                )));
+            };
+            let mut line = crate::device::serial::open(profile, port, link.baud)?;
+            let measured = crate::device::register::digitize(
+                &mut line,
+                &nominal,
+                upm,
+                profile.registration.search,
+                &opts,
+            )?;
+            let bytes = fit_and_make(&measured);
+            if let Some(reg) = reg_out.take() {
+                say(say_fit(&reg));
+                done.push(reg);
+            }
+            record(run, pc, profile, &done);
+            let bytes = bytes?;
+            let rep = crate::device::stream::send(&mut line, profile, &bytes, &opts)?;
+            say(format!(
+                "sent {name} to {} on {port}: {} bytes, {} strokes in {:.1} s",
+                profile.name, rep.bytes, rep.strokes, rep.seconds
+            ));
+        }
+    }
+    Ok(())
+}
