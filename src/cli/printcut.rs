@@ -286,7 +286,7 @@ pub fn deliver(
             };
             link::deliver_and_print(
                 &[(name.clone(), bytes)],
-                &[path.clone()],
+                std::slice::from_ref(&path),
                 &[Before::Start],
                 profile,
                 &one,
@@ -311,9 +311,10 @@ pub fn deliver(
             .map(|p| crate::output::to_device(profile, marks.width, marks.height, *p))
             .collect();
         let mut reg_out = None;
+        let sensor_name = format!("the sensor of `{}`", profile.name);
         let mut fit_and_make = |m: &[DVec2]| -> Result<Vec<u8>, Error> {
             let mm: Vec<DVec2> = m.iter().map(|p| *p / upm).collect();
-            let (reg, bytes) = prepare(&mm, "the sensor")?;
+            let (reg, bytes) = prepare(&mm, &sensor_name)?;
             reg_out = Some(reg);
             Ok(bytes)
         };

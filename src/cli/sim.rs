@@ -121,7 +121,12 @@ fn printed(
         Some(t) => {
             let v: Option<Vec<f64>> = t
                 .split(',')
-                .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0))
+                .map(|x| {
+                    x.trim()
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite() && *v > 0.0)
+                })
                 .collect();
             match v.as_deref() {
                 Some([w, h]) => (*w, *h),
@@ -135,5 +140,8 @@ fn printed(
     };
     let marks = crate::toolpath::registration::layout(w, h, &profile.registration)
         .map_err(|e| Error::Usage(format!("--sheet-size {w},{h}: {e}")))?;
-    Ok(Some(crate::device::sim::sensor::PrintedSheet { marks, placement }))
+    Ok(Some(crate::device::sim::sensor::PrintedSheet {
+        marks,
+        placement,
+    }))
 }

@@ -6,7 +6,10 @@
 //! mark should be (pen up), `DP;` (digitize: the sensor looks for the mark there) and `OS;`,
 //! and reads the status byte. Bit 2 (4) set: a point was digitized, and `OD;` answers it as
 //! `X,Y,P` in plotter units. Bit 2 clear: no mark was found near that place, an error naming
-//! the mark. Answers end with a carriage return; XON/XOFF bytes among them are skipped. Before
+//! the mark. The marks are measured nearest the machine's origin first (a sheet turned
+//! about the origin moves those least), the first where it was printed, the later ones where
+//! the marks found so far put them (`predict`); the answers are returned in mark order. The
+//! first mark must lie within the sensor's reach of where it was printed. Answers end with a carriage return; XON/XOFF bytes among them are skipped. Before
 //! the first mark the host sends `IN;` (the cut program starts with its own `IN;` too).
 //!
 //! A machine that does not answer within the stream's timeout, a garbled answer, a hang-up or
@@ -75,9 +78,14 @@ pub fn digitize(
         message: e.to_string(),
     };
     write_all(link, b"IN;", opts).map_err(|e| line(1, e))?;
-    let mut out = Vec::with_capacity(nominal.len());
-    for (k, p) in nominal.iter().enumerate() {
+    // Nearest the machine's origin first: a sheet turned about the origin moves those least.
+    let mut order: Vec<usize> = (0..nominal.len()).collect();
+    order.sort_by(|a, b| nominal[*a].length().total_cmp(&nominal[*b].length()));
+    let mut out = vec![DVec2::ZERO; nominal.len()];
+    let (mut seen, mut got) = (Vec::new(), Vec::new());
+    for k in order {
         let mark = k + 1;
+        let p = &predict(&seen, &got, nominal[k]);
         let (x, y) = (p.x.round() as i64, p.y.round() as i64);
         write_all(link, format!("PU{x},{y};DP;OS;").as_bytes(), opts).map_err(|e| line(mark, e))?;
         let status = answer(link, "OS", mark, opts)?;
@@ -105,11 +113,28 @@ pub fn digitize(
             .collect::<Result<_, _>>()
             .map_err(|_| garbled("OD;", &od))?;
         match v.as_slice() {
-            [x, y, ..] if x.is_finite() && y.is_finite() => out.push(DVec2::new(*x, *y)),
+            [x, y, ..] if x.is_finite() && y.is_finite() => {
+                out[k] = DVec2::new(*x, *y);
+                seen.push(nominal[k]);
+                got.push(out[k]);
+            }
             _ => return Err(garbled("OD;", &od)),
         }
     }
     Ok(out)
+}
+
+/// Where to look for the mark printed at `at`, from the marks found so far (`found`, for
+/// `nominal` in order): the first where printed, the second moved as the first was, the rest
+/// where the least-squares similarity of those found puts them (as cutters look for the later
+/// marks once the first are found, so that a sheet a little off or a print a little scaled
+/// still has its marks within the sensor's reach).
+fn predict(nominal: &[DVec2], found: &[DVec2], at: DVec2) -> DVec2 {
+    match found.len() {
+        0 => at,
+        1 => at + (found[0] - nominal[0]),
+        _ => crate::geom::similarity::fit(nominal, found).map_or(at, |f| f.transform.apply(at)),
+    }
 }
 
 fn write_all(link: &mut Link, mut bytes: &[u8], opts: &StreamOptions) -> std::io::Result<()> {

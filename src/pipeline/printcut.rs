@@ -13,7 +13,8 @@
 //! - [`register`]: the marks' measured positions (machine millimetres, from `--marks` or a
 //!   sensor) against where they were printed: the least-squares similarity
 //!   ([`crate::geom::similarity`]) from the sheet onto the machine, refused — before anything
-//!   is sent — when a mark is off the sheet or the media, two marks coincide, the scale is
+//!   is sent — when a mark is off the media or off the sheet (loaded with its lower-left
+//!   corner within the profile's `search` distance of the machine's origin), two marks coincide, the scale is
 //!   beyond the profile's `max_scale_error` (±1 %) or a mark's residual beyond its
 //!   `tolerance` (0.3 mm), naming the residual and the worst mark.
 //! - [`registered_program`]: the cutter's job moved by the fit, then made as the device makes
@@ -216,9 +217,10 @@ pub fn register(
             )));
         }
         let s = machine_to_sheet(profile, w, h, *q);
-        if s.x < 0.0 || s.y < 0.0 || s.x > w || s.y > h {
+        let e = r.search;
+        if s.x < -e || s.y < -e || s.x > w + e || s.y > h + e {
             return Err(bad(format!(
-                "{} at ({:.3}, {:.3}) mm is outside the {w:.0} × {h:.0} mm sheet (laid with its lower-left corner at the machine's origin); was the sheet loaded, or the mark read off, elsewhere?",
+                "{} at ({:.3}, {:.3}) mm is outside the {w:.0} × {h:.0} mm sheet, which is loaded with its lower-left corner within {e} mm of the machine's origin ([registration] search); was the sheet loaded, or the mark read off, elsewhere?",
                 describe(k),
                 q.x,
                 q.y

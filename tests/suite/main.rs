@@ -21,6 +21,7 @@ mod nest;
 mod param;
 mod pattern;
 mod pdf;
+mod printcut;
 mod resume;
 mod robust;
 mod simplify;
