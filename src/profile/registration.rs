@@ -121,3 +121,33 @@ pub(super) fn check(r: &Registration) -> Result<(), (&'static str, String)> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn profiles_say_whether_there_is_a_sensor() {
+        for p in crate::profile::all().unwrap() {
+            let expect = if p.name.starts_with("sim") {
+                Sensor::HpglDigitize
+            } else {
+                Sensor::None
+            };
+            assert_eq!(p.registration.sensor, expect, "{}", p.name);
+            assert_eq!(p.registration.inset, 10.0, "{}", p.name);
+        }
+        let head = "name='x'\ndescription='d'\nlanguage='hpgl'\ndialect='hp-gl'\nunits_per_mm=40\n[tools.cut]\npen=1\n";
+        let err = |extra: &str| {
+            crate::profile::parse(&format!("{head}[registration]\n{extra}"), "x.toml")
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err("inset = -1\n");
+        assert!(e.contains("x.toml: line 9: `registration.inset`"), "{e}");
+        let e = err("width = 30\n");
+        assert!(e.contains("`registration.width` must be less than"), "{e}");
+        let e = err("sensor = \"laser\"\n");
+        assert!(e.contains("x.toml") && e.contains("sensor"), "{e}");
+    }
+}
