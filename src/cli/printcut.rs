@@ -198,17 +198,12 @@ pub fn deliver(
     let Some(pc) = &run.print_cut else {
         return link::deliver_run(run, profile, link, quiet, dry_run);
     };
-    let say = |s: String| {
-        if !quiet {
-            println!("{s}");
-        }
-    };
     let pdf = format!("{}.pdf", run.job.name);
     if dry_run {
         if let Err(e) = link::check_media(profile, &pc.cutter) {
             eprintln!("flatcut: warning: {e}");
         }
-        say(format!(
+        say(quiet, format!(
             "print-and-cut, dry run: nothing measured or sent. Print {} at 100 % (marks included), load the sheet with its lower-left corner at the machine's origin, then run again without --dry-run{}",
             run.dir.join(&pdf).display(),
             if profile.registration.sensor == Sensor::None {
@@ -241,6 +236,14 @@ pub fn deliver(
             profile.name, profile.source
         )));
     }
+    if given.is_none() && profile.language != Language::Hpgl {
+        return Err(Error::Usage(format!(
+            "device `{}`: its sensor ({}) is driven by HP-GL digitizing, and the device speaks {}; give the marks with --marks",
+            profile.name,
+            profile.registration.sensor.name(),
+            profile.language.label()
+        )));
+    }
     let placement = args
         .sheet_offset
         .as_deref()
@@ -251,9 +254,7 @@ pub fn deliver(
     let mut done: Vec<Registered> = Vec::new();
     let opts = link::stream_options(link, quiet)?;
     for (t, &k) in chosen.iter().enumerate() {
-        let i = k - 1;
-        let name = sheet_name(&run.job.name, i, n, ext);
-        let path = run.dir.join(&name);
+        let name = sheet_name(&run.job.name, k - 1, n, ext);
         if t > 0 && !sim {
             let left: Vec<String> = chosen[t..]
                 .iter()
@@ -261,49 +262,99 @@ pub fn deliver(
                 .collect();
             link::wait_for_operator(&format!("load printed sheet {k} of {n}"), &left, &opts)?;
         }
-        // Fit, refuse or make and write the program.
-        let prepare = |measured_mm: &[DVec2], source: &str| -> Result<_, Error> {
-            let reg = printcut::register(pc, i, measured_mm, profile, source)?;
-            let bytes = printcut::registered_program(pc, &reg, profile)?;
-            crate::pipeline::write_atomic(&path, &bytes)?;
-            Ok((reg, bytes))
+        let one = One {
+            run,
+            pc,
+            profile,
+            link,
+            opts: &opts,
+            quiet,
+            i: k - 1,
+            n,
+            path: run.dir.join(&name),
+            name,
         };
-        if let Some(measured) = &given {
-            let result = prepare(measured, "--marks");
-            let (reg, bytes) = match result {
-                Ok(r) => r,
-                Err(e) => {
-                    record(run, pc, profile, &done);
-                    return Err(e);
-                }
-            };
-            say(say_fit(&reg));
+        match &given {
+            Some(measured) => one.by_hand(measured, &mut done)?,
+            None => one.by_sensor(placement, sim, &mut done)?,
+        }
+    }
+    Ok(())
+}
+
+fn say(quiet: bool, s: String) {
+    if !quiet {
+        println!("{s}");
+    }
+}
+
+/// One sheet of a print-and-cut send.
+struct One<'a> {
+    run: &'a CutRun,
+    pc: &'a PrintCut,
+    profile: &'a Profile,
+    link: &'a LinkArgs,
+    opts: &'a crate::device::stream::StreamOptions,
+    quiet: bool,
+    /// The sheet, 0-based, of `n`.
+    i: usize,
+    n: usize,
+    /// The registered program's file name and path.
+    name: String,
+    path: std::path::PathBuf,
+}
+
+impl One<'_> {
+    /// Fit `measured` (machine mm), refuse or make and write the program.
+    fn prepare(&self, measured: &[DVec2], source: &str) -> Result<(Registered, Vec<u8>), Error> {
+        let reg = printcut::register(self.pc, self.i, measured, self.profile, source)?;
+        let bytes = printcut::registered_program(self.pc, &reg, self.profile)?;
+        crate::pipeline::write_atomic(&self.path, &bytes)?;
+        Ok((reg, bytes))
+    }
+
+    /// Keep a fit (printed, in report.json).
+    fn keep(&self, reg: Option<Registered>, done: &mut Vec<Registered>) {
+        if let Some(reg) = reg {
+            say(self.quiet, say_fit(&reg));
             done.push(reg);
-            record(run, pc, profile, &done);
-            let one = LinkArgs {
-                sheets: None,
-                ..link.clone()
-            };
-            link::deliver_and_print(
-                &[(name.clone(), bytes)],
-                std::slice::from_ref(&path),
-                &[Before::Start],
-                profile,
-                &one,
-                &run.dir,
-                quiet,
-            )?;
-            continue;
         }
-        if profile.language != Language::Hpgl {
-            return Err(Error::Usage(format!(
-                "device `{}`: its sensor ({}) is driven by HP-GL digitizing, and the device speaks {}; give the marks with --marks",
-                profile.name,
-                profile.registration.sensor.name(),
-                profile.language.label()
-            )));
-        }
-        let marks = &pc.marks[i];
+        record(self.run, self.pc, self.profile, done);
+    }
+
+    /// `--marks`: fit, then send as any program.
+    fn by_hand(&self, measured: &[DVec2], done: &mut Vec<Registered>) -> Result<(), Error> {
+        let prepared = self.prepare(measured, "--marks");
+        let (reg, bytes) = match prepared {
+            Ok((reg, bytes)) => (Some(reg), Ok(bytes)),
+            Err(e) => (None, Err(e)),
+        };
+        self.keep(reg, done);
+        let one = LinkArgs {
+            sheets: None,
+            ..self.link.clone()
+        };
+        link::deliver_and_print(
+            &[(self.name.clone(), bytes?)],
+            std::slice::from_ref(&self.path),
+            &[Before::Start],
+            self.profile,
+            &one,
+            &self.run.dir,
+            self.quiet,
+        )
+    }
+
+    /// The device's sensor finds the marks (on the simulator, the printed sheet placed by
+    /// `placement`), then the program goes out on the same line.
+    fn by_sensor(
+        &self,
+        placement: SheetPlacement,
+        sim: bool,
+        done: &mut Vec<Registered>,
+    ) -> Result<(), Error> {
+        let (profile, link) = (self.profile, self.link);
+        let marks = &self.pc.marks[self.i];
         let upm = profile.units_per_mm;
         let nominal: Vec<DVec2> = marks
             .references()
@@ -314,60 +365,11 @@ pub fn deliver(
         let sensor_name = format!("the sensor of `{}`", profile.name);
         let mut fit_and_make = |m: &[DVec2]| -> Result<Vec<u8>, Error> {
             let mm: Vec<DVec2> = m.iter().map(|p| *p / upm).collect();
-            let (reg, bytes) = prepare(&mm, &sensor_name)?;
+            let (reg, bytes) = self.prepare(&mm, &sensor_name)?;
             reg_out = Some(reg);
             Ok(bytes)
         };
-        if sim {
-            let mut cfg = SimConfig::new(profile.clone());
-            if let Some(b) = link.baud {
-                cfg.profile.serial.baud = b;
-            }
-            cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
-            cfg.printed = Some(PrintedSheet {
-                marks: marks.clone(),
-                placement,
-            });
-            let (outcome, report) = crate::device::register::sim_job(
-                cfg,
-                &nominal,
-                &opts,
-                link::SIM_FINISH_CAP,
-                fit_and_make,
-            )?;
-            let stem = if n > 1 {
-                format!("sim-{k}")
-            } else {
-                "sim".into()
-            };
-            let (png, json) = crate::device::sim::write_outputs(&report, profile, &run.dir, &stem)?;
-            if let Some(reg) = reg_out.take() {
-                say(say_fit(&reg));
-                done.push(reg);
-            }
-            record(run, pc, profile, &done);
-            let rep = outcome??;
-            say(format!(
-                "sent {name} to the simulated {} ({} bytes, {} strokes, {:.1} s)",
-                profile.name, rep.bytes, rep.strokes, rep.seconds
-            ));
-            if report.violations() > 0 {
-                return Err(Error::Usage(format!(
-                    "the simulated {} lost data: {} bytes overran its buffer (see {})",
-                    profile.name,
-                    report.violations(),
-                    json.display()
-                )));
-            }
-            say(format!(
-                "the simulated {} cut {} paths, {:.0} mm; picture {} (report {})",
-                profile.name,
-                report.paths.len(),
-                report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
-                png.display(),
-                json.display()
-            ));
-        } else {
+        if !sim {
             let Some(port) = link.port.as_deref() else {
                 return Err(Error::Usage(format!(
                     "device `{}` is a real machine: give its serial port with --port",
@@ -375,26 +377,72 @@ pub fn deliver(
                 )));
             };
             let mut line = crate::device::serial::open(profile, port, link.baud)?;
-            let measured = crate::device::register::digitize(
-                &mut line,
-                &nominal,
-                upm,
-                profile.registration.search,
-                &opts,
-            )?;
+            let r = &profile.registration;
+            let measured =
+                crate::device::register::digitize(&mut line, &nominal, upm, r.search, self.opts)?;
             let bytes = fit_and_make(&measured);
-            if let Some(reg) = reg_out.take() {
-                say(say_fit(&reg));
-                done.push(reg);
-            }
-            record(run, pc, profile, &done);
-            let bytes = bytes?;
-            let rep = crate::device::stream::send(&mut line, profile, &bytes, &opts)?;
-            say(format!(
-                "sent {name} to {} on {port}: {} bytes, {} strokes in {:.1} s",
-                profile.name, rep.bytes, rep.strokes, rep.seconds
-            ));
+            self.keep(reg_out.take(), done);
+            let rep = crate::device::stream::send(&mut line, profile, &bytes?, self.opts)?;
+            say(
+                self.quiet,
+                format!(
+                    "sent {} to {} on {port}: {} bytes, {} strokes in {:.1} s",
+                    self.name, profile.name, rep.bytes, rep.strokes, rep.seconds
+                ),
+            );
+            return Ok(());
         }
+        let mut cfg = SimConfig::new(profile.clone());
+        if let Some(b) = link.baud {
+            cfg.profile.serial.baud = b;
+        }
+        cfg.time_factor = (link.sim_speed > 0.0).then_some(link.sim_speed);
+        cfg.printed = Some(PrintedSheet {
+            marks: marks.clone(),
+            placement,
+        });
+        let (outcome, report) = crate::device::register::sim_job(
+            cfg,
+            &nominal,
+            self.opts,
+            link::SIM_FINISH_CAP,
+            fit_and_make,
+        )?;
+        let stem = if self.n > 1 {
+            format!("sim-{}", self.i + 1)
+        } else {
+            "sim".into()
+        };
+        let (png, json) =
+            crate::device::sim::write_outputs(&report, profile, &self.run.dir, &stem)?;
+        self.keep(reg_out.take(), done);
+        let rep = outcome??;
+        say(
+            self.quiet,
+            format!(
+                "sent {} to the simulated {} ({} bytes, {} strokes, {:.1} s)",
+                self.name, profile.name, rep.bytes, rep.strokes, rep.seconds
+            ),
+        );
+        if report.violations() > 0 {
+            return Err(Error::Usage(format!(
+                "the simulated {} lost data: {} bytes overran its buffer (see {})",
+                profile.name,
+                report.violations(),
+                json.display()
+            )));
+        }
+        say(
+            self.quiet,
+            format!(
+                "the simulated {} cut {} paths, {:.0} mm; picture {} (report {})",
+                profile.name,
+                report.paths.len(),
+                report.per_tool.values().map(|t| t.length_mm).sum::<f64>() + 0.0,
+                png.display(),
+                json.display()
+            ),
+        );
+        Ok(())
     }
-    Ok(())
 }
