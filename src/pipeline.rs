@@ -293,15 +293,19 @@ pub fn plan(
     quiet: bool,
 ) -> Result<(Vec<Flat>, Layout, Job), Error> {
     plausible_sheet(spec)?;
+    // Print-and-cut: pieces are split and nested inside the margin that clears the marks.
+    let with_marks;
+    let spec = if choices.print_and_cut {
+        with_marks = printcut::spec_with_margin(spec, profile);
+        &with_marks
+    } else {
+        spec
+    };
     let (flats, pieces) = pieces(spec, quiet)?;
     let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
         height: spec.sheet.height,
-        margin: if choices.print_and_cut {
-            printcut::margin(spec, profile)
-        } else {
-            spec.sheet.margin
-        },
+        margin: spec.sheet.margin,
         spacing: spec.sheet.spacing,
         ..Default::default()
     };

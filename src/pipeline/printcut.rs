@@ -62,12 +62,14 @@ impl PrintCut {
     }
 }
 
-/// The nest's margin for a print-and-cut job on `profile`: the spec's, or more to clear the
-/// marks (for the spec's sheet size; a roll's marks are laid out on the length used).
-pub(super) fn margin(spec: &Spec, profile: &Profile) -> f64 {
+/// The spec as a print-and-cut job on `profile` is split and nested: its margin the spec's,
+/// or more to clear the marks (a roll's marks are laid out on the length used).
+pub(super) fn spec_with_margin(spec: &Spec, profile: &Profile) -> Spec {
     let r = &profile.registration;
     let clear = r.inset + r.square.max(r.width) + r.clearance;
-    spec.sheet.margin.max(clear)
+    let mut s = spec.clone();
+    s.sheet.margin = spec.sheet.margin.max(clear);
+    s
 }
 
 /// The toolpath options of a print-and-cut job: everything printed is kept.

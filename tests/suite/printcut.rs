@@ -324,3 +324,59 @@ fn dry_run_measures_nothing_and_a_device_without_sensor_asks_for_marks() {
         "{e}"
     );
 }
+
+/// The simulated cutter's sensor answers HP-GL digitizing from the bytes it receives: flatcut's
+/// host side (`device::register::digitize`) over a real pseudo-terminal finds each mark where
+/// the placement put it, to the plotter unit, and a sheet loaded too far off is a "not found"
+/// naming the mark.
+#[test]
+fn the_simulated_sensor_answers_hpgl_digitizing() {
+    use flatcut::device::sim::sensor::{PrintedSheet, SheetPlacement};
+    use flatcut::device::sim::{spawn, SimConfig};
+    use glam::DVec2;
+    let profile = flatcut::profile::find("sim").unwrap();
+    let marks =
+        flatcut::toolpath::registration::layout(297.0, 420.0, &profile.registration).unwrap();
+    let nominal: Vec<DVec2> = marks.references().iter().map(|p| *p * 40.0).collect();
+    let opts = flatcut::device::stream::StreamOptions {
+        timeout: std::time::Duration::from_secs(5),
+        progress: false,
+        ..Default::default()
+    };
+    for (dx, dy, deg, found) in [
+        (7.0, -4.0, 1.5, true),
+        (-2.5, 3.0, -2.0, true),
+        (30.0, 0.0, 0.0, false),
+    ] {
+        let placement = SheetPlacement {
+            offset: DVec2::new(dx, dy),
+            angle_deg: deg,
+            scale: DVec2::ONE,
+        };
+        let mut cfg = SimConfig::new(profile.clone());
+        cfg.printed = Some(PrintedSheet {
+            marks: marks.clone(),
+            placement,
+        });
+        let sim = spawn(cfg).unwrap();
+        let mut link = flatcut::device::serial::open(&profile, &sim.path, None).unwrap();
+        let got = flatcut::device::register::digitize(&mut link, &nominal, 40.0, 10.0, &opts);
+        drop(link);
+        let rep = sim.stop().unwrap();
+        assert!(rep.paths.is_empty(), "digitizing cuts nothing");
+        if !found {
+            let e = got.unwrap_err().to_string();
+            assert!(
+                e.contains("found no mark 2") && e.contains("nothing was cut"),
+                "{e}"
+            );
+            continue;
+        }
+        let got = got.unwrap();
+        for (k, p) in marks.references().iter().enumerate() {
+            let truth = placement.apply(*p);
+            let d = (got[k] / 40.0).distance(truth);
+            assert!(d <= 0.0125 * 2f64.sqrt() + 1e-9, "mark {}: {d} mm", k + 1);
+        }
+    }
+}
