@@ -13,6 +13,8 @@
 //!   files in the output folder; sending the programs is the caller's (`cli::link`), after the
 //!   files are written, so a failed send loses nothing.
 //! - [`nest_instance`]: an ESICUP instance → solution files (`flatcut nest`).
+//! - [`printcut`]: print-and-cut (`Toolpath::print_and_cut`): registration marks, the margin
+//!   that clears them, the cutter's job, the fit of measured marks and the registered program.
 //!
 //! Choices: options a user did not give are `None` and leave the stage's default; the
 //! command-line flags were checked by `cli` before they get here; warnings of the surface and

@@ -40,13 +40,13 @@ fn sim_json(dir: &Path) -> serde_json::Value {
         .expect("sim.json is JSON")
 }
 
-/// The simulator's recorded paths of `tool`, mm (the sim profile: 40 units per mm).
-fn recorded(dir: &Path, tool: &str) -> Vec<Vec<(f64, f64)>> {
+/// The simulator's recorded paths of `tools`, in the order cut, mm (HP-GL: 40 units per mm).
+fn recorded(dir: &Path, tools: &[&str]) -> Vec<Vec<(f64, f64)>> {
     sim_json(dir)["paths"]
         .as_array()
         .unwrap()
         .iter()
-        .filter(|p| p["tool"] == tool)
+        .filter(|p| tools.iter().any(|t| p["tool"] == *t))
         .map(|p| {
             p["points"]
                 .as_array()
@@ -61,17 +61,24 @@ fn recorded(dir: &Path, tool: &str) -> Vec<Vec<(f64, f64)>> {
 /// Largest distance, both ways, between the recorded cut paths and the nominal program's cut
 /// contours carried by the placement; also checks that they pair up one to one.
 fn deviation(dir: &Path, name: &str, placement: (f64, f64, f64)) -> f64 {
-    let plt = std::fs::read_to_string(dir.join(format!("{name}.plt"))).unwrap();
     let (dx, dy, deg) = placement;
+    deviation_by(dir, name, &["cut"], &|p| place(p, dx, dy, deg, 1.0, 1.0))
+}
+
+/// [`deviation`] for the recorded paths of `tools` against the pen-1 contours of the nominal
+/// program carried by `truth` (machine mm to machine mm).
+fn deviation_by(
+    dir: &Path,
+    name: &str,
+    tools: &[&str],
+    truth: &dyn Fn((f64, f64)) -> (f64, f64),
+) -> f64 {
+    let plt = std::fs::read_to_string(dir.join(format!("{name}.plt"))).unwrap();
     let printed: Vec<Vec<(f64, f64)>> = hpgl_cut_contours(&plt)
         .into_iter()
-        .map(|c| {
-            c.into_iter()
-                .map(|p| place(p, dx, dy, deg, 1.0, 1.0))
-                .collect()
-        })
+        .map(|c| c.into_iter().map(truth).collect())
         .collect();
-    let cut = recorded(dir, "cut");
+    let cut = recorded(dir, tools);
     assert_eq!(cut.len(), printed.len(), "one cut per printed outline");
     assert!(!cut.is_empty());
     let mut worst = 0.0f64;
@@ -379,4 +386,56 @@ fn the_simulated_sensor_answers_hpgl_digitizing() {
             assert!(d <= 0.0125 * 2f64.sqrt() + 1e-9, "mark {}: {d} mm", k + 1);
         }
     }
+}
+
+/// A roll-fed cutter whose axes are exchanged and mirrored (`roland-gx24`): the marks read
+/// off it by hand, in its own axes, register the cut onto the print all the same.
+#[test]
+fn marks_in_a_machines_own_axes_register_the_cut() {
+    use flatcut::pipeline::printcut::{machine_to_sheet, sheet_to_machine};
+    use glam::DVec2;
+    let profile = flatcut::profile::find("roland-gx24").unwrap();
+    let (w, h) = (210.0, 297.0);
+    let truth = |p: DVec2| {
+        let q = place((p.x, p.y), 7.0, -4.0, 1.5, 1.0, 1.0);
+        DVec2::new(q.0, q.1)
+    };
+    let nominal = [(12.5, 284.5), (10.0, 10.0), (200.0, 10.0), (200.0, 287.0)];
+    let marks: Vec<String> = nominal
+        .iter()
+        .map(|p| {
+            let m = sheet_to_machine(&profile, w, h, truth(DVec2::new(p.0, p.1)));
+            format!("{:.3},{:.3}", m.x, m.y)
+        })
+        .collect();
+    let dir = scratch("printcut-roland");
+    let o = flatcut(&[
+        "cut",
+        "patterns/tetrahedron.toml",
+        "-o",
+        dir.to_str().unwrap(),
+        "--device",
+        "roland-gx24",
+        "--simulate",
+        "--baud",
+        "115200",
+        // The axes are what is tested: no blade compensation (and its precut).
+        "--knife-offset",
+        "0",
+        "--print-and-cut",
+        "--marks",
+        &marks.join(":"),
+        "--sim-speed",
+        "0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Machine mm of the nominal program → the sheet → where the print really is → machine.
+    let carry = |m: (f64, f64)| {
+        let s = machine_to_sheet(&profile, w, h, DVec2::new(m.0, m.1));
+        let t = sheet_to_machine(&profile, w, h, truth(s));
+        (t.x, t.y)
+    };
+    let d = deviation_by(&dir, "tetrahedron", &["cut", "score"], &carry);
+    eprintln!("roland-gx24 --marks: recorded cuts vs printed outlines: {d:.4} mm at most");
+    assert!(d < 0.2, "{d}");
 }
