@@ -439,3 +439,58 @@ fn marks_in_a_machines_own_axes_register_the_cut() {
     eprintln!("roland-gx24 --marks: recorded cuts vs printed outlines: {d:.4} mm at most");
     assert!(d < 0.2, "{d}");
 }
+
+/// `flatcut sim --sheet-offset` loads a printed sheet for other software: its sensor answers
+/// digitizing over the pty it prints, where the placement puts the marks; a bad placement is
+/// exit 1 naming the flag.
+#[test]
+fn flatcut_sim_loads_a_printed_sheet() {
+    use glam::DVec2;
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let dir = scratch("printcut-sim");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flatcut"))
+        .args(["sim", "--sheet-offset", "-3,5,2", "--sheet-size", "300,200"])
+        .args(["--speed", "0", "--for", "3", "-o"])
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut first = String::new();
+    out.read_line(&mut first).unwrap();
+    let path = first
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap_or_else(|| panic!("first line: {first}"))
+        .to_string();
+    let profile = flatcut::profile::find("sim").unwrap();
+    let marks =
+        flatcut::toolpath::registration::layout(300.0, 200.0, &profile.registration).unwrap();
+    let nominal: Vec<DVec2> = marks.references().iter().map(|p| *p * 40.0).collect();
+    let opts = flatcut::device::stream::StreamOptions {
+        timeout: std::time::Duration::from_secs(2),
+        progress: false,
+        ..Default::default()
+    };
+    let mut link = flatcut::device::serial::open(&profile, &path, None).unwrap();
+    let got = flatcut::device::register::digitize(&mut link, &nominal, 40.0, 10.0, &opts).unwrap();
+    drop(link);
+    let placement = flatcut::device::sim::sensor::SheetPlacement {
+        offset: DVec2::new(-3.0, 5.0),
+        angle_deg: 2.0,
+        scale: DVec2::ONE,
+    };
+    for (k, p) in marks.references().iter().enumerate() {
+        let d = (got[k] / 40.0).distance(placement.apply(*p));
+        assert!(d < 0.02, "mark {}: {d} mm", k + 1);
+    }
+    for l in out.lines() {
+        let _ = l;
+    }
+    assert!(child.wait().unwrap().success());
+    let o = flatcut(&["sim", "--sheet-offset", "1,2", "--for", "0"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--sheet-offset 1,2"), "{}", stderr(&o));
+}
