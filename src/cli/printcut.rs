@@ -330,12 +330,18 @@ impl One<'_> {
             Err(e) => (None, Err(e)),
         };
         self.keep(reg, done);
+        self.send(bytes?)
+    }
+
+    /// The registered program sent as any program of a run (`link::deliver`: checked,
+    /// journalled for `flatcut resume`).
+    fn send(&self, bytes: Vec<u8>) -> Result<(), Error> {
         let one = LinkArgs {
             sheets: None,
             ..self.link.clone()
         };
         link::deliver_and_print(
-            &[(self.name.clone(), bytes?)],
+            &[(self.name.clone(), bytes)],
             std::slice::from_ref(&self.path),
             &[Before::Start],
             self.profile,
@@ -380,17 +386,12 @@ impl One<'_> {
             let r = &profile.registration;
             let measured =
                 crate::device::register::digitize(&mut line, &nominal, upm, r.search, self.opts)?;
+            drop(line);
             let bytes = fit_and_make(&measured);
             self.keep(reg_out.take(), done);
-            let rep = crate::device::stream::send(&mut line, profile, &bytes?, self.opts)?;
-            say(
-                self.quiet,
-                format!(
-                    "sent {} to {} on {port}: {} bytes, {} strokes in {:.1} s",
-                    self.name, profile.name, rep.bytes, rep.strokes, rep.seconds
-                ),
-            );
-            return Ok(());
+            // Sent as any program (checked, journalled for `flatcut resume`), the port opened
+            // again: the machine keeps its place and the sheet.
+            return self.send(bytes?);
         }
         let mut cfg = SimConfig::new(profile.clone());
         if let Some(b) = link.baud {

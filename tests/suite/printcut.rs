@@ -494,3 +494,59 @@ fn flatcut_sim_loads_a_printed_sheet() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("--sheet-offset 1,2"), "{}", stderr(&o));
 }
+
+/// The real-machine path: `--port` to a standalone `flatcut sim` with a printed sheet loaded
+/// 7 mm, −4 mm and 1.5° off. flatcut measures the marks over the port, fits, then sends the
+/// registered program as any program (journalled); the cut lands on the print.
+#[test]
+fn print_and_cut_over_a_port_to_flatcut_sim() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let simdir = scratch("printcut-port-sim");
+    let dir = scratch("printcut-port");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flatcut"))
+        .args([
+            "sim",
+            "--sheet-offset",
+            "7,-4,1.5",
+            "--speed",
+            "0",
+            "--for",
+            "4",
+        ])
+        .arg("-o")
+        .arg(&simdir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut first = String::new();
+    out.read_line(&mut first).unwrap();
+    let path = first
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap()
+        .to_string();
+    let o = flatcut(&[
+        "cut",
+        "patterns/tetrahedron.toml",
+        "-o",
+        dir.to_str().unwrap(),
+        "--print-and-cut",
+        "--port",
+        &path,
+    ]);
+    for l in out.lines() {
+        let _ = l;
+    }
+    assert!(child.wait().unwrap().success());
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The simulator's record is in its own folder; the nominal program in the run's.
+    std::fs::copy(simdir.join("sim.json"), dir.join("sim.json")).unwrap();
+    let d = deviation(&dir, "tetrahedron", (7.0, -4.0, 1.5));
+    eprintln!("over a port: recorded cuts vs printed outlines: {d:.4} mm at most");
+    assert!(d < 0.2, "{d}");
+    let journal = std::fs::read_to_string(dir.join("journal.json")).unwrap();
+    assert!(journal.contains("tetrahedron-registered.plt"), "{journal}");
+}
