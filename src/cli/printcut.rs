@@ -16,12 +16,14 @@
 //! the registration of the sheets that were measured.
 
 use super::link::{self, LinkArgs};
+use crate::device::register::{ProbeMark, RegisterError};
 use crate::device::sim::sensor::{PrintedSheet, SheetPlacement};
 use crate::device::sim::SimConfig;
 use crate::pipeline::printcut::{self, PrintCut, Registered};
 use crate::pipeline::{Before, CutRun};
 use crate::profile::registration::{Corner, Sensor};
 use crate::profile::{Language, Profile};
+use crate::toolpath::registration::MarkKind;
 use crate::Error;
 use clap::Args;
 use glam::DVec2;
@@ -236,12 +238,19 @@ pub fn deliver(
             profile.name, profile.source
         )));
     }
-    if given.is_none() && profile.language != Language::Hpgl {
+    let speaks = match profile.registration.sensor {
+        Sensor::HpglDigitize => Language::Hpgl,
+        Sensor::GrblProbe => Language::Gcode,
+        Sensor::None => profile.language,
+    };
+    if given.is_none() && profile.language != speaks {
         return Err(Error::Usage(format!(
-            "device `{}`: its sensor ({}) is driven by HP-GL digitizing, and the device speaks {}; give the marks with --marks",
+            "device `{}`: its sensor ({}) is driven in {}, and the device speaks {} ([registration] sensor, {}); give the marks with --marks",
             profile.name,
             profile.registration.sensor.name(),
-            profile.language.label()
+            speaks.label(),
+            profile.language.label(),
+            profile.source
         )));
     }
     let placement = args
@@ -362,11 +371,7 @@ impl One<'_> {
         let (profile, link) = (self.profile, self.link);
         let marks = &self.pc.marks[self.i];
         let upm = profile.units_per_mm;
-        let nominal: Vec<DVec2> = marks
-            .references()
-            .iter()
-            .map(|p| crate::output::to_device(profile, marks.width, marks.height, *p))
-            .collect();
+        let measure = measurer(profile, marks, self.opts);
         let mut reg_out = None;
         let sensor_name = format!("the sensor of `{}`", profile.name);
         let mut fit_and_make = |m: &[DVec2]| -> Result<Vec<u8>, Error> {
@@ -383,9 +388,7 @@ impl One<'_> {
                 )));
             };
             let mut line = crate::device::serial::open(profile, port, link.baud)?;
-            let r = &profile.registration;
-            let measured =
-                crate::device::register::digitize(&mut line, &nominal, upm, r.search, self.opts)?;
+            let measured = measure(&mut line)?;
             drop(line);
             let bytes = fit_and_make(&measured);
             self.keep(reg_out.take(), done);
@@ -404,9 +407,9 @@ impl One<'_> {
         });
         let (outcome, report) = crate::device::register::sim_job(
             cfg,
-            &nominal,
             self.opts,
             link::SIM_FINISH_CAP,
+            measure,
             fit_and_make,
         )?;
         let stem = if self.n > 1 {
@@ -445,5 +448,45 @@ impl One<'_> {
             ),
         );
         Ok(())
+    }
+}
+
+/// How the device's sensor measures `marks`: the measured reference points, device units.
+fn measurer<'a>(
+    profile: &'a Profile,
+    marks: &'a crate::toolpath::registration::Marks,
+    opts: &'a crate::device::stream::StreamOptions,
+) -> impl FnOnce(&mut crate::device::serial::Link) -> Result<Vec<DVec2>, RegisterError> + 'a {
+    let (w, h) = (marks.width, marks.height);
+    let dev = move |p: DVec2| crate::output::to_device(profile, w, h, p);
+    let r = &profile.registration;
+    move |line| match r.sensor {
+        Sensor::GrblProbe => {
+            let upm = profile.units_per_mm;
+            let probe: Vec<ProbeMark> = marks
+                .marks
+                .iter()
+                .map(|m| {
+                    let p = m.reference;
+                    let inward = DVec2::new((w / 2.0 - p.x).signum(), (h / 2.0 - p.y).signum());
+                    let along = |d: DVec2| ((dev(p + d) - dev(p)) / upm).normalize_or_zero();
+                    ProbeMark {
+                        at: dev(p) / upm,
+                        u: along(DVec2::new(inward.x, 0.0)),
+                        v: along(DVec2::new(0.0, inward.y)),
+                        square: (m.kind == MarkKind::Square).then_some(r.square),
+                    }
+                })
+                .collect();
+            let z_up = profile
+                .tool(crate::profile::StrokeKind::Cut)
+                .and_then(|t| t.z_up);
+            crate::device::register::probe_grbl(line, &probe, z_up, r.search, opts)
+                .map(|v| v.into_iter().map(|p| p * upm).collect())
+        }
+        _ => {
+            let nominal: Vec<DVec2> = marks.references().into_iter().map(dev).collect();
+            crate::device::register::digitize(line, &nominal, profile.units_per_mm, r.search, opts)
+        }
     }
 }

@@ -12,6 +12,16 @@
 //! first mark must lie within the sensor's reach of where it was printed. Answers end with a carriage return; XON/XOFF bytes among them are skipped. Before
 //! the first mark the host sends `IN;` (the cut program starts with its own `IN;` too).
 //!
+//! GRBL with a probe-pin sensor (`sensor = "grbl-probe"`, [`probe_grbl`]): after a reset
+//! (Ctrl-X, the welcome awaited, `$X` if it asks) and `G21 G90` and the tool lifted (`G0 Z`
+//! to the cut tool's `z_up`), each mark's edges are found with `G38.3` moves at 300 mm/min
+//! from `search` mm outside to `search` mm inside (GRBL 1.1: `[PRB:x,y,z:1]` at the contact,
+//! machine coordinates; `:0` without one, which is a mark not found): an L's outer corner is
+//! where its two outer edges meet, each edge through two contacts 8 and 14 mm along the arm;
+//! the square's centre is the middle of a chord probed from both sides, along one edge
+//! direction, then the other, then the first again. The marks are measured in the same order
+//! and from the same predictions as with digitizing.
+//!
 //! A machine that does not answer within the stream's timeout, a garbled answer, a hang-up or
 //! Ctrl-C stop the registration before any cut is sent. [`sim_job`] does the whole loop on the
 //! simulated cutter: start it with the printed sheet, measure, let the caller fit and make the
@@ -200,20 +210,205 @@ fn answer(
     }
 }
 
+/// A mark as the GRBL prober needs it, machine mm: its reference point where printed, the
+/// directions of its two edges into the sheet (`u` along the sheet's x, `v` along its y), and
+/// whether it is the square (side `square`) or an L.
+#[derive(Debug, Clone, Copy)]
+pub struct ProbeMark {
+    pub at: DVec2,
+    pub u: DVec2,
+    pub v: DVec2,
+    pub square: Option<f64>,
+}
+
+/// Probe feed, mm/min.
+const PROBE_FEED: f64 = 300.0;
+
+/// Measure each of `marks` with `G38.3` probe moves (see the module documentation); returns
+/// the reference points found, machine mm, in mark order.
+pub fn probe_grbl(
+    link: &mut Link,
+    marks: &[ProbeMark],
+    z_up: Option<f64>,
+    search: f64,
+    opts: &StreamOptions,
+) -> Result<Vec<DVec2>, RegisterError> {
+    let mut g = GrblLine { link, opts };
+    g.wake()?;
+    g.send("G21G90", 1)?;
+    if let Some(z) = z_up {
+        g.send(&format!("G0Z{z:.3}"), 1)?;
+    }
+    let nominal: Vec<DVec2> = marks.iter().map(|m| m.at).collect();
+    let mut order: Vec<usize> = (0..marks.len()).collect();
+    order.sort_by(|a, b| nominal[*a].length().total_cmp(&nominal[*b].length()));
+    let mut out = vec![DVec2::ZERO; marks.len()];
+    let (mut seen, mut got) = (Vec::new(), Vec::new());
+    for k in order {
+        let m = &marks[k];
+        // The mark's edge directions as the marks found so far turn the sheet.
+        let f = crate::geom::similarity::fit(&seen, &got);
+        let turn = |d: DVec2| {
+            f.as_ref()
+                .map_or(d, |f| DVec2::from_angle(f.transform.angle).rotate(d))
+        };
+        let (u, v) = (turn(m.u), turn(m.v));
+        let c = predict(&seen, &got, m.at);
+        let port = g.link.name.clone();
+        let not_found = || RegisterError::NotFound {
+            port: port.clone(),
+            mark: k + 1,
+            x: c.x,
+            y: c.y,
+            search,
+        };
+        let mut hit = |from: DVec2, to: DVec2| -> Result<DVec2, RegisterError> {
+            g.probe(from, to, k + 1)?.ok_or_else(not_found)
+        };
+        let r = search;
+        let found = match m.square {
+            Some(_) => {
+                let mut p = c;
+                for d in [u, v, u] {
+                    let a = hit(p - d * r, p + d * r)?;
+                    let b = hit(p + d * r, p - d * r)?;
+                    p = (a + b) / 2.0;
+                }
+                p
+            }
+            None => {
+                // Two points on the outer edge along v (met moving along u), two along u.
+                let e1 = [
+                    hit(c + v * 8.0 - u * r, c + v * 8.0 + u * r)?,
+                    hit(c + v * 14.0 - u * r, c + v * 14.0 + u * r)?,
+                ];
+                let e2 = [
+                    hit(c + u * 8.0 - v * r, c + u * 8.0 + v * r)?,
+                    hit(c + u * 14.0 - v * r, c + u * 14.0 + v * r)?,
+                ];
+                meet(e1, e2).ok_or_else(not_found)?
+            }
+        };
+        out[k] = found;
+        seen.push(m.at);
+        got.push(found);
+    }
+    Ok(out)
+}
+
+/// Where the line through `a` meets the line through `b`.
+fn meet(a: [DVec2; 2], b: [DVec2; 2]) -> Option<DVec2> {
+    let (da, db) = (a[1] - a[0], b[1] - b[0]);
+    let den = da.perp_dot(db);
+    if den.abs() < 1e-12 {
+        return None;
+    }
+    let t = (b[0] - a[0]).perp_dot(db) / den;
+    Some(a[0] + da * t)
+}
+
+/// A GRBL controller answered line by line (send-response).
+struct GrblLine<'a> {
+    link: &'a mut Link,
+    opts: &'a StreamOptions,
+}
+
+impl GrblLine<'_> {
+    fn err(&self, mark: usize, message: String) -> RegisterError {
+        RegisterError::Line {
+            port: self.link.name.clone(),
+            mark,
+            message,
+        }
+    }
+
+    /// Reset and wait for the welcome; unlock if it asks.
+    fn wake(&mut self) -> Result<(), RegisterError> {
+        let opts = self.opts;
+        write_all(self.link, &[crate::device::grbl::SOFT_RESET], opts)
+            .map_err(|e| self.err(1, e.to_string()))?;
+        let mut lock = false;
+        loop {
+            let l = answer(self.link, "Ctrl-X (reset)", 1, opts)?;
+            if l.contains("'$X' to unlock") {
+                lock = true;
+            }
+            if l.starts_with("Grbl ") {
+                break;
+            }
+        }
+        // The unlock hint follows the welcome.
+        std::thread::sleep(Duration::from_millis(50));
+        let mut buf = [0u8; 256];
+        let n = self.link.read_ready(&mut buf).unwrap_or(0);
+        if lock || String::from_utf8_lossy(&buf[..n]).contains("'$X' to unlock") {
+            self.send("$X", 1)?;
+        }
+        Ok(())
+    }
+
+    /// Send one line and collect what comes back up to its `ok`; `error:N` or an alarm is an
+    /// error naming the line.
+    fn send(&mut self, line: &str, mark: usize) -> Result<Vec<String>, RegisterError> {
+        let opts = self.opts;
+        write_all(self.link, format!("{line}\n").as_bytes(), opts)
+            .map_err(|e| self.err(mark, e.to_string()))?;
+        let mut said = Vec::new();
+        loop {
+            let l = answer(self.link, line, mark, opts)?;
+            if l == "ok" {
+                return Ok(said);
+            }
+            if l.starts_with("error") || l.starts_with("ALARM") {
+                return Err(self.err(mark, format!("GRBL answered `{l}` to `{line}`")));
+            }
+            said.push(l);
+        }
+    }
+
+    /// Probe from `from` to `to` (machine mm): the contact, if there was one.
+    fn probe(
+        &mut self,
+        from: DVec2,
+        to: DVec2,
+        mark: usize,
+    ) -> Result<Option<DVec2>, RegisterError> {
+        self.send(&format!("G0X{:.3}Y{:.3}", from.x, from.y), mark)?;
+        let line = format!("G38.3X{:.3}Y{:.3}F{PROBE_FEED}", to.x, to.y);
+        let said = self.send(&line, mark)?;
+        let prb = said
+            .iter()
+            .find_map(|l| l.strip_prefix("[PRB:").and_then(|r| r.strip_suffix(']')));
+        let Some(prb) = prb else {
+            return Err(self.err(mark, format!("no [PRB:…] answer to `{line}`")));
+        };
+        let (xyz, ok) = prb.rsplit_once(':').unwrap_or((prb, "0"));
+        let v: Vec<f64> = xyz
+            .split(',')
+            .filter_map(|t| t.trim().parse().ok())
+            .collect();
+        match (v.as_slice(), ok.trim()) {
+            ([x, y, ..], "1") => Ok(Some(DVec2::new(*x, *y))),
+            (_, "0") => Ok(None),
+            _ => Err(self.err(mark, format!("cannot read `[PRB:{prb}]`"))),
+        }
+    }
+}
+
 /// What [`sim_job`] did: the program's stream (`None`: the caller refused before sending
 /// anything) and the simulator's report.
 pub type SimOutcome<E> = (Result<Result<StreamReport, StreamError>, E>, SimReport);
 
 /// Print-and-cut on a simulated cutter: start it as `cfg` says (its printed sheet placed),
-/// measure the marks at `nominal` (machine units) with its sensor, hand the measured points to
+/// measure the marks with its sensor (`measure`: [`digitize`] or [`probe_grbl`]), hand the measured points to
 /// `prepare` (which fits them and makes the program, or refuses), and stream the program on
 /// the same line. A failed measurement or a refusal stops the simulator with nothing cut; its
 /// report says so.
 pub fn sim_job<E: From<RegisterError>>(
     cfg: SimConfig,
-    nominal: &[DVec2],
     opts: &StreamOptions,
     finish_within: Duration,
+    measure: impl FnOnce(&mut Link) -> Result<Vec<DVec2>, RegisterError>,
     prepare: impl FnOnce(&[DVec2]) -> Result<Vec<u8>, E>,
 ) -> Result<SimOutcome<E>, SimError> {
     let profile = cfg.profile.clone();
@@ -221,8 +416,7 @@ pub fn sim_job<E: From<RegisterError>>(
     let mut port =
         super::serial::open(&profile, &handle.path, None)?.with_virtual_cts(handle.cts.clone());
     port.name = format!("the simulated {}", profile.name);
-    let r = &profile.registration;
-    let measured = digitize(&mut port, nominal, profile.units_per_mm, r.search, opts)
+    let measured = measure(&mut port)
         .map_err(E::from)
         .and_then(|m| prepare(&m));
     match measured {

@@ -26,6 +26,11 @@ pub enum Sensor {
     /// should be and sends `DP`; the sensor digitizes the mark it finds there. The simulated
     /// cutter's sensor works this way (`device::sim::sensor`).
     HpglDigitize,
+    /// An optical mark sensor wired to GRBL's probe pin, beside the tool (no offset
+    /// modelled): flatcut finds each mark's edges with `G38.3` probe moves across them
+    /// (GRBL 1.1 answers `[PRB:x,y,z:1]` at the contact, `:0` without one) and takes the
+    /// square's centre from two chords, an L's corner from two points on each outer edge.
+    GrblProbe,
 }
 
 impl Sensor {
@@ -33,6 +38,7 @@ impl Sensor {
         match self {
             Sensor::None => "none",
             Sensor::HpglDigitize => "hpgl-digitize",
+            Sensor::GrblProbe => "grbl-probe",
         }
     }
 }

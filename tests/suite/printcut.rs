@@ -550,3 +550,106 @@ fn print_and_cut_over_a_port_to_flatcut_sim() {
     let journal = std::fs::read_to_string(dir.join("journal.json")).unwrap();
     assert!(journal.contains("tetrahedron-registered.plt"), "{journal}");
 }
+
+/// GRBL with an optical sensor on its probe pin (a user profile: `grbl-dragknife` with
+/// `sensor = "grbl-probe"`): flatcut finds the marks' edges with `G38.3` moves, which the
+/// simulated GRBL stops at the printed ink and answers `[PRB:…:1]`; the cut lands on the print,
+/// and a print 3 % large is refused before the first cut.
+#[test]
+fn grbl_probes_the_marks_with_g38() {
+    use std::process::Command;
+    let xdg = scratch("printcut-grbl-config");
+    let devices = xdg.join("flatcut").join("devices");
+    std::fs::create_dir_all(&devices).unwrap();
+    let text = std::fs::read_to_string(crate::common::manifest("devices/grbl-dragknife.toml"))
+        .unwrap()
+        .replace("name = \"grbl-dragknife\"", "name = \"grbl-sensor\"")
+        .replace("sensor = \"none\"", "sensor = \"grbl-probe\"");
+    std::fs::write(devices.join("grbl-sensor.toml"), text).unwrap();
+    let run = |dir: &Path, offset: &str| {
+        Command::new(env!("CARGO_BIN_EXE_flatcut"))
+            .args(["cut", "patterns/tetrahedron.toml", "-o"])
+            .arg(dir)
+            .args(["--device", "grbl-sensor", "--simulate", "--print-and-cut"])
+            .args(["--sheet-offset", offset, "--sim-speed", "0"])
+            .args(["--knife-offset", "0"])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("XDG_CONFIG_HOME", &xdg)
+            .output()
+            .unwrap()
+    };
+    let dir = scratch("printcut-grbl");
+    let o = run(&dir, "7,-4,1.5");
+    assert!(o.status.success(), "{}", stderr(&o));
+    // G-code in mm: the nominal program's cut moves, carried by the placement, against what
+    // the simulated GRBL cut.
+    let sim = sim_json(&dir);
+    let cut: Vec<Vec<(f64, f64)>> = sim["paths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            p["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|q| (q[0].as_f64().unwrap(), q[1].as_f64().unwrap()))
+                .collect()
+        })
+        .collect();
+    assert!(!cut.is_empty());
+    let reg = &report(&dir)["registration"]["sheets"][0];
+    let fit = &reg["fit"];
+    assert!(fit["max_mm"].as_f64().unwrap() < 0.01, "{fit}");
+    assert!(
+        (fit["rotation_deg"].as_f64().unwrap() - 1.5).abs() < 0.001,
+        "{fit}"
+    );
+    // Every recorded cut point lies on the print: on the design's cut strokes (read from the
+    // SVG-free way: the nominal G-code's G1 moves) carried by the placement.
+    let gcode = std::fs::read_to_string(dir.join("tetrahedron.gcode")).unwrap();
+    let mut design: Vec<Vec<(f64, f64)>> = Vec::new();
+    let (mut x, mut y, mut down) = (0.0, 0.0, false);
+    for l in gcode.lines() {
+        let word = |c: char| {
+            l.split_whitespace()
+                .find_map(|w| w.strip_prefix(c).and_then(|v| v.parse::<f64>().ok()))
+        };
+        if let Some(z) = word('Z') {
+            down = z < 0.0;
+            if down {
+                design.push(vec![place((x, y), 7.0, -4.0, 1.5, 1.0, 1.0)]);
+            }
+        }
+        if let (Some(nx), Some(ny)) = (word('X').or(Some(x)), word('Y').or(Some(y))) {
+            (x, y) = (nx, ny);
+            if down && (word('X').is_some() || word('Y').is_some()) {
+                if let Some(d) = design.last_mut() {
+                    d.push(place((x, y), 7.0, -4.0, 1.5, 1.0, 1.0));
+                }
+            }
+        }
+    }
+    assert!(!design.is_empty(), "{gcode}");
+    let mut worst = 0.0f64;
+    for c in &cut {
+        for q in c {
+            let d = design
+                .iter()
+                .map(|line| dist_to_polyline(*q, line))
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+        }
+    }
+    eprintln!("grbl-probe: recorded cuts vs printed outlines: {worst:.4} mm at most");
+    assert!(worst < 0.2, "{worst}");
+    let dir = scratch("printcut-grbl-scaled");
+    let o = run(&dir, "7,-4,1.5,1.03");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("refused before the first cut") && e.contains("residual"),
+        "{e}"
+    );
+    assert!(sim_json(&dir)["paths"].as_array().unwrap().is_empty());
+}

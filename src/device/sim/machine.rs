@@ -130,7 +130,13 @@ impl Device {
             p.serial.flow_control
         };
         let interp = match p.language {
-            Language::Gcode => Interp::Grbl(grbl::Grbl::new(p)),
+            Language::Gcode => {
+                let mut g = grbl::Grbl::new(p);
+                if p.registration.sensor == crate::profile::registration::Sensor::GrblProbe {
+                    g.probe = cfg.printed.as_ref().map(|s| sensor::Sensor::new(s, p));
+                }
+                Interp::Grbl(g)
+            }
             Language::Hpgl => {
                 let mut m = hpgl::Hpgl::new(p);
                 if p.registration.sensor == crate::profile::registration::Sensor::HpglDigitize {

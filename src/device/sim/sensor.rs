@@ -12,7 +12,9 @@
 //! square's centre, an L's outer corner) as the machine's integer units, as a sensor that
 //! finds a mark's edges and intersects them would; no mark in reach leaves no point. A
 //! scaled print moves the marks but the sensor still reports each mark's reference point as
-//! printed (its size is not measured). Choices: no sensor noise beyond the rounding to
+//! printed (its size is not measured). With `sensor = "grbl-probe"` the same sensor is on
+//! GRBL's probe pin: a `G38.3` move stops where it first sees ink (a mark's filled
+//! rectangles, placed). Choices: no sensor noise beyond the rounding to
 //! units; the nearest mark wins when several are in reach.
 
 use crate::profile::Profile;
@@ -61,6 +63,9 @@ pub(crate) struct Sensor {
     found_at: Vec<DVec2>,
     /// Search radius, device units.
     reach: f64,
+    /// The ink of the marks on the bed: each filled rectangle as its four corners, device
+    /// units.
+    ink: Vec<[DVec2; 4]>,
 }
 
 impl Sensor {
@@ -76,9 +81,28 @@ impl Sensor {
                 sheet.placement.apply(m) * upm
             })
             .collect();
+        let on_bed = |p: DVec2| {
+            let m = crate::output::to_device(profile, w, h, p) / upm;
+            sheet.placement.apply(m) * upm
+        };
+        let ink = sheet
+            .marks
+            .marks
+            .iter()
+            .flat_map(|m| &m.rects)
+            .map(|(lo, hi)| {
+                [
+                    on_bed(*lo),
+                    on_bed(DVec2::new(hi.x, lo.y)),
+                    on_bed(*hi),
+                    on_bed(DVec2::new(lo.x, hi.y)),
+                ]
+            })
+            .collect();
         Sensor {
             found_at,
             reach: profile.registration.search * upm,
+            ink,
         }
     }
 
@@ -91,6 +115,42 @@ impl Sensor {
             .min_by(|a, b| a.distance(at).total_cmp(&b.distance(at)))
             .map(|p| p.round())
     }
+}
+
+impl Sensor {
+    /// A probe moving from `from` to `to` (device units): the fraction of the way at which it
+    /// first sees ink (0 when it starts on a mark), if it does.
+    pub(crate) fn first_contact(&self, from: DVec2, to: DVec2) -> Option<f64> {
+        let d = to - from;
+        let mut best: Option<f64> = None;
+        for quad in &self.ink {
+            if inside(quad, from) {
+                return Some(0.0);
+            }
+            for k in 0..4 {
+                let (a, b) = (quad[k], quad[(k + 1) % 4]);
+                let e = b - a;
+                let den = d.perp_dot(e);
+                if den.abs() < 1e-15 {
+                    continue;
+                }
+                let t = (a - from).perp_dot(e) / den;
+                let u = (a - from).perp_dot(d) / den;
+                if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+                    best = Some(best.map_or(t, |b: f64| b.min(t)));
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Whether `p` lies in the convex quadrilateral `q` (either orientation).
+fn inside(q: &[DVec2; 4], p: DVec2) -> bool {
+    let s: Vec<f64> = (0..4)
+        .map(|k| (q[(k + 1) % 4] - q[k]).perp_dot(p - q[k]))
+        .collect();
+    s.iter().all(|v| *v >= 0.0) || s.iter().all(|v| *v <= 0.0)
 }
 
 #[cfg(test)]
@@ -112,5 +172,17 @@ mod tests {
         let truth = placement.apply(DVec2::new(10.0, 10.0)) * 40.0;
         assert_eq!(s.find(DVec2::new(400.0, 400.0)), Some(truth.round()));
         assert_eq!(s.find(DVec2::new(4000.0, 4000.0)), None);
+        // A probe along x at y = 14 mm meets the lower-left L's upright arm on its outer edge.
+        let (from, to) = (DVec2::new(0.0, 14.0 * 40.0), DVec2::new(800.0, 14.0 * 40.0));
+        let t = s.first_contact(from, to).unwrap();
+        let hit = from.lerp(to, t) / 40.0;
+        // The edge: x = 10 on the sheet, placed.
+        let a = placement.apply(DVec2::new(10.0, 10.0));
+        let b = placement.apply(DVec2::new(10.0, 30.0));
+        assert!(
+            (b - a).perp_dot(hit - a).abs() / (b - a).length() < 1e-9,
+            "{hit}"
+        );
+        assert_eq!(s.first_contact(DVec2::ZERO, DVec2::new(100.0, 0.0)), None);
     }
 }
