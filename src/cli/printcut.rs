@@ -6,9 +6,11 @@
 //!
 //! Where the marks' positions come from: `--marks X1,Y1:X2,Y2:X3,Y3[:X4,Y4]` (machine mm, read
 //! off the machine after jogging to each mark: mark 1 the square, then the Ls
-//! counter-clockwise; one sheet per run), else the device's sensor (`[registration] sensor`;
-//! HP-GL digitizing, which the simulated cutter has). A device with neither is an error that
-//! says how to measure. On the simulator the printed sheet is placed with `--sheet-offset
+//! counter-clockwise; one sheet per run), else the device's sensor (`[registration] sensor`:
+//! HP-GL digitizing, which the simulated cutter has, or GRBL `G38.3` probing; see
+//! `device::register`). A device with neither is an error that says how to measure. On a
+//! real port the marks are measured, the port closed, and the registered program sent as any
+//! program (checked, journalled for `flatcut resume`). On the simulator the printed sheet is placed with `--sheet-offset
 //! DX,DY,DEG[,SX[,SY]]` (mm, degrees counter-clockwise about the machine's origin, scale along
 //! X and Y; default 0,0,0) and the sensor finds its marks. With `--dry-run` nothing is
 //! measured or sent: the files (the PDF to print, the nominal program) are written and the
