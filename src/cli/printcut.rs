@@ -6,7 +6,9 @@
 //!
 //! Where the marks' positions come from: `--marks X1,Y1:X2,Y2:X3,Y3[:X4,Y4]` (machine mm, read
 //! off the machine after jogging to each mark: mark 1 the square, then the Ls
-//! counter-clockwise; one sheet per run), else the device's sensor (`[registration] sensor`:
+//! counter-clockwise; one sheet per run), or `--jog` (the head goes to each mark where it was
+//! printed and the arrow keys move it onto the mark: HP-GL `PU` moves, GRBL `$J=` jogs; Enter
+//! takes it; see [`Keys`]), else the device's sensor (`[registration] sensor`:
 //! HP-GL digitizing, which the simulated cutter has, or GRBL `G38.3` probing; see
 //! `device::register`). A device with neither is an error that says how to measure. On a
 //! real port the marks are measured, the port closed, and the registered program sent as any
@@ -18,7 +20,8 @@
 //! the registration of the sheets that were measured.
 
 use super::link::{self, LinkArgs};
-use crate::device::register::{ProbeMark, RegisterError};
+use crate::device::register::{Key, ProbeMark, RegisterError};
+use crate::device::serial::Link;
 use crate::device::sim::sensor::{PrintedSheet, SheetPlacement};
 use crate::device::sim::SimConfig;
 use crate::pipeline::printcut::{self, PrintCut, Registered};
@@ -49,6 +52,10 @@ pub struct PrintCutArgs {
     /// The corner of the square mark (overrides the profile's).
     #[arg(long, value_enum)]
     pub square_corner: Option<Corner>,
+    /// Measure the marks by jogging the head onto each with the arrow keys (`+`/`-` change
+    /// the step: 0.1, 1, 10 mm), Enter takes it, `q` stops; the same keys can be piped in.
+    #[arg(long, conflicts_with = "marks")]
+    pub jog: bool,
     /// Simulator: the printed sheet lies DX, DY mm off and turned DEG degrees
     /// (counter-clockwise about the origin), printed SX (and SY) times true size.
     #[arg(long, value_name = "DX,DY,DEG[,SX[,SY]]", allow_hyphen_values = true)]
@@ -59,12 +66,13 @@ impl PrintCutArgs {
     /// Check the flags before any work, and put the mark flags into the job's profile.
     pub fn apply(&self, profile: &mut Profile) -> Result<(), Error> {
         let used = self.marks.is_some()
+            || self.jog
             || self.mark_inset.is_some()
             || self.square_corner.is_some()
             || self.sheet_offset.is_some();
         if used && !self.print_and_cut {
             return Err(Error::Usage(
-                "--marks, --mark-inset, --square-corner and --sheet-offset are for print-and-cut: add --print-and-cut".into(),
+                "--marks, --jog, --mark-inset, --square-corner and --sheet-offset are for print-and-cut: add --print-and-cut".into(),
             ));
         }
         if let Some(v) = self.mark_inset {
@@ -234,7 +242,7 @@ pub fn deliver(
             "--marks: the job has {n} sheets, each with its own marks; measure and send one at a time with --sheets K --marks …"
         )));
     }
-    if given.is_none() && profile.registration.sensor == Sensor::None {
+    if given.is_none() && !args.jog && profile.registration.sensor == Sensor::None {
         return Err(Error::Usage(format!(
             "device `{}` has no registration sensor ([registration] sensor = \"none\", {}): jog to each printed mark and give the positions the machine shows with --marks X1,Y1:X2,Y2:X3,Y3[:X4,Y4] (mm; mark 1 the square, then the Ls counter-clockwise); {pdf} is written",
             profile.name, profile.source
@@ -245,7 +253,7 @@ pub fn deliver(
         Sensor::GrblProbe => Language::Gcode,
         Sensor::None => profile.language,
     };
-    if given.is_none() && profile.language != speaks {
+    if given.is_none() && !args.jog && profile.language != speaks {
         return Err(Error::Usage(format!(
             "device `{}`: its sensor ({}) is driven in {}, and the device speaks {} ([registration] sensor, {}); give the marks with --marks",
             profile.name,
@@ -264,6 +272,7 @@ pub fn deliver(
     let ext = profile.language.extension();
     let mut done: Vec<Registered> = Vec::new();
     let opts = link::stream_options(link, quiet)?;
+    let mut keys = args.jog.then(Keys::open);
     for (t, &k) in chosen.iter().enumerate() {
         let name = sheet_name(&run.job.name, k - 1, n, ext);
         if t > 0 && !sim {
@@ -287,7 +296,7 @@ pub fn deliver(
         };
         match &given {
             Some(measured) => one.by_hand(measured, &mut done)?,
-            None => one.by_sensor(placement, sim, &mut done)?,
+            None => one.by_sensor(placement, sim, keys.as_mut(), &mut done)?,
         }
     }
     Ok(())
@@ -368,14 +377,21 @@ impl One<'_> {
         &self,
         placement: SheetPlacement,
         sim: bool,
+        keys: Option<&mut Keys>,
         done: &mut Vec<Registered>,
     ) -> Result<(), Error> {
         let (profile, link) = (self.profile, self.link);
         let marks = &self.pc.marks[self.i];
         let upm = profile.units_per_mm;
-        let measure = measurer(profile, marks, self.opts);
+        let sensor_name = match keys {
+            Some(_) => "--jog".to_string(),
+            None => format!("the sensor of `{}`", profile.name),
+        };
+        let measure: Box<Measure<'_>> = match keys {
+            Some(keys) => Box::new(jogger(profile, marks, self.opts, keys)),
+            None => Box::new(measurer(profile, marks, self.opts)),
+        };
         let mut reg_out = None;
-        let sensor_name = format!("the sensor of `{}`", profile.name);
         let mut fit_and_make = |m: &[DVec2]| -> Result<Vec<u8>, Error> {
             let mm: Vec<DVec2> = m.iter().map(|p| *p / upm).collect();
             let (reg, bytes) = self.prepare(&mm, &sensor_name)?;
@@ -489,6 +505,146 @@ fn measurer<'a>(
         _ => {
             let nominal: Vec<DVec2> = marks.references().into_iter().map(dev).collect();
             crate::device::register::digitize(line, &nominal, profile.units_per_mm, r.search, opts)
+        }
+    }
+}
+
+/// How the marks of one sheet are measured on an open line: the positions, device units.
+type Measure<'a> = dyn FnOnce(&mut Link) -> Result<Vec<DVec2>, RegisterError> + 'a;
+
+/// Measuring by hand with [`Keys`] (`--jog`): the positions taken, device units.
+fn jogger<'a>(
+    profile: &'a Profile,
+    marks: &'a crate::toolpath::registration::Marks,
+    opts: &'a crate::device::stream::StreamOptions,
+    keys: &'a mut Keys,
+) -> impl FnOnce(&mut Link) -> Result<Vec<DVec2>, RegisterError> + 'a {
+    let upm = profile.units_per_mm;
+    let (w, h) = (marks.width, marks.height);
+    let nominal: Vec<DVec2> = marks
+        .references()
+        .into_iter()
+        .map(|p| crate::output::to_device(profile, w, h, p) / upm)
+        .collect();
+    let z_up = profile
+        .tool(crate::profile::StrokeKind::Cut)
+        .and_then(|t| t.z_up);
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let mut said = 0;
+    move |line| {
+        crate::device::register::jog(
+            line,
+            profile.language,
+            upm,
+            z_up,
+            &nominal,
+            opts,
+            |mark, p, step| {
+                let m = &marks.marks[mark - 1];
+                // On a terminal a status line; otherwise one line per mark.
+                if !tty && said == mark {
+                    return keys.next();
+                }
+                said = mark;
+                eprint!(
+                    "\rflatcut: mark {mark} ({} {}): head at ({:.2}, {:.2}) mm, step {step} mm; arrows move, +/- step, Enter takes it, q stops   ",
+                    m.corner,
+                    if m.kind == MarkKind::Square { "square's centre" } else { "L's corner" },
+                    p.x,
+                    p.y
+                );
+                if !tty {
+                    eprintln!();
+                }
+                let k = keys.next();
+                if tty && matches!(k, Key::Take | Key::Quit) {
+                    eprintln!();
+                }
+                k
+            },
+        )
+    }
+}
+
+/// Keys from standard input (`--jog`): on a terminal it is put in non-canonical mode without
+/// echo (`stty -icanon -echo`, restored when done); piped bytes are read the same way. Arrows
+/// (`ESC [ A`…`D`) move, `+`/`=` and `-` change the step, Enter takes, `q`, Ctrl-C or the end
+/// of the input stop.
+pub struct Keys {
+    restore: Option<String>,
+}
+
+impl Keys {
+    fn open() -> Keys {
+        use std::io::IsTerminal;
+        use std::process::{Command, Stdio};
+        let mut restore = None;
+        if std::io::stdin().is_terminal() {
+            let saved = Command::new("stty")
+                .arg("-g")
+                .stdin(Stdio::inherit())
+                .output()
+                .ok()
+                .filter(|o| o.status.success())
+                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+            let raw = Command::new("stty")
+                .args(["-icanon", "-echo", "min", "1"])
+                .stdin(Stdio::inherit())
+                .status()
+                .is_ok_and(|s| s.success());
+            if raw {
+                restore = saved;
+            }
+        }
+        Keys { restore }
+    }
+
+    fn byte(&mut self) -> Option<u8> {
+        use std::io::Read;
+        let mut b = [0u8; 1];
+        match std::io::stdin().lock().read(&mut b) {
+            Ok(1) => Some(b[0]),
+            _ => None,
+        }
+    }
+
+    fn next(&mut self) -> Key {
+        loop {
+            let Some(b) = self.byte() else {
+                return Key::Quit;
+            };
+            let k = match b {
+                0x1b => {
+                    if self.byte() != Some(b'[') {
+                        continue;
+                    }
+                    match self.byte() {
+                        Some(b'A') => Key::Up,
+                        Some(b'B') => Key::Down,
+                        Some(b'C') => Key::Right,
+                        Some(b'D') => Key::Left,
+                        Some(_) => continue,
+                        None => return Key::Quit,
+                    }
+                }
+                b'+' | b'=' => Key::Coarser,
+                b'-' => Key::Finer,
+                b'\r' | b'\n' => Key::Take,
+                b'q' | b'Q' | 0x03 | 0x04 => Key::Quit,
+                _ => continue,
+            };
+            return k;
+        }
+    }
+}
+
+impl Drop for Keys {
+    fn drop(&mut self) {
+        if let Some(saved) = &self.restore {
+            let _ = std::process::Command::new("stty")
+                .arg(saved)
+                .stdin(std::process::Stdio::inherit())
+                .status();
         }
     }
 }

@@ -22,6 +22,9 @@
 //! direction, then the other, then the first again. The marks are measured in the same order
 //! and from the same predictions as with digitizing.
 //!
+//! By hand ([`jog`]): the head goes to each mark where it was printed and the user moves it
+//! with keys (HP-GL `PU` moves, GRBL `$J=` jog moves) and takes the position.
+//!
 //! A machine that does not answer within the stream's timeout, a garbled answer, a hang-up or
 //! Ctrl-C stop the registration before any cut is sent. [`sim_job`] does the whole loop on the
 //! simulated cutter: start it with the printed sheet, measure, let the caller fit and make the
@@ -67,7 +70,7 @@ pub enum RegisterError {
         mark: usize,
         message: String,
     },
-    #[error("{port}: stopped by Ctrl-C while measuring the marks (nothing was cut)")]
+    #[error("{port}: stopped while measuring the marks (Ctrl-C, `q`, or the end of the input); nothing was cut")]
     Cancelled { port: String },
 }
 
@@ -431,4 +434,84 @@ pub fn sim_job<E: From<RegisterError>>(
             Ok((Err(e), rep))
         }
     }
+}
+
+/// A key of the interactive jog ([`jog`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Key {
+    Left,
+    Right,
+    Up,
+    Down,
+    /// A step ten times smaller (down to 0.1 mm).
+    Finer,
+    /// A step ten times larger (up to 10 mm).
+    Coarser,
+    /// Take the head's position as the mark's.
+    Take,
+    /// Stop measuring.
+    Quit,
+}
+
+/// Jog steps, mm.
+const STEPS: [f64; 3] = [0.1, 1.0, 10.0];
+
+/// Measure the marks by hand: for each mark in order the head goes (pen or tool up) to where
+/// it was printed, `nominal` (machine mm), and moves by the keys `key` returns (given the mark,
+/// 1-based, the head's position in mm and the step) — HP-GL `PU x,y;` moves, GRBL `$J=` jog
+/// moves (`$J=G90G21X…Y…F2000`, after a reset and `$X` as for probing) — until `Take`. The
+/// host knows where the head is, since it sent it there. Returns the positions taken,
+/// machine units.
+pub fn jog(
+    link: &mut Link,
+    language: crate::profile::Language,
+    units_per_mm: f64,
+    z_up: Option<f64>,
+    nominal: &[DVec2],
+    opts: &StreamOptions,
+    mut key: impl FnMut(usize, DVec2, f64) -> Key,
+) -> Result<Vec<DVec2>, RegisterError> {
+    let grbl = language == crate::profile::Language::Gcode;
+    let port = link.name.clone();
+    let mut g = GrblLine { link, opts };
+    if grbl {
+        g.wake()?;
+        g.send("G21G90", 1)?;
+        if let Some(z) = z_up {
+            g.send(&format!("G0Z{z:.3}"), 1)?;
+        }
+    } else {
+        write_all(g.link, b"IN;", opts).map_err(|e| g.err(1, e.to_string()))?;
+    }
+    let mut step = 1;
+    let mut out = Vec::with_capacity(nominal.len());
+    for (k, at) in nominal.iter().enumerate() {
+        let mark = k + 1;
+        let mut p = *at;
+        loop {
+            if grbl {
+                g.send(&format!("$J=G90G21X{:.3}Y{:.3}F2000", p.x, p.y), mark)?;
+            } else {
+                let (x, y) = (
+                    (p.x * units_per_mm).round() as i64,
+                    (p.y * units_per_mm).round() as i64,
+                );
+                write_all(g.link, format!("PU{x},{y};").as_bytes(), opts)
+                    .map_err(|e| g.err(mark, e.to_string()))?;
+            }
+            let s = STEPS[step];
+            match key(mark, p, s) {
+                Key::Left => p.x -= s,
+                Key::Right => p.x += s,
+                Key::Up => p.y += s,
+                Key::Down => p.y -= s,
+                Key::Finer => step = step.saturating_sub(1),
+                Key::Coarser => step = (step + 1).min(STEPS.len() - 1),
+                Key::Take => break,
+                Key::Quit => return Err(RegisterError::Cancelled { port }),
+            }
+        }
+        out.push(p * units_per_mm);
+    }
+    Ok(out)
 }

@@ -653,3 +653,63 @@ fn grbl_probes_the_marks_with_g38() {
     );
     assert!(sim_json(&dir)["paths"].as_array().unwrap().is_empty());
 }
+
+/// `--jog`: the head goes to each mark where it was printed and the arrow keys (here piped
+/// in: 0.1 mm steps) move it onto the mark on the misplaced sheet, Enter takes it; the
+/// simulated cutter receives the pen-up moves, and the cut lands on the print. `q` stops with
+/// nothing cut.
+#[test]
+fn jogging_onto_the_marks_registers_the_cut() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let nominal = [(12.5, 284.5), (10.0, 10.0), (200.0, 10.0), (200.0, 287.0)];
+    let mut keys: Vec<u8> = b"-".to_vec();
+    for p in nominal {
+        let q = place(p, 7.0, -4.0, 1.5, 1.0, 1.0);
+        let (nx, ny) = (
+            ((q.0 - p.0) / 0.1).round() as i64,
+            ((q.1 - p.1) / 0.1).round() as i64,
+        );
+        let (kx, ky): (&[u8], &[u8]) = (
+            if nx > 0 { b"\x1b[C" } else { b"\x1b[D" },
+            if ny > 0 { b"\x1b[A" } else { b"\x1b[B" },
+        );
+        for _ in 0..nx.abs() {
+            keys.extend_from_slice(kx);
+        }
+        for _ in 0..ny.abs() {
+            keys.extend_from_slice(ky);
+        }
+        keys.push(b'\n');
+    }
+    let run = |dir: &Path, keys: &[u8]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_flatcut"))
+            .args(["cut", "patterns/tetrahedron.toml", "-o"])
+            .arg(dir)
+            .args(["--print-and-cut", "--jog", "--sheet-offset", "7,-4,1.5"])
+            .args(["--sim-speed", "0"])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child.stdin.take().unwrap().write_all(keys).unwrap();
+        child.wait_with_output().unwrap()
+    };
+    let dir = scratch("printcut-jog");
+    let o = run(&dir, &keys);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let d = deviation(&dir, "tetrahedron", (7.0, -4.0, 1.5));
+    eprintln!("--jog: recorded cuts vs printed outlines: {d:.4} mm at most");
+    assert!(d < 0.2, "{d}");
+    assert_eq!(
+        report(&dir)["registration"]["sheets"][0]["measured_by"],
+        "--jog"
+    );
+    let dir = scratch("printcut-jog-quit");
+    let o = run(&dir, b"\x1b[C\x1b[Cq");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nothing was cut"), "{}", stderr(&o));
+    assert!(sim_json(&dir)["paths"].as_array().unwrap().is_empty());
+}
