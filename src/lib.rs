@@ -47,6 +47,8 @@
 //! lib.rs                       flatcut
 //! main.rs                      The `flatcut` binary
 //! pipeline.rs                  The one composer of the pipeline
+//! pipeline/
+//!   printcut.rs                Print-and-cut as the pipeline composes it (issue 25 item 4)
 //! cli/
 //!   mod.rs                     Command line
 //!   args.rs                    Flag groups shared by several subcommands (`cut`, `flatten`, `fitting`, `nest`)
@@ -57,12 +59,14 @@
 //!   link.rs                    What the subcommands that talk to a machine share
 //!   nest.rs                    `flatcut nest INSTANCE.json [--nest-time S] [--seed N] [--threads T] -o DIR`
 //!   ports.rs                   `flatcut ports` lists serial ports
+//!   printcut.rs                Print-and-cut on the command line: flags, measuring the marks, the registered send
 //!   send.rs                    `flatcut send FILE --device D [--port P]`
 //!   sim.rs                     `flatcut sim --device D -o DIR`
 //! device/
 //!   mod.rs                     Device stage
 //!   check.rs                   Checking an HP-GL program before its first byte goes out
 //!   grbl.rs                    What GRBL 1.1 says on the wire, shared by the streaming host (`super::stream`) and the simulate…
+//!   register.rs                Finding a printed sheet's registration marks with the machine's own sensor
 //!   motion.rs                  How long a GRBL machine takes for its moves (trapezoidal speed profiles)
 //!   serial.rs                  The serial transport
 //!   stream/
@@ -78,6 +82,7 @@
 //!     machine.rs               The simulated cutter's machine thread: line rate, buffer, flow control, answers
 //!     hpgl.rs                  The simulated cutter's HP-GL interpreter
 //!     record.rs                What the simulated cutter remembers of a job
+//!     sensor.rs                The simulated cutter's printed sheet and its optical registration-mark sensor
 //! flatten/
 //!   mod.rs                     Flatten stage
 //!   distortion.rs              Distortion of a flat layout against its 3D surface
@@ -104,6 +109,7 @@
 //!   proxy.rs                   The DCS proxy and its fit (Julius 2006, thesis §4.3, eq. 4.1 and eq. 5.4; §6.2.1, eq. 6.1)
 //!   rng.rs                     The crate's one seeded random number generator
 //!   segment.rs                 Distances between points and segments, in 2D and 3D
+//!   similarity.rs              Least-squares similarity fit in the plane (Umeyama 1991)
 //!   unionfind.rs               Union-find (disjoint sets) over `0..n` with path halving
 //! nest/
 //!   mod.rs                     Nest stage
@@ -147,6 +153,7 @@
 //! profile/
 //!   mod.rs                     Device profiles, the configuration several stages read (toolpath, output, device)
 //!   read.rs                    Reading a profile
+//!   registration.rs            The `[registration]` table: sensor, marks, tolerances (print-and-cut)
 //!   serial.rs                  Serial line settings and the protocol that paces a program into the device
 //!   tools.rs                   The tool table
 //! spec/
@@ -227,6 +234,7 @@
 //!   knife.rs                   What a machine's tools need beyond the ordered design
 //!   order.rs                   Travel optimisation inside one group of strokes
 //!   passes.rs                  Machines with one tool (issue 23)
+//!   registration.rs            Registration marks of a print-and-cut sheet (issue 25 item 4)
 //!   weed.rs                    Weed lines for vinyl (and any material whose waste is peeled off the carrier)
 //! ```
 
@@ -270,6 +278,8 @@ pub enum Error {
     Stream(Box<device::stream::StreamError>),
     #[error(transparent)]
     Sim(#[from] device::sim::SimError),
+    #[error(transparent)]
+    Register(#[from] device::register::RegisterError),
     #[error("{}: {source}", file.display())]
     In {
         file: std::path::PathBuf,

@@ -13,6 +13,8 @@
 //!   files in the output folder; sending the programs is the caller's (`cli::link`), after the
 //!   files are written, so a failed send loses nothing.
 //! - [`nest_instance`]: an ESICUP instance → solution files (`flatcut nest`).
+//! - [`printcut`]: print-and-cut (`Toolpath::print_and_cut`): registration marks, the margin
+//!   that clears them, the cutter's job, the fit of measured marks and the registered program.
 //!
 //! Choices: options a user did not give are `None` and leave the stage's default; the
 //! command-line flags were checked by `cli` before they get here; warnings of the surface and
@@ -28,6 +30,8 @@ use crate::spec::{MaterialKind, Spec};
 use crate::toolpath::{Job, StrokeKind, ToolpathOptions};
 use crate::Error;
 use std::path::{Path, PathBuf};
+
+pub mod printcut;
 
 /// Nesting search settings (`--nest-time`, `--seed`, `--threads`); `None` keeps the default.
 #[derive(Debug, Clone, Copy, Default)]
@@ -77,6 +81,9 @@ pub struct Toolpath {
     pub per_piece: Option<bool>,
     /// Cut weed lines.
     pub weed: bool,
+    /// Print-and-cut ([`printcut`]): registration marks on each sheet, everything printed in
+    /// the pictures, only the cut (and score) in the program.
+    pub print_and_cut: bool,
 }
 
 /// Surfaces → flats → pieces for a spec; prints the surfaces' warnings to stderr unless
@@ -288,6 +295,14 @@ pub fn plan(
     quiet: bool,
 ) -> Result<(Vec<Flat>, Layout, Job), Error> {
     plausible_sheet(spec)?;
+    // Print-and-cut: pieces are split and nested inside the margin that clears the marks.
+    let with_marks;
+    let spec = if choices.print_and_cut {
+        with_marks = printcut::spec_with_margin(spec, profile);
+        &with_marks
+    } else {
+        spec
+    };
     let (flats, pieces) = pieces(spec, quiet)?;
     let mut nest_opts = crate::nest::NestOptions {
         width: spec.sheet.width,
@@ -303,7 +318,10 @@ pub fn plan(
     })?;
     let profile = &job_profile(profile, spec, choices);
     let tp = toolpath_options(spec, profile, choices);
-    let job = crate::toolpath::plan(&layout, &spec.name, &tp);
+    let mut job = crate::toolpath::plan(&layout, &spec.name, &tp);
+    if choices.print_and_cut {
+        printcut::add_marks(&mut job, profile)?;
+    }
     Ok((flats, layout, job))
 }
 
@@ -342,6 +360,9 @@ fn toolpath_options(spec: &Spec, profile: &Profile, choices: &Toolpath) -> Toolp
     }
     if choices.weed {
         tp.weed = Some(crate::toolpath::weed::WeedOptions::default());
+    }
+    if choices.print_and_cut {
+        printcut::printed_options(&mut tp, choices);
     }
     tp
 }
@@ -437,6 +458,8 @@ pub struct CutRun {
     pub before: Vec<Before>,
     /// What the job left out for want of a tool (also in report.json).
     pub dropped: Vec<crate::toolpath::passes::Dropped>,
+    /// Print-and-cut: the marks and the cutter's job, for the send ([`printcut`]).
+    pub print_cut: Option<printcut::PrintCut>,
 }
 
 /// The whole of `flatcut cut` but the sending: plan the job for the device, write the program
@@ -450,11 +473,23 @@ pub fn cut(
     extras: &Extras,
 ) -> Result<CutRun, Error> {
     // A tool change is for a device without a pen of its own.
-    let tool_change = choices.tool_change && !profile.has(StrokeKind::Draw);
+    let pc = choices.print_and_cut;
+    let tool_change = choices.tool_change && !profile.has(StrokeKind::Draw) && !pc;
     let profile = &job_profile(profile, spec, choices);
     let (flats, layout, job) = plan(spec, profile, search, choices, extras.quiet)?;
-    let machine = machine_job(&job, profile, spec);
-    let dropped = dropped(spec, profile, choices, &layout);
+    let print_cut = pc
+        .then(|| printcut::PrintCut::of(&job, spec, profile))
+        .transpose()?;
+    let machine = match &print_cut {
+        Some(p) => machine_job(&p.cutter, profile, spec),
+        None => machine_job(&job, profile, spec),
+    };
+    // Print-and-cut prints what the device has no tool for.
+    let dropped = if pc {
+        Vec::new()
+    } else {
+        dropped(spec, profile, choices, &layout)
+    };
     if !extras.quiet {
         for d in &dropped {
             eprintln!(
@@ -513,7 +548,15 @@ pub fn cut(
         print,
         ..run_info(spec, &profile.name, &files)
     };
-    write_report(&mut run, &info, &flats, &layout)?;
+    match &print_cut {
+        Some(p) => {
+            let mut rep = report::build(&info, &flats, &layout);
+            rep["registration"] = printcut::report(p, profile, &[]);
+            let text = serde_json::to_string_pretty(&rep).unwrap_or_default() + "\n";
+            run.write("report.json", text.as_bytes())?;
+        }
+        None => write_report(&mut run, &info, &flats, &layout)?,
+    }
     run.commit()?;
     Ok(CutRun {
         flats,
@@ -524,6 +567,7 @@ pub fn cut(
         programs,
         before,
         dropped,
+        print_cut,
     })
 }
 

@@ -10,12 +10,16 @@
 //! [`super::link`]). The files are written before anything is sent, so a failed or
 //! interrupted send loses nothing. `--tool-change` makes the marks of a knife-only device in
 //! a pen pass before the knife pass (see [`super::link`] for the pause between them).
+//! `--print-and-cut` puts registration marks on each sheet and everything drawn in the PDF to
+//! print; the cutter gets only the cut (and score), registered on the marks
+//! ([`super::printcut`]).
 
 use super::args::{
     ask_alternatives, PatternArgs, PictureArgs, SearchArgs, SheetArgs, SizeArgs, SmoothArgs,
     ToolpathArgs,
 };
 use super::link::LinkArgs;
+use super::printcut::PrintCutArgs;
 use crate::pipeline::Extras;
 use crate::spec::MaterialKind;
 use crate::Error;
@@ -55,6 +59,8 @@ pub struct CutArgs {
     #[command(flatten)]
     pub link: LinkArgs,
     #[command(flatten)]
+    pub print_cut: PrintCutArgs,
+    #[command(flatten)]
     pub search: SearchArgs,
     /// Boundary surfaces: also write the N best distinct triangulations found, as
     /// `<surface>-alt-<k>.obj` (k = 1 is the one cut), to pick another by hand.
@@ -91,7 +97,8 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
         .clone()
         .or_else(|| spec.device.clone())
         .unwrap_or_else(|| "sim".to_string());
-    let profile = a.toolpath.device(&device)?;
+    let mut profile = a.toolpath.device(&device)?;
+    a.print_cut.apply(&mut profile)?;
     a.sheet.apply(&mut spec, Some(&profile))?;
     super::link::need_port(&profile, &a.link, a.dry_run)?;
     let extras = Extras {
@@ -107,12 +114,13 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     let search = a.search.search()?;
     let choices = crate::pipeline::Toolpath {
         tool_change: a.tool_change,
+        print_and_cut: a.print_cut.print_and_cut,
         ..a.toolpath.choices()
     };
     let run = crate::pipeline::cut(&spec, &profile, &search, &choices, &extras)?;
     if !a.quiet {
         super::print_cut(&spec, &run, &profile.name, a.dry_run);
     }
-    super::link::deliver_run(&run, &profile, &a.link, a.quiet, a.dry_run)?;
+    super::printcut::deliver(&run, &profile, &a.link, &a.print_cut, a.quiet, a.dry_run)?;
     Ok(())
 }

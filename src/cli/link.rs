@@ -60,7 +60,7 @@ pub struct LinkArgs {
 
 /// Longest a simulated machine may work off its buffer after the last byte while it makes
 /// progress (a job of a day at the simulated speed).
-const SIM_FINISH_CAP: Duration = Duration::from_secs(24 * 3600);
+pub(crate) const SIM_FINISH_CAP: Duration = Duration::from_secs(24 * 3600);
 
 /// The process-wide Ctrl-C flag; the handler is installed on first use.
 pub fn cancel_flag() -> Arc<AtomicBool> {

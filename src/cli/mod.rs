@@ -1,7 +1,8 @@
 //! Command line: clap argument structs, one file per subcommand, each of which parses its
 //! flags, calls [`crate::pipeline`] and prints; no subcommand's file calls another's. What
 //! several subcommands share lives beside them: the flag groups ([`args`]), the link to a
-//! machine with its progress bars and Ctrl-C ([`link`]), and the summary `cut` and `fitting`
+//! machine with its progress bars and Ctrl-C ([`link`]), print-and-cut's flags and send
+//! ([`printcut`]), and the summary `cut` and `fitting`
 //! print. `main.rs` only parses and maps errors to exit codes.
 
 pub mod args;
@@ -12,6 +13,7 @@ pub mod flatten;
 pub mod link;
 pub mod nest;
 pub mod ports;
+pub mod printcut;
 pub mod resume;
 pub mod send;
 pub mod sim;

@@ -2,6 +2,9 @@
 //! pseudo-terminal, prints `listening on /dev/pts/N` as its first line (so that any software —
 //! a sign-making program, a shell `cat` with `stty ixon`, flatcut itself — can stream to it),
 //! and on Ctrl-C writes `sim.png` and `sim.json` into DIR. `--for SECONDS` stops it by itself.
+//! `--sheet-offset DX,DY,DEG[,SX[,SY]]` (and `--sheet-size W,H`, default 210,297) loads a
+//! print-and-cut sheet with the profile's registration marks, placed that far off, for the
+//! simulated sensor to find (`device::sim::sensor`).
 
 use super::link::cancel_flag;
 use crate::device::sim::{self, Faults, SimConfig};
@@ -38,6 +41,14 @@ pub struct SimArgs {
     /// Fault injection: lose the first XON.
     #[arg(long)]
     pub lose_xon: bool,
+    /// Print-and-cut: a printed sheet lies DX, DY mm off and turned DEG degrees
+    /// (counter-clockwise about the origin), printed SX (and SY) times true size.
+    #[arg(long, value_name = "DX,DY,DEG[,SX[,SY]]", allow_hyphen_values = true)]
+    pub sheet_offset: Option<String>,
+    /// Print-and-cut: the printed sheet's size, mm (its marks as the profile's
+    /// `[registration]` says).
+    #[arg(long, value_name = "W,H")]
+    pub sheet_size: Option<String>,
 }
 
 pub fn run(a: &SimArgs) -> Result<(), Error> {
@@ -59,6 +70,7 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
         lose_xon: a.lose_xon,
         grbl_error: None,
     };
+    cfg.printed = printed(a, &profile)?;
     let handle = sim::spawn(cfg)?;
     println!("listening on {}", handle.path);
     println!(
@@ -88,4 +100,48 @@ pub fn run(a: &SimArgs) -> Result<(), Error> {
     );
     println!("picture: {}\nreport: {}", png.display(), json.display());
     Ok(())
+}
+
+/// The printed sheet `--sheet-offset` and `--sheet-size` load, if either is given.
+fn printed(
+    a: &SimArgs,
+    profile: &crate::profile::Profile,
+) -> Result<Option<crate::device::sim::sensor::PrintedSheet>, Error> {
+    if a.sheet_offset.is_none() && a.sheet_size.is_none() {
+        return Ok(None);
+    }
+    let placement = a
+        .sheet_offset
+        .as_deref()
+        .map(|s| super::printcut::parse_placement("--sheet-offset", s))
+        .transpose()?
+        .unwrap_or_default();
+    let (w, h) = match a.sheet_size.as_deref() {
+        None => (210.0, 297.0),
+        Some(t) => {
+            let v: Option<Vec<f64>> = t
+                .split(',')
+                .map(|x| {
+                    x.trim()
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite() && *v > 0.0)
+                })
+                .collect();
+            match v.as_deref() {
+                Some([w, h]) => (*w, *h),
+                _ => {
+                    return Err(Error::Usage(format!(
+                        "--sheet-size {t}: expected W,H in mm, e.g. 210,297"
+                    )))
+                }
+            }
+        }
+    };
+    let marks = crate::toolpath::registration::layout(w, h, &profile.registration)
+        .map_err(|e| Error::Usage(format!("--sheet-size {w},{h}: {e}")))?;
+    Ok(Some(crate::device::sim::sensor::PrintedSheet {
+        marks,
+        placement,
+    }))
 }

@@ -11,6 +11,8 @@
 //! - [`hull`]: 3D convex hulls and the local-convexity test of an edge.
 //! - [`cut`], [`proxy`]: cutting a mesh chart open into a disk, and the developable proxy fit
 //!   (D-Charts), shared by the surface and flatten stages.
+//! - [`similarity`]: the least-squares similarity (scale, rotation, translation) between two
+//!   point sets and its residuals (print-and-cut registration).
 //! - [`unionfind`], [`heap`]: disjoint sets and a smallest-first heap entry.
 //! - [`rng`]: the crate's one seeded random number generator.
 //! - [`font`]: the single-stroke font for labels a pen or knife can draw.
@@ -31,4 +33,5 @@ pub mod polygon;
 pub mod proxy;
 pub mod rng;
 pub mod segment;
+pub mod similarity;
 pub mod unionfind;

@@ -262,7 +262,8 @@ pub fn to_device(profile: &Profile, sheet_w: f64, sheet_h: f64, p: DVec2) -> DVe
 
 /// Roles in drawing order, back to front: what is drawn later lies on top.
 /// The SVG layers follow this order too, after the sheet layer.
-pub(crate) const DRAW_ORDER: [StrokeRole; 9] = [
+pub(crate) const DRAW_ORDER: [StrokeRole; 10] = [
+    StrokeRole::Register,
     StrokeRole::Label,
     StrokeRole::Mark,
     StrokeRole::Grain,
@@ -303,6 +304,7 @@ pub(crate) fn role_style(role: StrokeRole) -> RoleStyle {
         StrokeRole::Seam => ([0x80, 0x40, 0x00], &[4.0, 1.5]),
         StrokeRole::Grain => ([0x60, 0x00, 0x80], &[]),
         StrokeRole::Weed => ([0x90, 0x90, 0x90], &[]),
+        StrokeRole::Register => ([0x00, 0x00, 0x00], &[]),
     };
     RoleStyle { rgb, dash_mm }
 }

@@ -97,7 +97,7 @@ impl Layer {
         match role {
             StrokeRole::Cut | StrokeRole::Notch => Layer::Cut,
             StrokeRole::FoldMountain | StrokeRole::FoldValley => Layer::Folds,
-            StrokeRole::Mark => Layer::Marks,
+            StrokeRole::Mark | StrokeRole::Register => Layer::Marks,
             StrokeRole::Label => Layer::Labels,
             StrokeRole::Seam => Layer::Seams,
             StrokeRole::Grain => Layer::Grain,

@@ -167,7 +167,13 @@ pub fn render_painted(
             StrokeDash::new(array, 0.0)
         };
         let stroke = Stroke {
-            width: line_px,
+            width: match role {
+                // Registration marks are filled by strokes of their own width.
+                crate::toolpath::StrokeRole::Register => {
+                    px_width(crate::toolpath::registration::SIZE_STROKE_MM, scale)
+                }
+                _ => line_px,
+            },
             line_cap: LineCap::Round,
             line_join: LineJoin::Round,
             dash,

@@ -31,6 +31,7 @@ pub(crate) fn stroke_width_mm(role: StrokeRole) -> f64 {
         StrokeRole::Cut | StrokeRole::Notch | StrokeRole::Weed => 0.25,
         StrokeRole::FoldMountain | StrokeRole::FoldValley => 0.2,
         StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => 0.15,
+        StrokeRole::Register => crate::toolpath::registration::SIZE_STROKE_MM,
     }
 }
 

@@ -17,11 +17,13 @@
 //! Files: this one holds the schema ([`Profile`], [`Language`], [`Axes`]) and finding profiles
 //! ([`find`], [`all`]); `read.rs` the TOML reader and its checks with `FILE: line N` errors;
 //! `tools.rs` the tool table and the stroke kinds it maps ([`StrokeKind`]); `serial.rs` the
-//! serial line settings and the streaming protocol.
+//! serial line settings and the streaming protocol; `registration.rs` the print-and-cut
+//! sensor and marks (`[registration]`).
 
 mod grbl;
 pub use grbl::{significant_len, LINE_MAX};
 mod read;
+pub mod registration;
 mod serial;
 mod tools;
 
@@ -189,6 +191,9 @@ pub struct Profile {
     /// GRBL: the controller's version and motion settings (`[grbl]`, see [`GrblMachine`]).
     #[serde(default)]
     pub grbl: GrblMachine,
+    /// Print-and-cut: the registration sensor and the marks (`[registration]`).
+    #[serde(default)]
+    pub registration: registration::Registration,
     /// Commands sent before and after the job, verbatim.
     #[serde(default)]
     pub init: Vec<String>,

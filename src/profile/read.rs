@@ -138,6 +138,8 @@ fn check(p: &Profile) -> Result<(), Problem> {
         ));
     }
     check_media_and_line(p)?;
+    super::registration::check(&p.registration)
+        .map_err(|(key, m)| problem("registration", key, m))?;
     if p.buffer == 0 {
         return Err(problem("", "buffer", "must be at least 1 byte"));
     }

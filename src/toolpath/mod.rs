@@ -14,7 +14,8 @@
 //! alignment precut — is [`knife::prepare`], applied to the job that is encoded. Which tool makes
 //! a fold is `fold_kind`: the scoring tool, else the perforating one, else the pen.
 //! [`weed`] adds weed lines for vinyl. [`passes`] names what a device has no tool for and
-//! splits a job into the pen and knife passes of a tool change.
+//! splits a job into the pen and knife passes of a tool change. [`registration`] lays out the
+//! printed registration marks of a print-and-cut sheet.
 //!
 //! Choices where the issue is silent: the pen starts at the sheet origin (0, 0); notches
 //! are cut with the folds, before the outline they open; strokes of no piece (weed lines) come
@@ -29,6 +30,7 @@ pub mod cuttable;
 pub mod knife;
 pub mod order;
 pub mod passes;
+pub mod registration;
 pub mod weed;
 
 /// What a stroke is for; decides the SVG layer and, through [`StrokeKind`], the tool.
@@ -53,10 +55,12 @@ pub enum StrokeRole {
     Grain,
     /// Weed lines cut through the waste between pieces (vinyl).
     Weed,
+    /// Print-and-cut registration marks ([`registration`]): printed, never sent to a cutter.
+    Register,
 }
 
 impl StrokeRole {
-    pub const ALL: [StrokeRole; 9] = [
+    pub const ALL: [StrokeRole; 10] = [
         StrokeRole::Cut,
         StrokeRole::FoldMountain,
         StrokeRole::FoldValley,
@@ -66,6 +70,7 @@ impl StrokeRole {
         StrokeRole::Seam,
         StrokeRole::Grain,
         StrokeRole::Weed,
+        StrokeRole::Register,
     ];
 
     /// The tool class that makes this stroke.
@@ -73,9 +78,11 @@ impl StrokeRole {
         match self {
             StrokeRole::Cut | StrokeRole::Notch | StrokeRole::Weed => StrokeKind::Cut,
             StrokeRole::FoldMountain | StrokeRole::FoldValley => StrokeKind::Score,
-            StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => {
-                StrokeKind::Draw
-            }
+            StrokeRole::Mark
+            | StrokeRole::Label
+            | StrokeRole::Seam
+            | StrokeRole::Grain
+            | StrokeRole::Register => StrokeKind::Draw,
         }
     }
 
@@ -91,6 +98,7 @@ impl StrokeRole {
             StrokeRole::Seam => "seam",
             StrokeRole::Grain => "grain",
             StrokeRole::Weed => "weed",
+            StrokeRole::Register => "registration",
         }
     }
 }
@@ -167,7 +175,11 @@ pub struct ToolpathOptions {
 /// holes, then outer contours, then weed lines.
 fn group_of(s: &Stroke) -> usize {
     match s.role {
-        StrokeRole::Mark | StrokeRole::Label | StrokeRole::Seam | StrokeRole::Grain => 0,
+        StrokeRole::Mark
+        | StrokeRole::Label
+        | StrokeRole::Seam
+        | StrokeRole::Grain
+        | StrokeRole::Register => 0,
         StrokeRole::FoldMountain | StrokeRole::FoldValley | StrokeRole::Notch => 1,
         StrokeRole::Weed => 4,
         StrokeRole::Cut if !s.outer => 2,

@@ -22,6 +22,7 @@ mod param;
 mod pattern;
 mod pdf;
 mod print;
+mod printcut;
 mod resume;
 mod robust;
 mod simplify;

@@ -26,6 +26,8 @@ pub(crate) enum Motion {
     Cw,
     Ccw,
     None,
+    /// `G38.3`: probe toward the target, stop at contact, no alarm without one.
+    Probe,
 }
 
 /// Non-modal commands (group 0).
@@ -195,6 +197,12 @@ fn g_word(blk: &mut Block, v: f64, groups: &mut u32) -> Result<(), u32> {
         }
         80 => {
             blk.motion = Some(Motion::None);
+            1
+        }
+        38 if mantissa == 30 => {
+            axis_command(blk, AxisCommand::Motion)?;
+            blk.motion = Some(Motion::Probe);
+            used = true;
             1
         }
         4 | 10 | 28 | 30 | 53 | 92 => {

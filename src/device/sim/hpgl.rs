@@ -12,6 +12,14 @@
 //! coordinate range (±2^30 plotter units, HP 7475A manual ch. 14, error 3 "parameter out of
 //! range") is ignored whole and counted as `XX (out of range)`.
 //!
+//! Digitizing (print-and-cut, HP 7475A manual ch. 14): with a registration sensor
+//! ([`super::sensor`]) `DP` digitizes the mark the sensor finds near the head; `OS` answers
+//! the status byte (bit 2, 4: a digitized point is available; bit 3, 8: initialized; bit 4,
+//! 16: ready for data; bit 5, 32: an error, here a `DP` that found no mark), `OD` the
+//! digitized point as `X,Y,P` (units, pen 0 up / 1 down) and clears bit 2, `DC` clears the
+//! point; each answer ends with a carriage return. Without a sensor `DP` waits for a front
+//! panel the simulator does not have: it is ignored and counted, and `OS`/`OD` still answer.
+//!
 //! Motion time: pen-down moves at the `VS` speed (cm/s; the profile's tool speed when the
 //! program sets none), pen-up moves at [`TRAVEL_CM_S`]. This is what paces the simulated
 //! buffer's draining.
@@ -85,6 +93,14 @@ pub struct Hpgl {
     pub instructions: usize,
     /// Instructions not understood, by mnemonic.
     pub ignored: BTreeMap<String, usize>,
+    /// The registration sensor, if the machine has one and a printed sheet is loaded.
+    pub(crate) sensor: Option<super::sensor::Sensor>,
+    /// The last digitized point (units), until `OD` or `DC`.
+    digitized: Option<DVec2>,
+    /// A `DP` found no mark (status bit 5) since the last `OS`.
+    digitize_failed: bool,
+    /// Answers to output instructions, for the host.
+    pub(crate) out: Vec<u8>,
 }
 
 impl Hpgl {
@@ -114,6 +130,10 @@ impl Hpgl {
             rec: Recorder::for_profile(profile),
             instructions: 0,
             ignored: BTreeMap::new(),
+            sensor: None,
+            digitized: None,
+            digitize_failed: false,
+            out: Vec::new(),
         }
     }
 
@@ -214,6 +234,41 @@ impl Hpgl {
             }
             "VS" => {
                 self.speed_cm_s = nums.first().copied().filter(|v| *v > 0.0);
+                0.0
+            }
+            "DP" => {
+                let Some(sensor) = &self.sensor else {
+                    self.instructions -= 1;
+                    *self.ignored.entry("DP (no sensor)".into()).or_default() += 1;
+                    return 0.0;
+                };
+                self.digitized = sensor.find(self.pos);
+                self.digitize_failed = self.digitized.is_none();
+                0.0
+            }
+            "DC" => {
+                self.digitized = None;
+                0.0
+            }
+            "OS" => {
+                let status = 8
+                    + 16
+                    + u32::from(self.down)
+                    + if self.digitized.is_some() { 4 } else { 0 }
+                    + if std::mem::take(&mut self.digitize_failed) {
+                        32
+                    } else {
+                        0
+                    };
+                self.out.extend_from_slice(format!("{status}\r").as_bytes());
+                0.0
+            }
+            "OD" => {
+                let p = self.digitized.take().unwrap_or(self.pos);
+                self.out.extend_from_slice(
+                    format!("{},{},{}\r", p.x.round(), p.y.round(), u32::from(self.down))
+                        .as_bytes(),
+                );
                 0.0
             }
             "FS" | "!FS" => {

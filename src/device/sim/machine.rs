@@ -130,8 +130,20 @@ impl Device {
             p.serial.flow_control
         };
         let interp = match p.language {
-            Language::Gcode => Interp::Grbl(grbl::Grbl::new(p)),
-            Language::Hpgl => Interp::Hpgl(hpgl::Hpgl::new(p)),
+            Language::Gcode => {
+                let mut g = grbl::Grbl::new(p);
+                if p.registration.sensor == crate::profile::registration::Sensor::GrblProbe {
+                    g.probe = cfg.printed.as_ref().map(|s| sensor::Sensor::new(s, p));
+                }
+                Interp::Grbl(g)
+            }
+            Language::Hpgl => {
+                let mut m = hpgl::Hpgl::new(p);
+                if p.registration.sensor == crate::profile::registration::Sensor::HpglDigitize {
+                    m.sensor = cfg.printed.as_ref().map(|s| sensor::Sensor::new(s, p));
+                }
+                Interp::Hpgl(m)
+            }
             Language::Gpgl => Interp::Gpgl(gpgl::Gpgl::new(p)),
         };
         let rep = SimReport {
@@ -503,6 +515,7 @@ impl Device {
                         return;
                     };
                     let t = m.execute(&instr);
+                    self.out.append(&mut m.out);
                     self.rep.simulated_time_s += t;
                     if let Some(s) = self.scaled(t) {
                         self.motion

@@ -28,6 +28,8 @@
 //!   are answered `ok` (or `error:N`) when planned, as GRBL does. Motion takes the time the
 //!   interpreters compute (`hpgl`, [`grbl`]) divided by the time factor (`None`: no time).
 //!   GRBL real-time bytes (`?`, `!`, `~`, Ctrl-X) act on arrival and are never buffered.
+//! - **Print-and-cut**: a printed sheet placed on the bed with a known error and an optical
+//!   sensor that digitizes its registration marks (HP-GL `DP`/`OS`/`OD`), see [`sensor`].
 //! - **Faults** for tests ([`Faults`]): hang up after N bytes, stall (stop reading and
 //!   executing) after N bytes, send garbage after N bytes, lose the XONs, answer a given
 //!   GRBL line with `error:N`.
@@ -41,6 +43,7 @@ pub(crate) mod grbl_block;
 pub(crate) mod hpgl;
 mod machine;
 pub(crate) mod record;
+pub mod sensor;
 
 use crate::device::grbl as proto;
 use crate::profile::{FlowControl, Language, Profile};
@@ -88,6 +91,9 @@ pub struct SimConfig {
     /// Motion runs this many times faster than the real machine; `None`: motion takes no time.
     pub time_factor: Option<f64>,
     pub faults: Faults,
+    /// Print-and-cut: the printed sheet on the bed, which a registration sensor finds
+    /// ([`sensor`]); `None`: nothing printed is loaded.
+    pub printed: Option<sensor::PrintedSheet>,
 }
 
 impl SimConfig {
@@ -96,6 +102,7 @@ impl SimConfig {
             profile,
             time_factor: None,
             faults: Faults::default(),
+            printed: None,
         }
     }
 }

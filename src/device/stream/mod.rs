@@ -791,9 +791,22 @@ pub fn stream_job(
 ) -> Result<(Result<StreamReport, StreamError>, SimReport), SimError> {
     let profile = cfg.profile.clone();
     let handle = super::sim::spawn(cfg)?;
-    let mut port =
+    let port =
         super::serial::open(&profile, &handle.path, None)?.with_virtual_cts(handle.cts.clone());
-    let mut sent = send(&mut port, &profile, program, opts);
+    stream_into(handle, port, &profile, program, opts, finish_within)
+}
+
+/// The rest of [`stream_job`] on a simulator already started and a line already open to it
+/// (`device::register` measures the marks on the same line first).
+pub(crate) fn stream_into(
+    handle: super::sim::SimHandle,
+    mut port: Link,
+    profile: &Profile,
+    program: &[u8],
+    opts: &StreamOptions,
+    finish_within: Duration,
+) -> Result<(Result<StreamReport, StreamError>, SimReport), SimError> {
+    let mut sent = send(&mut port, profile, program, opts);
     let written = port.written;
     drop(port);
     // Cancelled while sending: the tool-up is queued behind the buffer; let the device work

@@ -90,6 +90,8 @@ pub struct Grbl {
     pub(crate) settings: Settings,
     pub(crate) planner: Planner,
     pub rec: Recorder,
+    /// A registration-mark sensor on the probe pin (`G38.3`), with a printed sheet loaded.
+    pub(crate) probe: Option<crate::device::sim::sensor::Sensor>,
     /// Lines executed without error.
     pub lines_ok: usize,
     /// GRBL 0.9 (text errors, `<State,MPos:…>` status).
@@ -173,6 +175,7 @@ impl Grbl {
             planner: Planner::new(&settings.machine()),
             settings,
             rec: Recorder::for_profile(profile),
+            probe: None,
             lines_ok: 0,
             v0_9: profile.grbl.version == "0.9",
         }
@@ -291,7 +294,12 @@ impl Grbl {
         let motion = k.motion.unwrap_or(self.motion);
         let inverse = k.inverse_time.unwrap_or(self.inverse_time);
         let moving = k.axis_command == AxisCommand::Motion;
-        if moving && matches!(motion, Motion::Linear | Motion::Cw | Motion::Ccw) {
+        if moving
+            && matches!(
+                motion,
+                Motion::Linear | Motion::Cw | Motion::Ccw | Motion::Probe
+            )
+        {
             let f = k.get(b'F');
             let undefined = if inverse {
                 f.is_none_or(|f| f == 0.0)
@@ -393,7 +401,7 @@ impl Grbl {
         }
         if let Some(m) = k.motion {
             self.motion = m;
-            self.g1 = matches!(m, Motion::Linear | Motion::Cw | Motion::Ccw);
+            self.g1 = matches!(m, Motion::Linear | Motion::Cw | Motion::Ccw | Motion::Probe);
         }
         let offset = self.offset();
         let axes = k.axes();
@@ -427,6 +435,11 @@ impl Grbl {
                     e.add(self.arc_to(target, center, self.motion == Motion::Cw, feed));
                 }
                 Motion::None => {}
+                Motion::Probe => {
+                    let (e2, text) = self.probe_to(target, feed);
+                    e.add(e2);
+                    e.text.push(text);
+                }
             }
         }
         match k.flow {
@@ -600,6 +613,27 @@ impl Grbl {
         }
     }
 
+    /// `G38.3` toward `target`: the move stops where the probe (the registration sensor)
+    /// first sees a mark; answers GRBL's `[PRB:x,y,z:1]` with the machine position there, or
+    /// goes the whole way and answers `:0` (no sensor: never a contact).
+    fn probe_to(&mut self, target: DVec3, feed: Option<f64>) -> (Effect, String) {
+        let from = self.pos;
+        let t = self.probe.as_ref().and_then(|s| {
+            s.first_contact(DVec2::new(from.x, from.y), DVec2::new(target.x, target.y))
+        });
+        let end = t.map_or(target, |t| from.lerp(target, t));
+        let e = self.line_to(end, feed);
+        let p = self.pos;
+        let text = format!(
+            "[PRB:{:.3},{:.3},{:.3}:{}]",
+            p.x,
+            p.y,
+            p.z,
+            u8::from(t.is_some())
+        );
+        (e, text)
+    }
+
     /// An arc as `mc_arc` cuts it: chords within the arc tolerance `$12`.
     fn arc_to(&mut self, target: DVec3, center: DVec3, cw: bool, feed: Option<f64>) -> Effect {
         let (a0, a1) = self.plane_axes();
@@ -697,6 +731,7 @@ impl Grbl {
             Motion::Cw => "G2",
             Motion::Ccw => "G3",
             Motion::None => "G80",
+            Motion::Probe => "G38.3",
         };
         let f = |v: f64| crate::output::fmt_mm(v);
         format!(

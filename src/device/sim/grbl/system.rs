@@ -174,12 +174,42 @@ impl Grbl {
                 })
             }),
             "H" => idle_only(Err(5)),
+            c if c.starts_with("J=") => self.jog(&c[2..]),
             c if c.starts_with(|ch: char| ch.is_ascii_digit()) => idle_only(self.setting(c)),
             c if c.starts_with('N') && c[1..].starts_with(|ch: char| ch.is_ascii_digit()) => {
                 idle_only(text(Vec::new()))
             }
             _ => Err(2),
         }
+    }
+
+    /// `$J=line` (GRBL 1.1 jogging): a feed move by the line's `G90`/`G91`, `G20`/`G21` and
+    /// axis words, which needs `F` (error 22 without it) and leaves the parser's modal state
+    /// as it was.
+    fn jog(&mut self, line: &str) -> Result<Effect, u32> {
+        let k =
+            crate::device::sim::grbl_block::parse(&crate::device::sim::grbl_block::strip(line))?;
+        let Some(f) = k.get(b'F').filter(|f| *f > 0.0) else {
+            return Err(22);
+        };
+        let scale = if k.units.unwrap_or(self.inches) {
+            25.4
+        } else {
+            1.0
+        };
+        let relative = k.relative.unwrap_or(self.relative);
+        let (axes, offset) = (k.axes(), self.offset());
+        let mut target = self.pos;
+        for (i, v) in axes.iter().enumerate() {
+            if let Some(v) = v {
+                target[i] = if relative {
+                    self.pos[i] + v * scale
+                } else {
+                    v * scale + offset[i]
+                };
+            }
+        }
+        Ok(self.line_to(target, Some(f * scale)))
     }
 
     /// `$n=v`.
