@@ -351,6 +351,7 @@ pub fn report(pc: &PrintCut, profile: &Profile, done: &[Registered]) -> Value {
                 v["measured_by"] = json!(reg.source);
                 v["measured_mm"] = json!(reg.measured.iter().map(|p| xy(*p)).collect::<Vec<_>>());
                 v["fit"] = json!({
+                    "maps": "a printed point p (sheet mm) lies at scale * rotate(p, rotation_deg) + translation_mm, in the sheet's frame",
                     "translation_mm": xy(t.translation),
                     "rotation_deg": (t.angle.to_degrees() * 1e6).round() / 1e6,
                     "scale": (t.scale * 1e7).round() / 1e7,
