@@ -277,7 +277,12 @@ fn centre(samples: impl Iterator<Item = (f64, u8)>) -> f64 {
 /// The side of the square at `rect` (mm, x y w h, on a page `page_h` mm high) measured in the
 /// raster: the distance between the centres of its opposite edges along 21 lines across its
 /// middle, in mm, (horizontal, vertical), each the mean over the lines.
-fn measure(r: &(usize, usize, Vec<u8>), dpi: f64, page_h: f64, rect: [f64; 4]) -> (f64, f64) {
+pub(crate) fn measure(
+    r: &(usize, usize, Vec<u8>),
+    dpi: f64,
+    page_h: f64,
+    rect: [f64; 4],
+) -> (f64, f64) {
     let (w, h, px) = r;
     let k = dpi / 25.4;
     let at = |col: i64, row: i64| -> u8 {

@@ -4,7 +4,7 @@
 //! the bad papers refused naming the flag.
 
 use crate::common::{flatcut, scratch, stderr};
-use crate::pdf::{cut, hpgl_cuts, pdfinfo_pages, poppler, raster};
+use crate::pdf::{cut, hpgl_cuts, measure, pdfinfo_pages, poppler, raster};
 use std::process::Command;
 
 /// Every pen-down stroke of an HP-GL program, any pen, in mm (40 units per mm).
@@ -166,6 +166,16 @@ fn a_610_by_900_sheet_tiled_on_a4() {
                 .any(|w| w.trim_matches(['(', ')']) == label),
             "{label} not on the map: {text}"
         );
+    }
+
+    // The map's test squares measure 50 mm and 2 in at 300 dpi (lower left, 4 mm inside the
+    // printable area, 4 mm apart).
+    let m = rep["print"]["margin_mm"].as_f64().unwrap() + 4.0;
+    let r = raster(&pdf, map.parse().unwrap(), 300, &dir);
+    for (x, side) in [(m, 50.0), (m + 54.0, 50.8)] {
+        let (across, down) = measure(&r, 300.0, page_mm[1], [x, m, side, side]);
+        eprintln!("map: {side} mm square measures {across:.4} x {down:.4} mm");
+        assert!((across - side).abs() < 0.1 && (down - side).abs() < 0.1);
     }
 
     // Every page raster at 300 dpi.
