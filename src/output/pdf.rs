@@ -344,12 +344,8 @@ pub fn render_painted(job: &Job, paint: Option<&Paint>) -> Vec<u8> {
     let page_ids: Vec<Ref> = (0..job.sheets.len())
         .map(|k| Ref::new(first_page + 2 * k as i32))
         .collect();
-    // Resource names of the layers in the pages: /oc1, /oc2, …
-    let oc_names: Vec<String> = (1..=layers.len()).map(|k| format!("oc{k}")).collect();
-    let oc_name = |layer: Layer| -> &[u8] {
-        let k = layers.iter().position(|l| *l == layer).unwrap_or(0);
-        oc_names.get(k).map_or(b"oc1", |s| s.as_bytes())
-    };
+    let names = LayerNames::new(&layers);
+    let oc_name = |layer: Layer| names.of(layer);
 
     let mut pdf = Pdf::new();
     write_catalog(&mut pdf, catalog_id, pages_id, &layers, &layer_ids);
@@ -387,6 +383,27 @@ pub fn render_painted(job: &Job, paint: Option<&Paint>) -> Vec<u8> {
         pdf.stream(content_id, &content);
     }
     pdf.finish()
+}
+
+/// Resource names of the layers in the pages: `/oc1`, `/oc2`, … in the order of `layers`.
+pub(crate) struct LayerNames {
+    layers: Vec<Layer>,
+    names: Vec<String>,
+}
+
+impl LayerNames {
+    pub fn new(layers: &[Layer]) -> LayerNames {
+        LayerNames {
+            layers: layers.to_vec(),
+            names: (1..=layers.len()).map(|k| format!("oc{k}")).collect(),
+        }
+    }
+
+    /// The resource name of `layer` (the first layer's for one not in the list).
+    pub fn of(&self, layer: Layer) -> &[u8] {
+        let k = self.layers.iter().position(|l| *l == layer).unwrap_or(0);
+        self.names.get(k).map_or(b"oc1", |s| s.as_bytes())
+    }
 }
 
 /// The catalog with the layers (optional content groups `layer_ids`, all on, the viewer's

@@ -348,11 +348,8 @@ pub fn render(job: &Job, tiling: &Tiling, paint: Option<&Paint>) -> Vec<u8> {
     let page_ids: Vec<Ref> = (0..tiling.pages)
         .map(|k| Ref::new(first_page + 2 * k as i32))
         .collect();
-    let oc_names: Vec<String> = (1..=layers.len()).map(|k| format!("oc{k}")).collect();
-    let oc_name = |layer: Layer| -> &[u8] {
-        let k = layers.iter().position(|l| *l == layer).unwrap_or(0);
-        oc_names.get(k).map_or(b"oc1", |s| s.as_bytes())
-    };
+    let names = pdf::LayerNames::new(&layers);
+    let oc_name = |layer: Layer| names.of(layer);
 
     let mut doc = Pdf::new();
     pdf::write_catalog(&mut doc, catalog_id, pages_id, &layers, &layer_ids);
