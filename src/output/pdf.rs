@@ -360,24 +360,17 @@ pub fn render_painted(job: &Job, paint: Option<&Paint>) -> Vec<u8> {
     for (k, (sheet, &page_id)) in job.sheets.iter().zip(&page_ids).enumerate() {
         let content_id = Ref::new(page_id.get() + 1);
         let (w, h) = page_size_mm(sheet);
-        let mut page = pdf.page(page_id);
-        page.parent(pages_id)
-            .media_box(Rect::new(
-                0.0,
-                0.0,
-                (w * PT_PER_MM) as f32,
-                (h * PT_PER_MM) as f32,
-            ))
-            .contents(content_id);
-        let mut resources = page.resources();
-        let mut named = resources.insert(Name(b"Properties")).dict();
-        for (layer, id) in layers.iter().zip(&layer_ids) {
-            named.pair(Name(oc_name(*layer)), *id);
-        }
-        named.finish();
-        image_resources(&mut resources, &image_ids);
-        resources.finish();
-        page.finish();
+        let page = PageRefs {
+            page: page_id,
+            pages: pages_id,
+            content: content_id,
+        };
+        let resources = PageResources {
+            layers: (&layers, &layer_ids, &names),
+            font: None,
+            images: &image_ids,
+        };
+        write_page(&mut pdf, page, (w, h), &resources);
         let faces = paint.map_or(&[][..], |p| p.sheet(k));
         let content = page_content(sheet, &oc_name, faces, &images);
         pdf.stream(content_id, &content);
@@ -438,6 +431,47 @@ pub(crate) fn write_catalog(
             .pair(Name(b"Type"), Name(b"OCG"))
             .pair(Name(b"Name"), TextStr(layer.name()));
     }
+}
+
+/// A page's object, its parent and its content stream.
+pub(crate) struct PageRefs {
+    pub page: Ref,
+    pub pages: Ref,
+    pub content: Ref,
+}
+
+/// What a page's resources name: the layers (with their objects and names), a font as `/F1`,
+/// the texture images.
+pub(crate) struct PageResources<'a> {
+    pub layers: (&'a [Layer], &'a [Ref], &'a LayerNames),
+    pub font: Option<Ref>,
+    pub images: &'a [Ref],
+}
+
+/// Writes a page of `size` mm (w, h) with its resources.
+pub(crate) fn write_page(pdf: &mut Pdf, refs: PageRefs, size: (f64, f64), res: &PageResources) {
+    let mut page = pdf.page(refs.page);
+    page.parent(refs.pages)
+        .media_box(Rect::new(
+            0.0,
+            0.0,
+            (size.0 * PT_PER_MM) as f32,
+            (size.1 * PT_PER_MM) as f32,
+        ))
+        .contents(refs.content);
+    let mut resources = page.resources();
+    let mut named = resources.insert(Name(b"Properties")).dict();
+    let (layers, ids, names) = res.layers;
+    for (layer, id) in layers.iter().zip(ids) {
+        named.pair(Name(names.of(*layer)), *id);
+    }
+    named.finish();
+    if let Some(font) = res.font {
+        resources.fonts().pair(Name(b"F1"), font);
+    }
+    image_resources(&mut resources, res.images);
+    resources.finish();
+    page.finish();
 }
 
 /// The page resources naming the texture images `/Tx1`, `/Tx2`, … (none: no entry).

@@ -31,7 +31,7 @@
 
 use glam::DVec2;
 use pdf_writer::types::TextRenderingMode;
-use pdf_writer::{Content, Finish, Name, Pdf, Rect, Ref, Str};
+use pdf_writer::{Content, Name, Pdf, Ref, Str};
 use serde::Serialize;
 
 use super::pdf::{self, Frame, Layer, TestSquare, PT_PER_MM, TEST_SQUARE_SIDES_MM};
@@ -131,6 +131,34 @@ pub struct SheetTiling {
     pub tiles: Vec<Tile>,
     /// Labels of the pages left out, with nothing on them.
     pub blank: Vec<String>,
+    /// The part of the sheet a page shows (w, h) and how far apart neighbouring pages' parts
+    /// start (the window less the overlap), mm.
+    #[serde(skip)]
+    pub window: DVec2,
+    #[serde(skip)]
+    pub step: DVec2,
+}
+
+impl SheetTiling {
+    /// Lower-left corner (sheet mm) of the window of row `r`, column `c` on a sheet `h` high.
+    fn cell(&self, r: usize, c: usize, h: f64) -> DVec2 {
+        cell_lo(self.window, self.step, h, r, c)
+    }
+}
+
+/// Lower-left corner of the window of row `r` (from the top), column `c` on a sheet `h` high.
+fn cell_lo(win: DVec2, step: DVec2, h: f64, r: usize, c: usize) -> DVec2 {
+    DVec2::new(c as f64 * step.x, h - r as f64 * step.y - win.y)
+}
+
+/// The label of page row `r`, column `c` of sheet `i` (0-based) of `n`: `B3`, or `2-B3`.
+fn page_label(i: usize, n: usize, r: usize, c: usize) -> String {
+    let rc = format!("{}{}", row_name(r), c + 1);
+    if n > 1 {
+        format!("{}-{rc}", i + 1)
+    } else {
+        rc
+    }
 }
 
 /// The whole tiled document's plan (written to report.json as `print`).
@@ -213,7 +241,7 @@ fn grid(sheet: &SheetJob, page: DVec2, margin: f64, overlap: f64) -> Grid {
     }
     for r in 0..rows {
         for c in 0..cols {
-            let lo = DVec2::new(c as f64 * step.x, h - r as f64 * step.y - win.y);
+            let lo = cell_lo(win, step, h, r, c);
             let hi = lo + win;
             if segments
                 .iter()
@@ -279,14 +307,7 @@ pub fn plan(job: &Job, opts: &PrintOptions) -> Result<Tiling, OutputError> {
                 sheet.height
             )));
         }
-        let label = |r: usize, c: usize| {
-            let rc = format!("{}{}", row_name(r), c + 1);
-            if n > 1 {
-                format!("{}-{rc}", i + 1)
-            } else {
-                rc
-            }
-        };
+        let label = |r: usize, c: usize| page_label(i, n, r, c);
         page += 1;
         let map_page = page;
         let tiles = g
@@ -313,8 +334,9 @@ pub fn plan(job: &Job, opts: &PrintOptions) -> Result<Tiling, OutputError> {
             map_page,
             tiles,
             blank: g.blank.iter().map(|&(r, c)| label(r, c)).collect(),
+            window: g.win,
+            step: g.step,
         });
-        let _ = g.step;
     }
     Ok(Tiling {
         paper: opts.paper.clone(),
@@ -379,25 +401,17 @@ pub fn render(job: &Job, tiling: &Tiling, paint: Option<&Paint>) -> Vec<u8> {
     }
     for ((size, content), &page_id) in contents.iter().zip(&page_ids) {
         let content_id = Ref::new(page_id.get() + 1);
-        let mut page = doc.page(page_id);
-        page.parent(pages_id)
-            .media_box(Rect::new(
-                0.0,
-                0.0,
-                (size.x * PT_PER_MM) as f32,
-                (size.y * PT_PER_MM) as f32,
-            ))
-            .contents(content_id);
-        let mut resources = page.resources();
-        let mut named = resources.insert(Name(b"Properties")).dict();
-        for (layer, id) in layers.iter().zip(&layer_ids) {
-            named.pair(Name(oc_name(*layer)), *id);
-        }
-        named.finish();
-        resources.fonts().pair(Name(b"F1"), font_id);
-        pdf::image_resources(&mut resources, &image_ids);
-        resources.finish();
-        page.finish();
+        let refs = pdf::PageRefs {
+            page: page_id,
+            pages: pages_id,
+            content: content_id,
+        };
+        let resources = pdf::PageResources {
+            layers: (&layers, &layer_ids, &names),
+            font: Some(font_id),
+            images: &image_ids,
+        };
+        pdf::write_page(&mut doc, refs, (size.x, size.y), &resources);
         doc.stream(content_id, content);
     }
     doc.finish()
@@ -428,15 +442,7 @@ fn text(c: &mut Content, s: &str, at: DVec2, height: f64) {
 /// module doc).
 fn alignment(c: &mut Content, sheet: &SheetJob, st: &SheetTiling, tiling: &Tiling, frame: Frame) {
     let (w, h) = pdf::page_size_mm(sheet);
-    let ov = tiling.overlap_mm;
-    let Some(first) = st.tiles.first() else {
-        return;
-    };
-    let win = DVec2::new(
-        first.window_mm[2] - first.window_mm[0],
-        first.window_mm[3] - first.window_mm[1],
-    );
-    let step = win - DVec2::splat(ov);
+    let (ov, step) = (tiling.overlap_mm, st.step);
     let mut lines = Vec::new();
     for c in 1..st.cols {
         let x = c as f64 * step.x + ov / 2.0;
@@ -577,14 +583,13 @@ fn map_content<'a>(
     let squares_h = TEST_SQUARE_SIDES_MM[1] + 6.0;
     let room_lo = DVec2::new(m, m + squares_h);
     let room_hi = DVec2::new(page.x - m, y - 8.0);
-    let Some(first) = st.tiles.first().map(|t| t.window_mm) else {
+    if st.tiles.is_empty() {
         c.restore_state();
         c.end_marked_content();
         squares(&mut c, page, m, oc_name);
         return c.finish().to_vec();
-    };
-    let win = DVec2::new(first[2] - first[0], first[3] - first[1]);
-    let step = win - DVec2::splat(tiling.overlap_mm);
+    }
+    let (win, step) = (st.window, st.step);
     let (_, h) = pdf::page_size_mm(sheet);
     // Sheet coordinates of the grid's outer corners.
     let g_lo = DVec2::new(0.0, h - (st.rows - 1) as f64 * step.y - win.y);
@@ -618,7 +623,7 @@ fn map_content<'a>(
     c.stroke();
     // Every page of the grid, with its label; blank ones dashed.
     let cell = |r: usize, col: usize| {
-        let lo = DVec2::new(col as f64 * step.x, h - r as f64 * step.y - win.y);
+        let lo = st.cell(r, col, h);
         (to_map(lo), to_map(lo + win))
     };
     let label_h = (step.x.min(step.y) * s / 4.0).clamp(1.5, 8.0);
@@ -626,10 +631,15 @@ fn map_content<'a>(
         .tiles
         .iter()
         .map(|t| (t.row, t.col, t.label.clone(), true))
-        .chain(st.blank.iter().map(|l| {
-            let (r, col) = label_cell(l);
-            (r, col, l.clone(), false)
-        }))
+        .chain(
+            (0..st.rows)
+                .flat_map(|r| (0..st.cols).map(move |col| (r, col)))
+                .filter_map(|(r, col)| {
+                    let printed = st.tiles.iter().any(|t| (t.row, t.col) == (r, col));
+                    let label = page_label(st.sheet - 1, job.sheets.len(), r, col);
+                    (!printed).then_some((r, col, label, false))
+                }),
+        )
     {
         let (lo, hi) = cell(r, col);
         c.save_state();
@@ -722,18 +732,6 @@ fn map_header(
     y
 }
 
-/// Row and column of a label made by [`plan`] (`B3`, `2-B3`).
-fn label_cell(label: &str) -> (usize, usize) {
-    let rc = label.rsplit('-').next().unwrap_or(label);
-    let letters: String = rc.chars().take_while(|c| c.is_ascii_uppercase()).collect();
-    let digits: String = rc.chars().skip(letters.len()).collect();
-    let row = letters
-        .bytes()
-        .fold(0usize, |acc, b| acc * 26 + usize::from(b - b'A') + 1)
-        .saturating_sub(1);
-    (row, digits.parse::<usize>().unwrap_or(1).saturating_sub(1))
-}
-
 /// The test squares at the bottom left of a map page.
 fn squares<'a>(c: &mut Content, page: DVec2, m: f64, oc_name: &dyn Fn(Layer) -> &'a [u8]) {
     let [a, b] = TEST_SQUARE_SIDES_MM;
@@ -774,8 +772,8 @@ mod tests {
         assert_eq!(row_name(25), "Z");
         assert_eq!(row_name(26), "AA");
         assert_eq!(row_name(27), "AB");
-        assert_eq!(label_cell("B3"), (1, 2));
-        assert_eq!(label_cell("2-AA12"), (26, 11));
+        assert_eq!(page_label(0, 1, 1, 2), "B3");
+        assert_eq!(page_label(1, 2, 26, 11), "2-AA12");
     }
 
     #[test]

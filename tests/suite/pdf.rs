@@ -405,6 +405,11 @@ fn library_cut(
 
 /// The HP-GL's pen-down strokes with pen 1 (the cut pen of `sim`), in mm (40 units per mm).
 pub(crate) fn hpgl_cuts(plt: &str) -> Vec<Vec<[f64; 2]>> {
+    hpgl_strokes(plt, Some(1))
+}
+
+/// The HP-GL's pen-down strokes with `pen` (any pen: `None`), in mm (40 units per mm).
+pub(crate) fn hpgl_strokes(plt: &str, only: Option<i32>) -> Vec<Vec<[f64; 2]>> {
     let mut strokes: Vec<Vec<[f64; 2]>> = Vec::new();
     let (mut pen, mut at) = (0, [0.0, 0.0]);
     for cmd in plt.split(';').map(str::trim) {
@@ -421,7 +426,7 @@ pub(crate) fn hpgl_cuts(plt: &str) -> Vec<Vec<[f64; 2]>> {
                     at = [c[0], c[1]];
                 }
             }
-            "PD" if pen == 1 => {
+            "PD" if only.is_none_or(|p| p == pen) => {
                 let mut s = vec![at];
                 s.extend(nums.chunks(2).map(|c| [c[0], c[1]]));
                 at = *s.last().unwrap();

@@ -4,37 +4,8 @@
 //! the bad papers refused naming the flag.
 
 use crate::common::{flatcut, scratch, stderr};
-use crate::pdf::{cut, hpgl_cuts, measure, pdfinfo_pages, poppler, raster};
+use crate::pdf::{cut, hpgl_cuts, hpgl_strokes, measure, pdfinfo_pages, poppler, raster};
 use std::process::Command;
-
-/// Every pen-down stroke of an HP-GL program, any pen, in mm (40 units per mm).
-fn hpgl_all(plt: &str) -> Vec<Vec<[f64; 2]>> {
-    let mut strokes: Vec<Vec<[f64; 2]>> = Vec::new();
-    let mut at = [0.0, 0.0];
-    for cmd in plt.split(';').map(str::trim) {
-        let (op, args) = cmd.split_at(cmd.len().min(2));
-        let nums: Vec<f64> = args
-            .split(',')
-            .filter_map(|t| t.trim().parse::<f64>().ok())
-            .map(|v| v / 40.0)
-            .collect();
-        match op {
-            "PU" => {
-                if let Some(c) = nums.chunks(2).last() {
-                    at = [c[0], c[1]];
-                }
-            }
-            "PD" => {
-                let mut s = vec![at];
-                s.extend(nums.chunks(2).map(|c| [c[0], c[1]]));
-                at = *s.last().unwrap();
-                strokes.push(s);
-            }
-            _ => {}
-        }
-    }
-    strokes
-}
 
 /// Points every `step` mm along the strokes.
 fn samples(strokes: &[Vec<[f64; 2]>], step: f64) -> Vec<[f64; 2]> {
@@ -228,7 +199,7 @@ fn a_610_by_900_sheet_tiled_on_a4() {
     eprintln!("{} cut points checked on the pages", checked);
 
     // No page without a stroke: each printed window holds a point of some stroke.
-    let all = samples(&hpgl_all(&plt), 1.0);
+    let all = samples(&hpgl_strokes(&plt, None), 1.0);
     for t in &tiles {
         assert!(
             all.iter().any(|p| inside(t, *p, -1.0)),
