@@ -741,7 +741,15 @@ fn cuttable(
 ) -> Vec<crate::toolpath::cuttable::Warning> {
     use crate::toolpath::cuttable::{check, CuttableOptions};
     let o = CuttableOptions::for_device(knife_offset, spec.pattern_options().kerf);
-    let warnings = check(&layout.pieces, &o);
+    let mut warnings = check(&layout.pieces, &o);
+    let kind = spec.material.kind;
+    for (piece, message) in crate::pattern::marks::seam_mismatches(&layout.pieces, kind) {
+        warnings.push(crate::toolpath::cuttable::Warning {
+            piece,
+            kind: "seam-mismatch",
+            message,
+        });
+    }
     if !quiet {
         for w in &warnings {
             eprintln!("flatcut: warning: {}", w.message);

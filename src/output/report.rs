@@ -1,6 +1,7 @@
 //! `report.json`: what a run made, for people and for scripts. Pieces (id, name, surface and
 //! its source file, area, cut and fold lengths, every fold line with its kind and bend angle,
-//! sheet and placement), seams (`{id, piece_a, piece_b, length_a_mm, length_b_mm, notches}`:
+//! sheet and placement), seams (`{id, piece_a, piece_b, length_3d_mm, length_a_mm, length_b_mm,
+//! notches}`, the 3D length of the seam's mesh edges and each side's as cut:
 //! notch positions in mm from side A's start, and `notches_b_mm` from side B's start, which is
 //! A's end; `tab` says which side has the glue tab; `"split": true` on the seams made by
 //! splitting a piece too large for the sheet), sheets (size, pieces, utilisation; on a
@@ -226,6 +227,7 @@ fn seams_json(layout: &Layout) -> Vec<Value> {
             "id": a.id,
             "piece_a": pa.id,
             "piece_b": pb.id,
+            "length_3d_mm": r6(a.length_3d),
             "length_a_mm": r6(a.length),
             "length_b_mm": r6(b.length),
             "edges": a.count,

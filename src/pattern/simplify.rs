@@ -21,8 +21,10 @@
 //!   made only if, on both sides, every original vertex between the two neighbours lies within
 //!   `tolerance` mm of the new segment (the deviation of the simplified chain from the original,
 //!   measured exactly; the distance between a polyline and a chord through its ends is largest
-//!   at a vertex), and if the two sides' lengths then differ by at most [`MISMATCH_MM`] (or by
-//!   no more than they already did before simplifying), so that the seam still meets when sewn.
+//!   at a vertex), and if the two sides' lengths then differ by at most [`MISMATCH_MM`] and
+//!   [`MISMATCH_REL`] of the seam's length (or by no more than they already did before
+//!   simplifying), so that the seam still meets when sewn, well within the strictest material's
+//!   seam tolerance (metal, 0.1 %).
 //!   A collapse refused waits until one of its neighbours is collapsed (its cost and geometry
 //!   change); simplification ends when no vertex can go. Default tolerances: see
 //!   [`super::PatternOptions::for_material`]; 0 turns simplification off.
@@ -50,6 +52,10 @@ use std::collections::BinaryHeap;
 /// Largest difference (mm) simplification may bring between the lengths of a seam's two sides,
 /// unless they already differed by more.
 pub const MISMATCH_MM: f64 = 0.1;
+
+/// Largest relative difference simplification may bring between a seam's two sides (of the
+/// longer side), unless they already differed by more.
+pub const MISMATCH_REL: f64 = 5e-4;
 
 /// Least distance (mm) between a new segment and the rest of the piece's border.
 const CLEARANCE_MM: f64 = 2.0 * super::allowance::CLEAN_MM;
@@ -179,7 +185,7 @@ fn candidates(
             super::marks::polyline_length(&sb.points),
         );
         lengths.push([la, lb]);
-        allowed.push(MISMATCH_MM.max((la - lb).abs()));
+        allowed.push((MISMATCH_MM.min(MISMATCH_REL * la.max(lb))).max((la - lb).abs()));
         if sa.count != sb.count {
             continue;
         }
@@ -545,6 +551,7 @@ mod tests {
             first,
             count: n - 1,
             length: super::super::marks::polyline_length(&points),
+            length_3d: super::super::marks::polyline_length(&points),
             points,
             notches: Vec::new(),
             tab: false,

@@ -52,7 +52,8 @@ impl CuttableOptions {
 pub struct Warning {
     /// The piece's name, as written on it.
     pub piece: String,
-    /// `piece-too-small`, `text-too-small` or `slit-narrower-than-kerf`.
+    /// `piece-too-small`, `text-too-small` or `slit-narrower-than-kerf`; the pipeline adds
+    /// `seam-mismatch` ([`crate::pattern::marks::seam_mismatches`]).
     pub kind: &'static str,
     /// One line for the user.
     pub message: String,

@@ -994,10 +994,28 @@ fn torus_is_cut_open_along_two_loops() {
     assert_eq!(s.flipped, 0);
     assert!(s.l2.is_finite() && s.l2 > 1.0 && s.l2 <= o.tolerance);
     assert!(flat.surface.warnings.is_empty());
-    assert_eq!(flat.surface.cuts.len(), cuts.len());
-    // Both sides of the cut are seams of this piece; their 3D length is the cuts' length.
-    assert!((len3 - len).abs() < 1e-6 * len);
-    assert!(a > 0.0 && b > 0.0);
+    // The two loops stay cut; matching the seams' lengths (issue 20) raises L2 to near the
+    // tolerance, which a dart from the border may relieve.
+    for p in &pairs {
+        assert!(
+            flat.surface.cuts.contains(p),
+            "loop edge {p:?} no longer cut"
+        );
+    }
+    let cut_len: f64 = flat
+        .surface
+        .cuts
+        .iter()
+        .map(|&[a, b]| mesh.vertices[a].distance(mesh.vertices[b]))
+        .sum();
+    assert!(cut_len >= len - 1e-9);
+    // Both sides of the cuts are seams of this piece; their 3D length is the cuts' length,
+    // and each side is as long flat (issue 20: fabric within 1 %; matched far closer).
+    assert!((len3 - cut_len).abs() < 1e-6 * cut_len);
+    assert!(
+        (a - len3).abs() < 1e-3 * len3 && (b - len3).abs() < 1e-3 * len3,
+        "{a} {b} {len3}"
+    );
     // Same input, same output.
     let again = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
     assert_eq!(again.face_2d, flat.face_2d);

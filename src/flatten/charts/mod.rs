@@ -53,10 +53,14 @@
 //! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
 //! visible fault.
 //!
-//! The two sides of a seam (a cut inside a piece, or the edge a gusset shares with its
-//! chart) have the same 3D length; laid flat they are as long as the parameterisation makes
-//! them, equal only where it is isometric: on a non-developable piece they differ by up to
-//! its stretch, which sewing takes up as ease.
+//! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
+//! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
+//! stretch), so both sides of every seam between charts, and of every cut inside one, are as
+//! long flat as in 3D and the stretch a non-developable chart needs is taken up inside it.
+//! Matching raises L2 a little (the inside absorbs what the boundary gave up), so a chart near
+//! the tolerance may be cut further. Layouts over the tolerance are not matched while they are
+//! still to be cut or split; a chart left over it at the end is matched then, or halved when
+//! its matched layout would overlap or flip (`MATCH_ROUNDS` rounds).
 
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
@@ -177,6 +181,9 @@ struct Charts<'a> {
     topo: &'a Topology,
     graph: &'a Graph,
     method: ParamMethod,
+    /// Seams are matched ([`param::match_seams`]) on layouts whose L2 stretch is at most
+    /// this: one over it is cut or split further, which matching would only delay.
+    match_below: f64,
 }
 
 impl Charts<'_> {
@@ -209,6 +216,12 @@ impl Charts<'_> {
                 })
             }
             Err(_) => return Ok(Layout::Refused),
+        };
+        // Seams as long flat as in 3D, the stretch taken up inside (issue 20).
+        let p = if p.stretch.l2 <= self.match_below {
+            param::match_seams(&local, &ids, &p)
+        } else {
+            p
         };
         let mut uv = p.uv;
         if uv.iter().any(|c| c.iter().any(|q| !q.is_finite())) {
@@ -487,6 +500,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         topo: &topology,
         graph: &graph,
         method: opts.method,
+        match_below: opts.tolerance,
     };
     let surface_cuts = edge_ids(&topology, &surface.cuts);
     let mut todo = ctx.initial(&chart_of, &surface_cuts);
@@ -508,6 +522,44 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
     }
     reattach(&ctx, &mut done, opts, overlap_eps);
+    // A chart left over the tolerance gets its seams matched all the same; one whose matched
+    // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
+    let all = Charts {
+        match_below: f64::INFINITY,
+        ..ctx
+    };
+    for _ in 0..MATCH_ROUNDS {
+        let mut keep = Vec::with_capacity(done.len());
+        for mut l in done.drain(..) {
+            if l.stretch.l2 <= opts.tolerance {
+                keep.push(l);
+                continue;
+            }
+            if let Ok(Layout::Laid(uv, s)) = all.lay(&l.faces, &l.cuts) {
+                if s.flipped <= l.stretch.flipped && self_overlap(&uv, overlap_eps).is_none() {
+                    (l.uv, l.stretch) = (uv, s);
+                    keep.push(l);
+                    continue;
+                }
+            }
+            let t = Todo {
+                faces: l.faces.clone(),
+                splits: opts.max_splits,
+                cuts: l.cuts.clone(),
+                cut_off: false,
+            };
+            if l.faces.len() < 2 || !ctx.split_in_two(&mut todo, &t, opts.max_splits) {
+                keep.push(l);
+            }
+        }
+        done = keep;
+        if todo.is_empty() {
+            break;
+        }
+        while let Some(t) = todo.pop() {
+            ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
+        }
+    }
     Ok(assemble(surface, topology, done, opts))
 }
 
@@ -626,3 +678,7 @@ pub fn stretch(flat: &Flat) -> (Vec<Stretch>, Stretch) {
 /// A global overlap is cut off ([`overlap::cut_off`]) when the part cut off has at most this fraction
 /// of the chart's area; a larger one splits the chart between the two overlapping faces.
 const CUT_OFF_AREA: f64 = 0.25;
+
+/// Rounds of matching the seams of charts left over the tolerance (halving those whose
+/// matched layout overlaps or flips) after all charts are laid.
+const MATCH_ROUNDS: usize = 3;

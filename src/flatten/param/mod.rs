@@ -59,8 +59,10 @@ use glam::{DMat2, DVec2, DVec3};
 use std::collections::HashMap;
 
 mod abf;
+mod seams;
 
 use abf::abf_angles;
+pub use seams::match_seams;
 
 /// Smallest triangle angle accepted (radians).
 pub(crate) const MIN_ANGLE: f64 = 1e-3;
@@ -844,6 +846,22 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
             uv[v] = p;
         }
     }
+    match minimise_stretch(chart, uv, &vec![false; nv], STRETCH_SWEEPS) {
+        Some(uv) => finish(mesh, faces, chart, start.method, uv),
+        None => start.clone(),
+    }
+}
+
+/// The sweeps of [`refine`] on a flip-free layout `uv` (per local vertex), the vertices marked
+/// `fixed` left where they are, at most `sweeps` sweeps; `None` when `uv` has a flipped or
+/// collapsed triangle.
+fn minimise_stretch(
+    chart: &Chart,
+    mut uv: Vec<DVec2>,
+    fixed: &[bool],
+    sweeps: usize,
+) -> Option<Vec<DVec2>> {
+    let nv = chart.pos.len();
     let shapes = shapes_from_3d(chart);
     // Per triangle: 3D edge matrix in its own plane, 3D area.
     let q: Vec<DMat2> = shapes
@@ -878,13 +896,11 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
         }
         Some((s, a))
     };
-    let Some((mut s_tot, mut a_tot)) = totals(&uv) else {
-        return start.clone();
-    };
+    let (mut s_tot, mut a_tot) = totals(&uv)?;
     let e0 = s_tot * a_tot;
     let mut e_prev = e0;
-    for _sweep in 0..STRETCH_SWEEPS {
-        for v in 0..nv {
+    for _sweep in 0..sweeps {
+        for v in (0..nv).filter(|&v| !fixed[v]) {
             // Local sums and gradient.
             let (mut s_loc, mut a_loc) = (0.0, 0.0);
             let (mut gs, mut ga) = (DVec2::ZERO, DVec2::ZERO);
@@ -949,9 +965,7 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
             }
         }
         // Fresh sums (no drift), and stop when a sweep gains little.
-        let Some((s, a)) = totals(&uv) else {
-            return start.clone();
-        };
+        let (s, a) = totals(&uv)?;
         s_tot = s;
         a_tot = a;
         let e = s * a;
@@ -960,7 +974,7 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
         }
         e_prev = e;
     }
-    finish(mesh, faces, chart, start.method, uv)
+    Some(uv)
 }
 
 #[cfg(test)]
