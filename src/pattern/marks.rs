@@ -292,7 +292,7 @@ pub fn seam_mismatches(pieces: &[Piece], kind: MaterialKind) -> Vec<(String, Str
     for [(pa, ia), (pb, ib)] in pairs(pieces) {
         let (a, b) = (&pieces[pa].seams[ia], &pieces[pb].seams[ib]);
         let l3 = a.length_3d;
-        if !(l3 > 0.0) || a.split {
+        if l3.is_nan() || l3 <= 0.0 || a.split {
             continue;
         }
         let simplified = pieces[pa].simplified.is_some() || pieces[pb].simplified.is_some();

@@ -209,7 +209,7 @@ pub fn build_to_fit(
     }
     let mut last = pieces;
     let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
-    for _round in 0..8 {
+    for round in 0..8 {
         let mut tags = Vec::new();
         let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
         let mut split_edges: Vec<HashSet<usize>> = Vec::new();
@@ -247,9 +247,11 @@ pub fn build_to_fit(
                 return Err(too_large(p, room));
             }
             // Grown by the overflow (an island that fit as a whole now needs splitting too:
-            // possible only when the piece changed, which the same faces cannot).
+            // possible only when the piece changed, which the same faces cannot), doubled
+            // each round: the estimate can be short by much more than the overflow (a seam
+            // allowance mitred at a sharp corner reaches far past its width).
             let g = grow[fi][ii].get_or_insert(base);
-            *g += 0.5 * over + 0.5;
+            *g += (0.5 * over + 0.5) * f64::from(1u32 << round);
             again = true;
         }
         let offset: Vec<usize> = flats

@@ -9,6 +9,7 @@ mod common;
 mod bent;
 mod boundary;
 mod cli;
+mod corpus;
 mod dcharts;
 mod device;
 mod fandisk;

@@ -70,7 +70,7 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
         .filter(|e| e.2 > 0.0 && e.2.is_finite())
         .collect();
     let before = boundary_error(&uv, &edges);
-    if !(before > EXACT) || nv < 3 {
+    if before.is_nan() || before <= EXACT || nv < 3 {
         return start.clone();
     }
     let shapes = shapes_from_3d(&chart);
@@ -91,7 +91,8 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
     // The inside relaxed to the least L2 stretch the matched boundary allows.
     let relaxed =
         minimise_stretch(&chart, relaxed.clone(), &chart.boundary, SWEEPS).unwrap_or(relaxed);
-    if !(boundary_error(&relaxed, &edges) < before) {
+    let after = boundary_error(&relaxed, &edges);
+    if after.is_nan() || after >= before {
         return start.clone();
     }
     let mut lo = DVec2::splat(f64::INFINITY);
@@ -150,19 +151,19 @@ fn relax(
             for ((tri, s), c) in tris.iter().zip(shapes).zip(cots) {
                 // Best rotation: maximise tr(Rᵀ S), S = Σ cot (uᵢ − uⱼ)(xᵢ − xⱼ)ᵀ.
                 let (mut a, mut b, mut cc, mut d) = (0.0, 0.0, 0.0, 0.0);
-                for k in 0..3 {
+                for (k, &ck) in c.iter().enumerate() {
                     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                     let du = uv[tri[i]] - uv[tri[j]];
                     let dx = s[i] - s[j];
-                    a += c[k] * du.x * dx.x;
-                    b += c[k] * du.x * dx.y;
-                    cc += c[k] * du.y * dx.x;
-                    d += c[k] * du.y * dx.y;
+                    a += ck * du.x * dx.x;
+                    b += ck * du.x * dx.y;
+                    cc += ck * du.y * dx.x;
+                    d += ck * du.y * dx.y;
                 }
                 let r = DVec2::from_angle((cc - b).atan2(a + d));
-                for k in 0..3 {
+                for (k, &ck) in c.iter().enumerate() {
                     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                    let t = c[k] * r.rotate(s[i] - s[j]);
+                    let t = ck * r.rotate(s[i] - s[j]);
                     rhs[tri[i]] += t;
                     rhs[tri[j]] -= t;
                 }
