@@ -579,6 +579,104 @@ fn smooth_detection() {
     let raw = flatcut::surface::obj::read(&manifest("patterns/lampshade.obj")).unwrap();
     let lamp = flatcut::surface::obj::validate(raw, 1.0).unwrap().0;
     assert!(!dcharts::is_smooth(&lamp));
+    // Issue 20: CAD parts of developable patches are segmented (fandisk went face by face,
+    // one piece with over 1,000 fold lines), low-poly models are not.
+    assert!(dcharts::is_smooth(&load("fandisk.obj")));
+    assert!(dcharts::is_smooth(&load("blade.obj")));
+    for m in ["cow.obj", "homer.obj", "knot1.obj", "pig.obj"] {
+        assert!(dcharts::is_smooth(&load(m)), "{m}");
+    }
+    assert!(!dcharts::is_smooth(&frustum(100.0, 0.001, 150.0, 24, 1)));
+    assert!(!dcharts::is_smooth(&uv_sphere(100.0, 24, 12)));
+    // Scale does not change the choice.
+    let mut small = load("fandisk.obj");
+    for v in small.vertices.iter_mut() {
+        *v *= 1e-3;
+    }
+    assert!(dcharts::is_smooth(&small));
+}
+
+/// A UV sphere of `n` meridians and `m` parallels: quads split in two, triangles at the poles.
+fn uv_sphere(r: f64, n: usize, m: usize) -> Mesh {
+    let mut vertices = vec![DVec3::new(0.0, 0.0, r)];
+    for k in 1..m {
+        let th = PI * k as f64 / m as f64;
+        for i in 0..n {
+            let ph = 2.0 * PI * i as f64 / n as f64;
+            vertices.push(r * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
+        }
+    }
+    vertices.push(DVec3::new(0.0, 0.0, -r));
+    let south = vertices.len() - 1;
+    let at = |k: usize, i: usize| 1 + (k - 1) * n + i % n;
+    let mut faces = Vec::new();
+    for i in 0..n {
+        faces.push(Face {
+            verts: vec![0, at(1, i), at(1, i + 1)],
+            line: None,
+        });
+        faces.push(Face {
+            verts: vec![south, at(m - 1, i + 1), at(m - 1, i)],
+            line: None,
+        });
+    }
+    for k in 1..m - 1 {
+        for i in 0..n {
+            push_quad(
+                &mut faces,
+                [at(k, i), at(k + 1, i), at(k + 1, i + 1), at(k, i + 1)],
+            );
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+/// Issue 20: a 24-facet cone and a 24 × 12 UV sphere, cut as a bare OBJ at 300 mm, keep every
+/// facet fold: unfolded face by face, every edge between two facets is a fold line or a cut.
+#[test]
+fn low_poly_cone_and_sphere_keep_every_facet_fold() {
+    let dir = scratch("low_poly_facets");
+    for (name, mesh) in [
+        ("cone24", frustum(100.0, 0.001, 150.0, 24, 1)),
+        ("sphere24x12", uv_sphere(100.0, 24, 12)),
+    ] {
+        let mut obj = String::new();
+        for v in &mesh.vertices {
+            obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+        }
+        for f in &mesh.faces {
+            let ids: Vec<String> = f.verts.iter().map(|v| (v + 1).to_string()).collect();
+            obj += &format!("f {}\n", ids.join(" "));
+        }
+        let path = dir.join(format!("{name}.obj"));
+        std::fs::write(&path, obj).unwrap();
+        let mut spec = flatcut::spec::Spec::from_mesh(&path);
+        spec.size = Some(300.0);
+        let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).expect(name);
+        let flat = &flats[0];
+        assert!(
+            flat.surface.charts.is_none(),
+            "{name}: segmented into charts"
+        );
+        // Facet edges: interior edges bending by more than 1° (quad diagonals are flat).
+        let facet: Vec<usize> = (0..flat.topology.edges.len())
+            .filter(|&e| flat.dihedral[e].abs() > 1f64.to_radians())
+            .collect();
+        let joined = facet.iter().filter(|&&e| flat.joined[e]).count();
+        let folds: usize = pieces
+            .iter()
+            .map(|p| p.folds.iter().filter(|f| !f.tab).count())
+            .sum();
+        println!(
+            "{name}: {} facet edges, {joined} joined, {folds} fold lines, {} pieces",
+            facet.len(),
+            pieces.len()
+        );
+        assert!(facet.len() >= 24, "{name}: {} facet edges", facet.len());
+        // Every joined facet edge is a fold line; the others are cut (seams).
+        assert_eq!(folds, joined, "{name}");
+        assert!(joined > 0);
+    }
 }
 
 /// `vt` lines of an OBJ, in order.

@@ -18,6 +18,9 @@
 //!
 //! [`apply`] reads a mesh surface's spec settings (the DCS approximation of chapter 6 first,
 //! [`super::dcs`]) and stores the charts, their cuts and creases on the [`super::Surface`].
+//! When the spec leaves `segment` out, the mesh decides ([`is_smooth`]) and the surface's
+//! `figures` (report.json) say how: `bent_edges`, `gentle_bend_share` (of those, the share
+//! bending under 10°) and `segmented` (1: charts, 0: face by face).
 //!
 //! Choices where the thesis is silent: the default initial chart count is 8 (the thesis gives
 //! a rough estimate per model, 6 for the fandisk); `η` defaults to 10⁻³, between the thesis'
@@ -36,7 +39,7 @@ mod holes;
 mod merge;
 mod straighten;
 
-pub use creases::is_smooth;
+pub use creases::{bends, is_smooth, Bends};
 use creases::{creases, CREASE_DEG};
 pub use straighten::boundary_length;
 
@@ -255,11 +258,25 @@ pub fn apply(
         dcs::approximate(&mut surface.mesh, &opts)
             .map_err(|e| invalid(format!("DCS approximation: {e}")))?;
     }
-    let mode = seg.mode.unwrap_or(if is_smooth(&surface.mesh) {
-        Segment::Dcharts
-    } else {
-        Segment::Faces
-    });
+    let mode = match seg.mode {
+        Some(m) => m,
+        None => {
+            // Decided from the mesh; report.json says so and why (`figures`).
+            let b = bends(&surface.mesh);
+            surface.figures.push(("bent_edges", b.bent as f64));
+            surface
+                .figures
+                .push(("gentle_bend_share", b.gentle_share()));
+            surface
+                .figures
+                .push(("segmented", f64::from(u8::from(b.smooth()))));
+            if b.smooth() {
+                Segment::Dcharts
+            } else {
+                Segment::Faces
+            }
+        }
+    };
     if mode == Segment::Faces {
         return Ok(());
     }
