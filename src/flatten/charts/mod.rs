@@ -53,6 +53,10 @@
 //! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
 //! visible fault.
 //!
+//! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
+//! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
+//! and without overlap (`merge`).
+//!
 //! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
 //! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
 //! stretch), so both sides of every seam between charts, and of every cut inside one, are as
@@ -73,6 +77,7 @@ use crate::surface::Surface;
 use glam::DVec2;
 
 mod darts;
+mod merge;
 mod overlap;
 
 use darts::{darts, gussets, DART_MIN_FACES};
@@ -522,6 +527,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
     }
     reattach(&ctx, &mut done, opts, overlap_eps);
+    merge::merge_small(&ctx, &mut done, opts, overlap_eps);
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {
