@@ -28,6 +28,7 @@ use glam::DVec2;
 use serde::Serialize;
 
 pub mod allowance;
+pub mod legible;
 pub mod marks;
 pub mod simplify;
 pub mod split;
@@ -247,6 +248,8 @@ pub struct Piece {
     pub grain: Option<f64>,
     /// What simplifying its seams did ([`simplify`]); `None` when they were not simplified.
     pub simplified: Option<simplify::Simplified>,
+    /// Texts left off for want of a clear place ([`legible`]).
+    pub left_out: Vec<legible::LeftOut>,
 }
 
 impl Piece {
@@ -279,6 +282,7 @@ impl Piece {
             label: Text::default(),
             grain: None,
             simplified: None,
+            left_out: Vec::new(),
         }
     }
 
@@ -375,9 +379,13 @@ pub(crate) fn build_tagged(
         }
         marks::place(flat, mine, opts, simplified);
         for p in mine.iter_mut() {
-            marks::finish(flat, p, opts);
+            marks::finish(p, opts);
         }
         allowance::apply(flat, mine, opts);
+        // Texts last, once every stroke is final: moved off each other and off the lines.
+        for p in mine.iter_mut() {
+            legible::place(flat, p, opts);
+        }
     }
     Ok(pieces)
 }
