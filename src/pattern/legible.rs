@@ -313,6 +313,9 @@ impl Grid {
 /// The strokes of a piece that texts keep clear of, and the texts placed so far.
 struct Room {
     border: Vec<Vec<DVec2>>,
+    /// The border's segments and their grid, for the inside test.
+    border_segments: Vec<(DVec2, DVec2)>,
+    border_grid: Grid,
     segments: Vec<(DVec2, DVec2)>,
     grid: Grid,
     texts: Vec<Footprint>,
@@ -340,8 +343,19 @@ impl Room {
         for (k, s) in segments.iter().enumerate() {
             grid.insert_segment(s.0, s.1, k as u32);
         }
+        let border_segments: Vec<(DVec2, DVec2)> = p
+            .border
+            .iter()
+            .flat_map(|r| (0..r.len()).map(move |k| (r[k], r[(k + 1) % r.len()])))
+            .collect();
+        let mut border_grid = Grid::new(lo, hi);
+        for (k, s) in border_segments.iter().enumerate() {
+            border_grid.insert_segment(s.0, s.1, k as u32);
+        }
         Room {
             border: p.border.clone(),
+            border_segments,
+            border_grid,
             segments,
             grid,
             texts: Vec::new(),
@@ -350,10 +364,41 @@ impl Room {
         }
     }
 
+    /// Whether `q` is inside the border (even-odd over its rings, as
+    /// [`polygon::contains_rings`]): the crossings of a ray towards +x, counted on the border
+    /// segments listed in the grid cells it passes.
+    fn inside(&mut self, q: DVec2) -> bool {
+        let g = &self.border_grid;
+        let top = g.lo + DVec2::new(g.nx as f64, g.ny as f64) * g.cell;
+        if !(q.cmpge(g.lo).all() && q.cmple(top).all()) {
+            return false;
+        }
+        let mut ids = std::mem::take(&mut self.scratch);
+        ids.clear();
+        let j = g.row(q.y);
+        for i in g.col(q.x)..g.nx {
+            ids.extend_from_slice(&g.cells[j * g.nx + i]);
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        let mut inside = false;
+        for &k in &ids {
+            let (a, b) = self.border_segments[k as usize];
+            if (a.y > q.y) != (b.y > q.y) {
+                let x = a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if q.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        self.scratch = ids;
+        inside
+    }
+
     /// Whether `f` (already grown by its margin) lies inside the border, crossing no stroke
     /// and no text placed so far.
     fn clear(&mut self, f: &Footprint) -> bool {
-        if !polygon::contains_rings(&self.border, f.center()) {
+        if !self.inside(f.center()) {
             return false;
         }
         let (lo, hi) = f.bounds();
@@ -380,7 +425,7 @@ impl Room {
 
     /// How far `q` is from every stroke and placed text, up to `cap`; 0 outside the border.
     fn clearance(&mut self, q: DVec2, cap: f64) -> f64 {
-        if !polygon::contains_rings(&self.border, q) {
+        if !self.inside(q) {
             return 0.0;
         }
         let (lo, hi) = (q - DVec2::splat(cap), q + DVec2::splat(cap));
@@ -448,42 +493,44 @@ impl Set {
 }
 
 /// The heights tried for a text whose natural height is `h0`: `h0`, then a fifth smaller each
-/// time down to [`MIN_TEXT_MM`] (which is tried last); only `h0` when it is under that.
-fn sizes(h0: f64) -> Vec<f64> {
+/// time down to `floor` (which is tried last); only `h0` when it is not above that.
+fn sizes(h0: f64, floor: f64) -> Vec<f64> {
     if !(h0.is_finite() && h0 > 0.0) {
         return Vec::new();
     }
     let mut out = vec![h0];
+    if floor.is_nan() || floor >= h0 {
+        return out;
+    }
     let mut h = h0 * SHRINK;
-    while h > MIN_TEXT_MM {
+    while h > floor + 1e-9 {
         out.push(h);
         h *= SHRINK;
     }
-    if h0 > MIN_TEXT_MM {
-        out.push(MIN_TEXT_MM);
-    }
+    out.push(floor);
     out
 }
 
 /// A text to write along one of `lines` (each `(a, b, sides)`: the text goes on the left of
-/// `a → b` for side +1, on the right for −1), at most `max_h` high: the first clear place, or
-/// `None`.
+/// `a → b` for side +1, on the right for −1), at most `max_h` high and, if need be, as small
+/// as `floor`: the first clear place, or `None`.
 fn along(
     room: &mut Room,
     words: &str,
     lines: &[(DVec2, DVec2, &[f64])],
     max_h: f64,
+    floor: f64,
 ) -> Option<(Footprint, Text)> {
     let w1 = font::text_width(words, 1.0);
     let longest = lines
         .iter()
         .map(|(a, b, _)| a.distance(*b))
         .fold(0.0, f64::max);
-    if !(w1 > 0.0) {
+    if w1.is_nan() || w1 <= 0.0 {
         return None;
     }
     let h0 = max_h.min(0.8 * longest / w1);
-    for h in sizes(h0) {
+    for h in sizes(h0, floor) {
         let Some(set) = Set::new(words, h) else {
             continue;
         };
@@ -563,10 +610,12 @@ fn settle(p: &mut Piece, opts: &PatternOptions, depths: &[f64]) {
             segs.truncate(MAX_SEGMENTS - 1);
             lines.extend(segs.into_iter().map(|(x, y)| (x, y, &[1.0][..])));
         }
-        let max_h = opts
-            .max_mark_height
-            .min(text_height(&p.marks[mi].text).max(MIN_TEXT_MM));
-        match along(&mut room, &words, &lines, max_h) {
+        // A seam id already under the floor (a small model) is moved, not shrunk.
+        let floor = match text_height(&p.marks[mi].text) {
+            h if h > 0.0 => MIN_TEXT_MM.min(h),
+            _ => MIN_TEXT_MM,
+        };
+        match along(&mut room, &words, &lines, opts.max_mark_height, floor) {
             Some((f, text)) => {
                 room.take(f);
                 p.marks[mi].text = text;
@@ -614,7 +663,9 @@ fn bend_notes(
             room.clear(&fp.grown(MARGIN * h)).then_some((fp, t))
         });
         let lines: [(DVec2, DVec2, &[f64]); 1] = [(f.a, f.b, &[1.0, -1.0])];
-        match first.or_else(|| along(room, &words, &lines, opts.max_mark_height)) {
+        let placed =
+            first.or_else(|| along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM));
+        match placed {
             Some((fp, t)) => {
                 room.take(fp);
                 notes.push(t);
@@ -640,11 +691,11 @@ fn label(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut V
     let Some(f) = Footprint::of(&p.label) else {
         return;
     };
-    if room.clear(&f) {
+    let natural = text_height(&p.label);
+    if room.clear(&f.grown(MARGIN * natural)) {
         room.take(f);
         return;
     }
-    let natural = text_height(&p.label);
     let line2 = format!("#{} {}", p.id, super::marks::side_up(opts.material));
     let layouts = [Some(line2.as_str()), None];
     for line2 in layouts {
@@ -659,7 +710,7 @@ fn label(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut V
             .flatten()
             .map(|q| q.distance(mid))
             .fold(0.0, f64::max);
-        if !(r1 > 0.0) {
+        if r1.is_nan() || r1 <= 0.0 {
             continue;
         }
         let floor = MIN_TEXT_MM.min(natural);
@@ -918,9 +969,42 @@ mod tests {
     }
 
     #[test]
+    fn the_inside_test_agrees_with_the_polygon_one() {
+        // A ring with a hole, tested on a grid of points.
+        let outer: Vec<DVec2> = (0..40)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 40.0;
+                DVec2::new(100.0 * a.cos(), 60.0 * a.sin() + 10.0 * (3.0 * a).sin())
+            })
+            .collect();
+        let hole = vec![
+            DVec2::new(-20.0, -10.0),
+            DVec2::new(-20.0, 10.0),
+            DVec2::new(30.0, 10.0),
+            DVec2::new(30.0, -10.0),
+        ];
+        let mut p = Piece::from_outline(1, "1".into(), outer);
+        p.border.push(hole);
+        let mut room = Room::new(&p);
+        let mut n = 0;
+        for i in -60..=60 {
+            for j in -40..=40 {
+                let q = DVec2::new(1.7 * i as f64 + 0.013, 1.7 * j as f64 + 0.007);
+                assert_eq!(room.inside(q), polygon::contains_rings(&p.border, q), "{q}");
+                n += usize::from(room.inside(q));
+            }
+        }
+        assert!(n > 3000, "{n}");
+    }
+
+    #[test]
     fn sizes_stop_at_the_floor() {
-        assert_eq!(sizes(3.0), vec![3.0, 2.4000000000000004, MIN_TEXT_MM]);
-        assert_eq!(sizes(1.5), vec![1.5]);
-        assert!(sizes(f64::NAN).is_empty());
+        assert_eq!(
+            sizes(3.0, MIN_TEXT_MM),
+            vec![3.0, 2.4000000000000004, MIN_TEXT_MM]
+        );
+        assert_eq!(sizes(1.5, MIN_TEXT_MM), vec![1.5]);
+        assert_eq!(sizes(1.5, 1.2), vec![1.5, 1.2]);
+        assert!(sizes(f64::NAN, MIN_TEXT_MM).is_empty());
     }
 }

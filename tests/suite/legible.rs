@@ -345,6 +345,7 @@ fn fitting_cone_marks_a_shops_bend_lines_by_default() {
     // Lines a brake operator can bump: neighbours at least 20 mm apart at their middles (where
     // the notes are) and 15 mm at the blank's short edge.
     let mids: Vec<DVec2> = bends.iter().map(|f| 0.5 * (f.a + f.b)).collect();
+    let mut gaps = Vec::new();
     for (i, f) in bends.iter().enumerate() {
         let nearest_mid = mids
             .iter()
@@ -353,6 +354,7 @@ fn fitting_cone_marks_a_shops_bend_lines_by_default() {
             .map(|(_, m)| m.distance(mids[i]))
             .fold(f64::INFINITY, f64::min);
         assert!(nearest_mid >= 20.0, "bend {}: {nearest_mid:.1} mm", i + 1);
+        gaps.push(nearest_mid);
         let nearest = bends
             .iter()
             .enumerate()
@@ -361,6 +363,13 @@ fn fitting_cone_marks_a_shops_bend_lines_by_default() {
             .fold(f64::INFINITY, f64::min);
         assert!(nearest >= 15.0, "bend {}: {nearest:.1} mm", i + 1);
     }
+    // Evenly spread, as far as the strip's bridges allow (the curves' points are 7.6 and
+    // 5.5 mm apart).
+    let (lo, hi) = gaps
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), g| (l.min(*g), h.max(*g)));
+    eprintln!("gaps between bend lines' middles: {lo:.1} to {hi:.1} mm");
+    assert!(hi <= 1.25 * lo, "{lo:.1} to {hi:.1} mm");
     // Each line has its note, the same for all, and nothing overlaps.
     assert_eq!(p.notes.len(), n);
     assert!(p.left_out.is_empty(), "{:?}", p.left_out);

@@ -10,13 +10,20 @@
 //! Choices where nothing else decides:
 //! - The bending is shared out by cumulative angle: ruling `k` carries the interval
 //!   `[C(k−1), C(k)]` of the cumulative absolute angle `C`, the total `T` is cut into N equal
-//!   cells, and each cell's line is the ruling whose interval holds the cell's middle. A
-//!   ruling whose interval straddles two cells gives each its part, so on a cone every line
-//!   carries T/N exactly instead of the jitter of whole rulings (12°, 14°, 12°, …). Its sign
-//!   (mountain or valley) is the ruling's own, so the angles always add up to the strip's.
-//!   Only rulings that bend themselves (more than 0.01°) are picked: no line falls inside a
-//!   flat triangle. Cells whose middles fall on the same ruling (a sharp crease that carries
-//!   more than one share) make one line with their sum.
+//!   shares, and a ruling whose interval straddles two shares gives each its part, so on a cone
+//!   every line carries T/N exactly instead of the jitter of whole rulings (12°, 14°, 12°, …).
+//!   Its sign (mountain or valley) is the ruling's own, so the angles always add up to the
+//!   strip's. Only rulings that bend themselves (more than 0.01°) are picked: no line falls
+//!   inside a flat triangle. Shares whose lines fall on the same ruling (a sharp crease that
+//!   carries more than one share) make one line with their sum.
+//! - Which ruling of a share: a strip's bridges come in fans (several bridges from one point of
+//!   a curve), each skewed by up to half a segment of the other curve from the surface's true
+//!   ruling there. The line is the bridge at the share's middle, or one in the middle half of
+//!   the share (by cumulative angle) whose ends lie closer to the true ruling through it (a
+//!   straight line fitted to the bridges' end positions, [`ideal`]) by more than half its
+//!   distance from the middle one. On a Ø300 cone the lines then cut the two edges of the
+//!   blank at even steps, as a shop lays them out, instead of 11 to 16 mm apart along the
+//!   short one.
 //! - N is the largest number of lines that keeps every two neighbours at least
 //!   [`SHOP_MIN_MM`] apart, measured as the `along` positions the caller gives (the distance
 //!   between the bridges' midpoints along the strip: where the notes are written). 20 mm: a
@@ -70,7 +77,7 @@ pub fn picks(rulings: &[Ruling]) -> Vec<(usize, f64)> {
     let (Some(&first), Some(&last)) = (eligible.first(), eligible.last()) else {
         return Vec::new();
     };
-    if !(total > EPS_DEG) {
+    if total.is_nan() || total <= EPS_DEG {
         return Vec::new();
     }
     let length = (rulings[last].along - rulings[first].along).abs();
@@ -137,9 +144,11 @@ fn share(rulings: &[Ruling], eligible: &[usize], total: f64, n: usize) -> Vec<(u
         // Candidates: the rulings in the middle half of the share.
         let (qlo, qhi) = (lo + 0.25 * cell, hi - 0.25 * cell);
         let from = eligible.partition_point(|&j| start[j] + rulings[j].mass() <= qlo);
-        // A straighter ruling wins over the one at the middle by more than a quarter of how
-        // far from it it lies (so a uniform strip keeps its lines evenly spaced).
-        let score = |j: usize| skew(j) + (rulings[j].along - rulings[eligible[k]].along).abs();
+        // A straighter ruling wins over the one at the middle if it is straighter by more
+        // than half of how far from it it lies (so a uniform strip keeps its lines evenly
+        // spaced).
+        let score =
+            |j: usize| skew(j) + 0.5 * (rulings[j].along - rulings[eligible[k]].along).abs();
         let mut pick = (eligible[k], score(eligible[k]));
         for &j in eligible[from..].iter().take_while(|&&j| start[j] < qhi) {
             let s = score(j);
