@@ -1,9 +1,9 @@
 //! Legible finishing (issue 20, item 10): every text on a piece — seam ids, bend notes, the
 //! label — is placed so that its box overlaps no other text and no stroke of another kind
 //! (cut outline, the border, fold lines, tab folds, notches, the sewing line, the grain arrow).
-//! A text that collides where [`super::marks`] put it is moved, then shrunk down to
-//! [`MIN_TEXT_MM`], then left out with a [`LeftOut`] record that the toolpath stage turns into
-//! a `text-left-out` warning naming the piece and the text.
+//! A text that collides where it would go is moved, then shrunk down to [`MIN_TEXT_MM`], then
+//! left out with a [`LeftOut`] record that the toolpath stage turns into a `text-left-out`
+//! warning naming the piece and the text.
 //!
 //! **Boxes.** A text set along a line (`dir` given) keeps its orientation on the piece: the
 //! toolpath stage at most turns it half a turn about its centre to read upright, which maps
@@ -11,37 +11,41 @@
 //! and across it. The label (`dir` none) is turned on the sheet about the centre of its
 //! bounding box to read along the sheet's x axis whatever rotation the nest chose, so what it
 //! may cover is the disc round that centre through its farthest stroke point: the label is
-//! tested as that disc.
+//! tested as that disc ([`Footprint`]).
 //!
-//! **Candidates**, tried in order until one is inside the piece's border and clear, with a
-//! margin of a tenth of the text's height (boxes) or the label's 10 % (discs, as before):
-//! 1. where [`super::marks`] put it (so a piece without collisions keeps every text as it was);
+//! **Candidates**, tried in order until one lies inside the piece's border and clear of every
+//! stroke and every text placed before it, by a tenth of its height:
+//! 1. where it went before this step: a seam id and the label where [`super::marks`] put them
+//!    (so a piece without collisions keeps them as they were), a bend note at the middle of
+//!    its line on either side, as large as the line allows up to the largest mark height;
 //! 2. a seam id along each segment of its seam side, its own (the longest) first, a bend note
-//!    along its bend line on either side: at each size, at the standard gap (a quarter of the
-//!    height) then one and two heights further inward, sliding from the middle of the segment
-//!    towards its ends;
+//!    along its line on either side: at each size, at the standard gap (a quarter of the
+//!    height) then 1¼ and 2½ heights further off, sliding from the middle of the segment
+//!    towards its ends; a text set along a line is never turned off it (a seam id or a bend
+//!    note away from its line says nothing);
 //! 3. the label at the point of the piece farthest from every stroke and every text already
-//!    placed (a best-first search like polylabel's, on that clearance), as large as fits up to
-//!    its largest height, with its two lines, then with its name alone;
-//! 4. sizes from the text's natural height (the largest its line allows) down by a fifth at a
-//!    time to [`MIN_TEXT_MM`]; a text already smaller than that (a small model) is moved but not
-//!    shrunk.
+//!    placed (a best-first search like polylabel's, on that clearance), as large as fits in
+//!    90 % of that clearance (as before, in the inscribed circle) up to its largest height:
+//!    its two lines, else its name alone;
+//! 4. sizes from the text's natural height down by a fifth at a time to [`MIN_TEXT_MM`]; a text
+//!    already smaller than that where it was (a small model) is moved but not shrunk.
 //!
 //! Texts are placed seam ids first (in seam order), then bend notes (in fold order), then the
-//! label, which has the whole piece to choose from; each is tested against the texts placed
-//! before it. Everything is deterministic: fixed candidate orders, ties to the first.
+//! label, which has the whole piece to choose from. Everything is deterministic: fixed
+//! candidate orders, ties to the first.
 //!
 //! **Bounded time.** The strokes of a piece (thousands of fold segments on a fine strip) go
 //! into a uniform grid of at most 128 × 128 cells, each segment into the cells it passes
-//! through; a candidate tests only the segments and texts in the cells its box covers.
+//! through; a candidate tests only the segments and texts listed in the cells its box covers,
+//! and the inside test casts its ray through the cells of one row.
 //!
-//! Choices where the issue is silent: a text set along a line is never turned off it (a seam
-//! id or a bend note away from its line says nothing); bend notes are written by this step, once
-//! the folds are final (tab folds added, folds cut back to the outline), instead of by
-//! [`super::marks::finish`].
+//! Choices where the issue is silent: bend notes are written by this step, once the folds are
+//! final (tab folds added, folds cut back to the outline), no longer kept inside the face
+//! beside the bend (a strip's faces are thin triangles, which made its notes 1–2 mm high): the
+//! collision test keeps them off the other lines; the label keeps its "turn to read upright"
+//! (it is never set along a line to squeeze between folds).
 
 use super::{FoldKind, PatternOptions, Piece, Text};
-use crate::flatten::Flat;
 use crate::geom::{font, polygon};
 use glam::DVec2;
 
@@ -560,27 +564,7 @@ fn along(
 
 /// Places every text of a piece whose strokes are final (see the module doc); writes the bend
 /// notes when `opts.bend_notes`.
-pub(super) fn place(flat: &Flat, p: &mut Piece, opts: &PatternOptions) {
-    // The depth of the face beside each fold: how far marks would let its note reach.
-    let mesh = &flat.surface.mesh;
-    let depths: Vec<f64> = p
-        .folds
-        .iter()
-        .map(|f| {
-            flat.topology
-                .edges
-                .get(f.edge)
-                .and_then(|e| e.uses.first())
-                .map_or(f64::INFINITY, |&(face, _)| {
-                    2.0 * mesh.face_area(face) / f.a.distance(f.b).max(f64::MIN_POSITIVE)
-                })
-        })
-        .collect();
-    settle(p, opts, &depths);
-}
-
-/// [`place`] with the face depth beside each fold given.
-fn settle(p: &mut Piece, opts: &PatternOptions, depths: &[f64]) {
+pub(super) fn place(p: &mut Piece, opts: &PatternOptions) {
     let mut room = Room::new(p);
     let mut left_out = Vec::new();
 
@@ -632,32 +616,29 @@ fn settle(p: &mut Piece, opts: &PatternOptions, depths: &[f64]) {
     p.marks.retain(|m| !m.text.is_empty());
 
     if opts.bend_notes {
-        bend_notes(p, opts, depths, &mut room, &mut left_out);
+        bend_notes(p, opts, &mut room, &mut left_out);
     }
     label(p, opts, &mut room, &mut left_out);
     p.left_out = left_out;
 }
 
-/// `90° UP` (valley) or `90° DOWN` (mountain) beside each bend line (not the tab folds): where
-/// [`super::marks`] would put it (the middle of the bend, inside the face, on either side),
-/// else the first clear place along it.
-fn bend_notes(
-    p: &mut Piece,
-    opts: &PatternOptions,
-    depths: &[f64],
-    room: &mut Room,
-    left_out: &mut Vec<LeftOut>,
-) {
-    let mut notes = Vec::new();
-    for (f, &depth) in p.folds.iter().zip(depths).filter(|(f, _)| !f.tab) {
+/// `90° UP` (valley) or `90° DOWN` (mountain) beside each bend line (not the tab folds): at
+/// the middle of the line on either side, as large as the line allows (up to the largest mark
+/// height), else the first clear place along it; `note_folds` says which line each is beside.
+fn bend_notes(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut Vec<LeftOut>) {
+    let (mut notes, mut note_folds) = (Vec::new(), Vec::new());
+    for (i, f) in p.folds.iter().enumerate() {
+        if f.tab {
+            continue;
+        }
         let way = match f.kind {
             FoldKind::Mountain => "DOWN",
             FoldKind::Valley => "UP",
         };
         let words = format!("{:.0}° {way}", f.angle.to_degrees());
-        // Where marks put it: the middle, inside the face, on either side.
+        // At the middle of the line, on either side, as large as the line allows.
         let first = [(f.a, f.b), (f.b, f.a)].into_iter().find_map(|(a, b)| {
-            let t = super::marks::edge_text(&words, a, b, depth, opts.max_mark_height);
+            let t = super::marks::edge_text(&words, a, b, f64::INFINITY, opts.max_mark_height);
             let fp = Footprint::of(&t)?;
             let h = text_height(&t);
             room.clear(&fp.grown(MARGIN * h)).then_some((fp, t))
@@ -669,6 +650,7 @@ fn bend_notes(
             Some((fp, t)) => {
                 room.take(fp);
                 notes.push(t);
+                note_folds.push(i);
             }
             None => left_out.push(LeftOut {
                 what: "bend note",
@@ -677,6 +659,7 @@ fn bend_notes(
         }
     }
     p.notes = notes;
+    p.note_folds = note_folds;
 }
 
 /// The label where marks put it if it is clear, else at the clearest point of the piece, as
@@ -911,8 +894,7 @@ mod tests {
     #[test]
     fn a_label_with_no_clear_place_is_left_out_and_recorded() {
         let mut p = crowded();
-        let depths = vec![f64::INFINITY; p.folds.len()];
-        settle(&mut p, &PatternOptions::default(), &depths);
+        place(&mut p, &PatternOptions::default());
         assert!(p.label.is_empty());
         assert_eq!(
             p.left_out,
@@ -925,8 +907,7 @@ mod tests {
         // 2.6 mm high (with its second line it would be 1.7 mm, under the floor).
         let mut p = crowded();
         p.folds.retain(|f| !(f.a.x > 12.5 && f.a.x < 23.5));
-        let depths = vec![f64::INFINITY; p.folds.len()];
-        settle(&mut p, &PatternOptions::default(), &depths);
+        place(&mut p, &PatternOptions::default());
         assert!(p.left_out.is_empty(), "{:?}", p.left_out);
         let f = Footprint::of(&p.label).unwrap();
         let Footprint::Disc { c, r } = f else {
@@ -951,8 +932,7 @@ mod tests {
             bend_notes: true,
             ..PatternOptions::default()
         };
-        let depths = vec![f64::INFINITY; n];
-        settle(&mut p, &opts, &depths);
+        place(&mut p, &opts);
         let placed: Vec<Footprint> = p.notes.iter().filter_map(Footprint::of).collect();
         assert_eq!(
             placed.len() + p.left_out.iter().filter(|l| l.what == "bend note").count(),

@@ -235,6 +235,8 @@ pub struct Piece {
     pub notches: Vec<Notch>,
     /// Bend notes (metal): angle and direction beside each bend line.
     pub notes: Vec<Text>,
+    /// The fold (index into `folds`) each note is written beside, in the order of `notes`.
+    pub note_folds: Vec<usize>,
     /// The sewing line, drawn, when the outline carries a seam allowance.
     pub seam_line: Vec<Vec<DVec2>>,
     /// The grain-line arrow (fabric).
@@ -277,6 +279,7 @@ impl Piece {
             seams: Vec::new(),
             notches: Vec::new(),
             notes: Vec::new(),
+            note_folds: Vec::new(),
             seam_line: Vec::new(),
             grain_line: Vec::new(),
             label: Text::default(),
@@ -384,7 +387,7 @@ pub(crate) fn build_tagged(
         allowance::apply(flat, mine, opts);
         // Texts last, once every stroke is final: moved off each other and off the lines.
         for p in mine.iter_mut() {
-            legible::place(flat, p, opts);
+            legible::place(p, opts);
         }
     }
     Ok(pieces)

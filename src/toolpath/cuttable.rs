@@ -125,8 +125,13 @@ fn left_out(p: &Piece) -> Vec<String> {
     seen.into_iter()
         .map(|(what, words, n)| {
             let times = if n > 1 { format!(" ({n} times)") } else { String::new() };
+            let hint = if what == "bend note" {
+                "make the model larger (--size) or mark fewer bend lines (--bend-lines shop or a spacing in mm)"
+            } else {
+                "make the model larger (--size)"
+            };
             format!(
-                "piece {}: {what} \"{words}\" left out{times}: no place clear of the other text and the lines at {MIN_TEXT_MM} mm or more; make the model larger (--size) or mark fewer lines (--bend-lines)",
+                "piece {}: {what} \"{words}\" left out{times}: no place clear of the other text and the lines at {MIN_TEXT_MM} mm or more; {hint}",
                 p.name
             )
         })
