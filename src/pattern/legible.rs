@@ -507,7 +507,7 @@ fn sizes(h0: f64, floor: f64) -> Vec<f64> {
         return out;
     }
     let mut h = h0 * SHRINK;
-    while h > floor + 1e-9 {
+    while h > floor + 1e-9 && out.len() < 8 {
         out.push(h);
         h *= SHRINK;
     }

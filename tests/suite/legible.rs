@@ -454,3 +454,71 @@ fn fitting_cone_with_every_ruling_warns_of_the_notes_left_out() {
     assert!(times > 0 && drawn > 0);
     assert!(stderr(&o).contains("left out"), "{}", stderr(&o));
 }
+
+/// Signed sum (degrees) of a piece's bend lines (mountains positive) and their middles.
+fn bend_sum(pieces: &[Piece]) -> (f64, Vec<DVec2>) {
+    let mut sum = 0.0;
+    let mut mids = Vec::new();
+    for p in pieces {
+        for f in p.folds.iter().filter(|f| !f.tab) {
+            let s = match f.kind {
+                flatcut::pattern::FoldKind::Mountain => 1.0,
+                flatcut::pattern::FoldKind::Valley => -1.0,
+            };
+            sum += s * f.angle.to_degrees();
+            mids.push(0.5 * (f.a + f.b));
+        }
+    }
+    (sum, mids)
+}
+
+#[test]
+fn shop_bend_lines_of_strips_bent_sheets_and_splines_share_the_whole_bend() {
+    use flatcut::surface::strip::BendLines;
+    for name in ["lampshade-strip", "bent-a4", "spline-loft"] {
+        let base = flatcut::spec::load(&manifest(&format!("patterns/{name}.toml"))).unwrap();
+        let with = |lines: BendLines| {
+            let mut spec = base.clone();
+            for s in &mut spec.surfaces {
+                if let Some(st) = &mut s.strip {
+                    st.bend_lines = lines;
+                }
+                if let Some(b) = &mut s.bent {
+                    b.bend_lines = lines;
+                }
+                if let Some(sp) = &mut s.spline {
+                    sp.bend_lines = lines;
+                }
+            }
+            flatcut::pipeline::pieces(&spec, true).unwrap().1
+        };
+        let (all, shop) = (with(BendLines::All), with(BendLines::Shop));
+        let ((sum_all, mids_all), (sum_shop, mids)) = (bend_sum(&all), bend_sum(&shop));
+        eprintln!(
+            "{name}: all {} lines, {sum_all:.2}°; shop {} lines, {sum_shop:.2}°",
+            mids_all.len(),
+            mids.len()
+        );
+        assert!(!mids.is_empty() && mids.len() < mids_all.len(), "{name}");
+        // Rulings under 0.01° carry no line of their own in `all`: the sums differ by at most
+        // those.
+        assert!(
+            (sum_all - sum_shop).abs() <= 0.01 * mids_all.len() as f64 + 1e-6,
+            "{name}: {sum_all} vs {sum_shop}"
+        );
+        for (i, m) in mids.iter().enumerate() {
+            let nearest = mids
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| q.distance(*m))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest >= 15.0,
+                "{name}: line {} {nearest:.1} mm from the next",
+                i + 1
+            );
+        }
+        assert!(shop.iter().all(|p| collisions(p).is_empty()), "{name}");
+    }
+}
