@@ -26,7 +26,10 @@
 //! 3. the label at the point of the piece farthest from every stroke and every text already
 //!    placed (a best-first search like polylabel's, on that clearance), as large as fits in
 //!    90 % of that clearance (as before, in the inscribed circle) up to its largest height:
-//!    its two lines, else its name alone;
+//!    its two lines, else its name alone; then the same in the piece's margin, the part of
+//!    the cut outline outside its border (a glue tab, the seam allowance), still inside the
+//!    outline. A textured piece (printed faces) tries its margin first, so that the label
+//!    goes on a tab rather than over the print;
 //! 4. sizes from the text's natural height down by a fifth at a time to [`MIN_TEXT_MM`]; a text
 //!    already smaller than that where it was (a small model) is moved but not shrunk.
 //!
@@ -314,12 +317,69 @@ impl Grid {
     }
 }
 
+/// Rings (an outer contour and its holes) with their segments in a grid, for a fast inside
+/// test.
+struct Rings {
+    segments: Vec<(DVec2, DVec2)>,
+    grid: Grid,
+}
+
+impl Rings {
+    fn new(rings: &[Vec<DVec2>], lo: DVec2, hi: DVec2) -> Rings {
+        let segments: Vec<(DVec2, DVec2)> = rings
+            .iter()
+            .flat_map(|r| (0..r.len()).map(move |k| (r[k], r[(k + 1) % r.len()])))
+            .collect();
+        let mut grid = Grid::new(lo, hi);
+        for (k, s) in segments.iter().enumerate() {
+            grid.insert_segment(s.0, s.1, k as u32);
+        }
+        Rings { segments, grid }
+    }
+
+    /// Whether `q` is inside (even-odd over the rings, as [`polygon::contains_rings`]): the
+    /// crossings of a ray towards +x, counted on the segments listed in the grid cells it
+    /// passes.
+    fn contains(&self, q: DVec2, ids: &mut Vec<u32>) -> bool {
+        let g = &self.grid;
+        let top = g.lo + DVec2::new(g.nx as f64, g.ny as f64) * g.cell;
+        if !(q.cmpge(g.lo).all() && q.cmple(top).all()) {
+            return false;
+        }
+        ids.clear();
+        let j = g.row(q.y);
+        for i in g.col(q.x)..g.nx {
+            ids.extend_from_slice(&g.cells[j * g.nx + i]);
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        let mut inside = false;
+        for &k in ids.iter() {
+            let (a, b) = self.segments[k as usize];
+            if (a.y > q.y) != (b.y > q.y) {
+                let x = a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if q.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
+/// Where a text may go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Within {
+    /// Inside the border: on the surface itself.
+    Border,
+    /// Inside the cut outline but not the border: on a glue tab or in the seam allowance.
+    Margin,
+}
+
 /// The strokes of a piece that texts keep clear of, and the texts placed so far.
 struct Room {
-    border: Vec<Vec<DVec2>>,
-    /// The border's segments and their grid, for the inside test.
-    border_segments: Vec<(DVec2, DVec2)>,
-    border_grid: Grid,
+    border: Rings,
+    outline: Rings,
     segments: Vec<(DVec2, DVec2)>,
     grid: Grid,
     texts: Vec<Footprint>,
@@ -347,19 +407,9 @@ impl Room {
         for (k, s) in segments.iter().enumerate() {
             grid.insert_segment(s.0, s.1, k as u32);
         }
-        let border_segments: Vec<(DVec2, DVec2)> = p
-            .border
-            .iter()
-            .flat_map(|r| (0..r.len()).map(move |k| (r[k], r[(k + 1) % r.len()])))
-            .collect();
-        let mut border_grid = Grid::new(lo, hi);
-        for (k, s) in border_segments.iter().enumerate() {
-            border_grid.insert_segment(s.0, s.1, k as u32);
-        }
         Room {
-            border: p.border.clone(),
-            border_segments,
-            border_grid,
+            border: Rings::new(&p.border, lo, hi),
+            outline: Rings::new(&p.outline, lo, hi),
             segments,
             grid,
             texts: Vec::new(),
@@ -368,41 +418,28 @@ impl Room {
         }
     }
 
-    /// Whether `q` is inside the border (even-odd over its rings, as
-    /// [`polygon::contains_rings`]): the crossings of a ray towards +x, counted on the border
-    /// segments listed in the grid cells it passes.
-    fn inside(&mut self, q: DVec2) -> bool {
-        let g = &self.border_grid;
-        let top = g.lo + DVec2::new(g.nx as f64, g.ny as f64) * g.cell;
-        if !(q.cmpge(g.lo).all() && q.cmple(top).all()) {
-            return false;
-        }
+    /// Whether `q` lies where a text may go.
+    fn inside(&mut self, q: DVec2, within: Within) -> bool {
         let mut ids = std::mem::take(&mut self.scratch);
-        ids.clear();
-        let j = g.row(q.y);
-        for i in g.col(q.x)..g.nx {
-            ids.extend_from_slice(&g.cells[j * g.nx + i]);
-        }
-        ids.sort_unstable();
-        ids.dedup();
-        let mut inside = false;
-        for &k in &ids {
-            let (a, b) = self.border_segments[k as usize];
-            if (a.y > q.y) != (b.y > q.y) {
-                let x = a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x);
-                if q.x < x {
-                    inside = !inside;
-                }
+        let ok = match within {
+            Within::Border => self.border.contains(q, &mut ids),
+            Within::Margin => {
+                self.outline.contains(q, &mut ids) && !self.border.contains(q, &mut ids)
             }
-        }
+        };
         self.scratch = ids;
-        inside
+        ok
     }
 
     /// Whether `f` (already grown by its margin) lies inside the border, crossing no stroke
     /// and no text placed so far.
     fn clear(&mut self, f: &Footprint) -> bool {
-        if !self.inside(f.center()) {
+        self.clear_within(f, Within::Border)
+    }
+
+    /// [`Self::clear`], inside the border or in the margin outside it.
+    fn clear_within(&mut self, f: &Footprint, within: Within) -> bool {
+        if !self.inside(f.center(), within) {
             return false;
         }
         let (lo, hi) = f.bounds();
@@ -427,9 +464,9 @@ impl Room {
         self.texts.push(f);
     }
 
-    /// How far `q` is from every stroke and placed text, up to `cap`; 0 outside the border.
-    fn clearance(&mut self, q: DVec2, cap: f64) -> f64 {
-        if !self.inside(q) {
+    /// How far `q` is from every stroke and placed text, up to `cap`; 0 where no text may go.
+    fn clearance(&mut self, q: DVec2, cap: f64, within: Within) -> f64 {
+        if !self.inside(q, within) {
             return 0.0;
         }
         let (lo, hi) = (q - DVec2::splat(cap), q + DVec2::splat(cap));
@@ -563,8 +600,8 @@ fn along(
 }
 
 /// Places every text of a piece whose strokes are final (see the module doc); writes the bend
-/// notes when `opts.bend_notes`.
-pub(super) fn place(p: &mut Piece, opts: &PatternOptions) {
+/// notes when `opts.bend_notes`. `textured`: the piece's faces are printed with a texture.
+pub(super) fn place(p: &mut Piece, opts: &PatternOptions, textured: bool) {
     let mut room = Room::new(p);
     let mut left_out = Vec::new();
 
@@ -618,7 +655,7 @@ pub(super) fn place(p: &mut Piece, opts: &PatternOptions) {
     if opts.bend_notes {
         bend_notes(p, opts, &mut room, &mut left_out);
     }
-    label(p, opts, &mut room, &mut left_out);
+    label(p, opts, textured, &mut room, &mut left_out);
     p.left_out = left_out;
 }
 
@@ -663,56 +700,42 @@ fn bend_notes(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &
 }
 
 /// The label where marks put it if it is clear, else at the clearest point of the piece, as
-/// large as fits there: two lines, else the name alone; else left out.
-fn label(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut Vec<LeftOut>) {
-    let words = format!(
-        "{} #{} {}",
-        p.name,
-        p.id,
-        super::marks::side_up(opts.material)
-    );
+/// large as fits there: two lines, else the name alone; else at the clearest point of its
+/// margin (glue tabs, seam allowance), where the outline leaves room; else left out. On a
+/// textured piece, whose faces are printed, the margin comes first: the label goes on a tab
+/// if it fits there, not over the print.
+fn label(
+    p: &mut Piece,
+    opts: &PatternOptions,
+    textured: bool,
+    room: &mut Room,
+    left_out: &mut Vec<LeftOut>,
+) {
+    let side = super::marks::side_up(opts.material);
+    let words = format!("{} #{} {side}", p.name, p.id);
     let Some(f) = Footprint::of(&p.label) else {
         return;
     };
     let natural = text_height(&p.label);
+    let floor = MIN_TEXT_MM.min(natural);
+    let line2 = format!("#{} {side}", p.id);
+    let search = |p: &mut Piece, room: &mut Room, within: Within| {
+        for line2 in [Some(line2.as_str()), None] {
+            if let Some(text) = free_label(&p.name, line2, opts, floor, room, within) {
+                p.label = text;
+                return true;
+            }
+        }
+        false
+    };
+    if textured && search(p, room, Within::Margin) {
+        return;
+    }
     if room.clear(&f.grown(MARGIN * natural)) {
         room.take(f);
         return;
     }
-    let line2 = format!("#{} {}", p.id, super::marks::side_up(opts.material));
-    let layouts = [Some(line2.as_str()), None];
-    for line2 in layouts {
-        // The block at height 1 round the middle of its bounds: radius per mm of height.
-        let unit = super::marks::label_block(&p.name, line2, DVec2::ZERO, 1.0);
-        let Some((lo, hi)) = polygon::bounds(unit.iter().flatten().copied()) else {
-            continue;
-        };
-        let mid = 0.5 * (lo + hi);
-        let r1 = unit
-            .iter()
-            .flatten()
-            .map(|q| q.distance(mid))
-            .fold(0.0, f64::max);
-        if r1.is_nan() || r1 <= 0.0 {
-            continue;
-        }
-        let floor = MIN_TEXT_MM.min(natural);
-        let max_h = opts.max_label_height.max(floor);
-        // The label fills 90 % of the clear disc, as before.
-        let cap = r1 * max_h / 0.9;
-        let Some((c, clear)) = clearest(room, cap, 0.05 * max_h.max(0.1)) else {
-            continue;
-        };
-        let h = (0.9 * clear / r1).min(max_h);
-        if h < floor || h <= 0.0 {
-            continue;
-        }
-        let strokes = super::marks::label_block(&p.name, line2, c - mid * h, h);
-        let text = Text { strokes, dir: None };
-        if let Some(f) = Footprint::of(&text) {
-            room.take(f);
-        }
-        p.label = text;
+    if search(p, room, Within::Border) || (!textured && search(p, room, Within::Margin)) {
         return;
     }
     p.label = Text::default();
@@ -722,13 +745,53 @@ fn label(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut V
     });
 }
 
-/// The point inside the border farthest from every stroke and placed text (up to `cap`), to
+/// A label of `line1` (over `line2`) at the clearest point `within` the piece, as large as
+/// fits in 90 % of the clear disc there (as [`super::marks`] sizes it in the inscribed circle),
+/// at most the largest label height; `None` under `floor`. The label is taken into the room.
+fn free_label(
+    line1: &str,
+    line2: Option<&str>,
+    opts: &PatternOptions,
+    floor: f64,
+    room: &mut Room,
+    within: Within,
+) -> Option<Text> {
+    // The block at height 1 round the middle of its bounds: radius per mm of height.
+    let unit = super::marks::label_block(line1, line2, DVec2::ZERO, 1.0);
+    let (lo, hi) = polygon::bounds(unit.iter().flatten().copied())?;
+    let mid = 0.5 * (lo + hi);
+    let r1 = unit
+        .iter()
+        .flatten()
+        .map(|q| q.distance(mid))
+        .fold(0.0, f64::max);
+    if r1.is_nan() || r1 <= 0.0 {
+        return None;
+    }
+    let max_h = opts.max_label_height.max(floor);
+    let cap = r1 * max_h / 0.9;
+    let (c, clear) = clearest(room, cap, 0.05 * max_h.max(0.1), within)?;
+    let h = (0.9 * clear / r1).min(max_h);
+    if h < floor || h <= 0.0 {
+        return None;
+    }
+    let strokes = super::marks::label_block(line1, line2, c - mid * h, h);
+    let text = Text { strokes, dir: None };
+    room.take(Footprint::of(&text)?);
+    Some(text)
+}
+
+/// The point `within` the piece farthest from every stroke and placed text (up to `cap`), to
 /// within `precision` mm: polylabel's best-first search over square cells on that clearance
 /// (1-Lipschitz, so a cell cannot beat its centre's value plus its half diagonal).
-fn clearest(room: &mut Room, cap: f64, precision: f64) -> Option<(DVec2, f64)> {
+fn clearest(room: &mut Room, cap: f64, precision: f64, within: Within) -> Option<(DVec2, f64)> {
     use std::cmp::Ordering;
     use std::collections::BinaryHeap;
-    let (lo, hi) = polygon::bounds(room.border.first()?.iter().copied())?;
+    let rings = match within {
+        Within::Border => &room.border,
+        Within::Margin => &room.outline,
+    };
+    let (lo, hi) = polygon::bounds(rings.segments.iter().flat_map(|s| [s.0, s.1]))?;
     let size = hi - lo;
     let cell = size.min_element().max(size.max_element() / 256.0);
     if !(cell.is_finite() && cell > 0.0 && cap > 0.0) {
@@ -760,7 +823,7 @@ fn clearest(room: &mut Room, cap: f64, precision: f64) -> Option<(DVec2, f64)> {
     }
     let mut made = 0u64;
     let mut make = |room: &mut Room, c: DVec2, h: f64| {
-        let d = room.clearance(c, cap);
+        let d = room.clearance(c, cap, within);
         made += 1;
         Cell {
             c,
@@ -894,7 +957,7 @@ mod tests {
     #[test]
     fn a_label_with_no_clear_place_is_left_out_and_recorded() {
         let mut p = crowded();
-        place(&mut p, &PatternOptions::default());
+        place(&mut p, &PatternOptions::default(), false);
         assert!(p.label.is_empty());
         assert_eq!(
             p.left_out,
@@ -903,11 +966,41 @@ mod tests {
                 words: "strip #1 OUTSIDE UP".into()
             }]
         );
+        // With a 12 mm margin along the bottom (a wide glue tab): the label goes there, the name
+        // alone.
+        let mut p = crowded();
+        p.outline = vec![vec![
+            DVec2::new(0.0, -12.0),
+            DVec2::new(40.0, -12.0),
+            DVec2::new(40.0, 16.0),
+            DVec2::new(0.0, 16.0),
+        ]];
+        place(&mut p, &PatternOptions::default(), false);
+        assert!(p.left_out.is_empty(), "{:?}", p.left_out);
+        let Some(Footprint::Disc { c, r }) = Footprint::of(&p.label) else {
+            panic!("a label")
+        };
+        assert!(c.y - r >= -12.0 && c.y + r <= 0.0, "{c} {r}");
+        assert!(text_height(&p.label) >= MIN_TEXT_MM);
+        // A textured piece takes the tab even when the face has room.
+        let mut p = crowded();
+        p.folds.clear();
+        p.outline = vec![vec![
+            DVec2::new(0.0, -12.0),
+            DVec2::new(40.0, -12.0),
+            DVec2::new(40.0, 16.0),
+            DVec2::new(0.0, 16.0),
+        ]];
+        place(&mut p, &PatternOptions::default(), true);
+        let Some(Footprint::Disc { c, .. }) = Footprint::of(&p.label) else {
+            panic!("a label")
+        };
+        assert!(c.y < 0.0, "{c}");
         // Seven folds taken away: 12 mm free, a disc of 6 mm radius holds the name alone
         // 2.6 mm high (with its second line it would be 1.7 mm, under the floor).
         let mut p = crowded();
         p.folds.retain(|f| !(f.a.x > 12.5 && f.a.x < 23.5));
-        place(&mut p, &PatternOptions::default());
+        place(&mut p, &PatternOptions::default(), false);
         assert!(p.left_out.is_empty(), "{:?}", p.left_out);
         let f = Footprint::of(&p.label).unwrap();
         let Footprint::Disc { c, r } = f else {
@@ -932,7 +1025,7 @@ mod tests {
             bend_notes: true,
             ..PatternOptions::default()
         };
-        place(&mut p, &opts);
+        place(&mut p, &opts, false);
         let placed: Vec<Footprint> = p.notes.iter().filter_map(Footprint::of).collect();
         assert_eq!(
             placed.len() + p.left_out.iter().filter(|l| l.what == "bend note").count(),
@@ -970,8 +1063,12 @@ mod tests {
         for i in -60..=60 {
             for j in -40..=40 {
                 let q = DVec2::new(1.7 * i as f64 + 0.013, 1.7 * j as f64 + 0.007);
-                assert_eq!(room.inside(q), polygon::contains_rings(&p.border, q), "{q}");
-                n += usize::from(room.inside(q));
+                assert_eq!(
+                    room.inside(q, Within::Border),
+                    polygon::contains_rings(&p.border, q),
+                    "{q}"
+                );
+                n += usize::from(room.inside(q, Within::Border));
             }
         }
         assert!(n > 3000, "{n}");

@@ -386,8 +386,9 @@ pub(crate) fn build_tagged(
         }
         allowance::apply(flat, mine, opts);
         // Texts last, once every stroke is final: moved off each other and off the lines.
+        let textured = flat.surface.texture.is_some();
         for p in mine.iter_mut() {
-            legible::place(p, opts);
+            legible::place(p, opts, textured);
         }
     }
     Ok(pieces)
