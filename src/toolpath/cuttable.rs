@@ -54,7 +54,7 @@ impl CuttableOptions {
 pub struct Warning {
     /// The piece's name, as written on it.
     pub piece: String,
-    /// `piece-too-small`, `text-too-small`, `text-left-out` or `slit-narrower-than-kerf`.
+    /// `piece-too-small`, `text-too-small` or `slit-narrower-than-kerf`.
     pub kind: &'static str,
     /// One line for the user.
     pub message: String,
@@ -113,7 +113,8 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
 }
 
 /// One message per text the pattern stage left off a piece (`pattern::legible`), the same
-/// text left out several times (a bend note on many lines) said once with the count.
+/// text left out several times (a bend note on many lines) said once with the count: warnings
+/// of kind `text-left-out`.
 fn left_out(p: &Piece) -> Vec<String> {
     let mut seen: Vec<(&str, &str, usize)> = Vec::new();
     for l in &p.left_out {
