@@ -147,6 +147,7 @@
 //!   mod.rs                     Pattern stage
 //!   allowance.rs               What a material adds to the border of a piece before it is cut (issue 8, item 2)
 //!   bends.rs                   Which joined edges of a flat become fold (score) or bend lines, and at which angle
+//!   legible.rs                 Legible finishing (issue 20, item 10): every text on a piece clear of the others and of every l…
 //!   marks.rs                   Marks that tell a person which edge goes where and which way up a piece goes
 //!   simplify.rs                Simplified seams for pieces laid out from D-Charts (issue 7, thesis §5.3 "Simplifying boundarie…
 //!   split.rs                   Splitting pieces that do not fit the sheet (issue 21, items 4 and 5): a piece larger than the s…
@@ -227,6 +228,7 @@
 //!     lanes.rs                 The data the cost rows of `super::global` run on
 //!     local.rs                 LODT + LMBT (§4), kept for comparison
 //!     offset.rs                A strip moved by a distance along its surface normals
+//!     shop.rs                  Bend lines as a sheet-metal shop marks them (`bend_lines = "shop"`, the default of `flatcut fit…
 //! toolpath/
 //!   mod.rs                     Toolpath stage
 //!   collect.rs                 The strokes of one sheet, unordered

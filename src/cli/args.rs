@@ -32,10 +32,11 @@ pub struct PatternArgs {
     /// edges or rulings so that every part fits) or none (refuse them). Default: auto.
     #[arg(long, value_enum)]
     pub split: Option<crate::pattern::split::Split>,
-    /// Which rulings of strips, bent sheets and spline surfaces are scored: all, none or one
-    /// every MM millimetres (the angles in between summed); overrides their `bend_lines`.
-    /// Creases of spline surfaces are folds whatever this says.
-    #[arg(long, value_name = "all|none|MM", value_parser = parse_bend_lines)]
+    /// Which rulings of strips, bent sheets and spline surfaces are scored: all, none, one
+    /// every MM millimetres (the angles in between summed) or shop (equal shares of the bend
+    /// on lines at least 20 mm apart); overrides their `bend_lines`. Creases of spline
+    /// surfaces are folds whatever this says.
+    #[arg(long, value_name = "all|none|shop|MM", value_parser = parse_bend_lines)]
     pub bend_lines: Option<BendLines>,
 }
 
@@ -482,15 +483,16 @@ pub fn parse_dpi(s: &str) -> Result<f64, String> {
     }
 }
 
-/// `all`, `none` or a positive number of millimetres.
+/// `all`, `none`, `shop` or a positive number of millimetres.
 pub fn parse_bend_lines(s: &str) -> Result<BendLines, String> {
     match s.trim().to_ascii_lowercase().as_str() {
         "all" => Ok(BendLines::All),
         "none" => Ok(BendLines::None),
+        "shop" => Ok(BendLines::Shop),
         t => match t.parse::<f64>() {
             Ok(v) if v.is_finite() && v > 0.0 => Ok(BendLines::Spacing(v)),
             _ => Err(format!(
-                "expected all, none or a spacing in mm more than 0, got {s:?}"
+                "expected all, none, shop or a spacing in mm more than 0, got {s:?}"
             )),
         },
     }

@@ -7,7 +7,8 @@
 //! 0 (develop the given surface), K to 0.4; the sheet is 2500 × 1250 mm (a common steel sheet)
 //! unless `--sheet-width` / `--sheet-height` say otherwise, with a 10 mm margin; the job is
 //! named after the kind (`cone`, `square-to-round`, …) unless `--name` is given; the device,
-//! as for `cut`, defaults to `sim`.
+//! as for `cut`, defaults to `sim`; bend lines are a shop's (`--bend-lines shop`: equal shares
+//! of the bend at least 20 mm apart), not every ruling of the fine strip.
 
 use super::args::parse_bend_lines;
 use crate::pipeline::{Extras, Search, Toolpath};
@@ -87,9 +88,11 @@ pub struct FittingArgs {
     /// Neutral surface position from the inside face, as a fraction of the thickness.
     #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
     pub k_factor: f64,
-    /// Bend lines: all, none, or a spacing in mm (rulings about that far apart, each with the
-    /// angle accumulated since the previous one).
-    #[arg(long, default_value = "all", value_parser = parse_bend_lines)]
+    /// Bend lines: shop (default: the whole bend in equal shares on lines at least 20 mm
+    /// apart, as a brake operator bumps a cone), all (every ruling that bends, often hundreds
+    /// of a degree or two), none, or a spacing in mm (rulings about that far apart, each with
+    /// the angle accumulated since the previous one).
+    #[arg(long, default_value = "shop", value_parser = parse_bend_lines)]
     pub bend_lines: BendLines,
     /// Chordal tolerance of the curves (mm).
     #[arg(long, default_value_t = crate::geom::curve::DEFAULT_TOLERANCE)]

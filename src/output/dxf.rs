@@ -12,7 +12,10 @@
 //!   `BEND_DOWN`;
 //! - `MARK`: edge ids beside cut edges, open LWPOLYLINEs (single-stroke font);
 //! - `TEXT`: piece labels as strokes, and one TEXT entity per bend line giving its angle
-//!   (`12.5° DOWN`), at the middle of the line, along it.
+//!   (`12.5° DOWN`) where the pattern wrote the bend's note (beside the line, clear of the
+//!   other lines and texts: `pattern::legible`), at the note's height, reading left to right;
+//!   a bend whose note was left out for want of room gets it at the middle of the line, along
+//!   it (CAD and brake software still read every angle).
 //!
 //! Choices: every entity has a handle and its subclass markers, the tables hold the layers and
 //! the CONTINUOUS line type only; coordinates have 4 decimals (0.1 µm).
@@ -108,6 +111,24 @@ impl Dxf {
     }
 }
 
+/// A bend note's box on the sheet as a DXF TEXT takes it: the baseline's left end, the height
+/// and the angle (degrees) of the reading direction, turned to read left to right.
+fn note_box(t: &crate::pattern::Text, place: &crate::nest::Placement) -> Option<(DVec2, f64, f64)> {
+    let r = t.dir?;
+    let o = t.points().next()?;
+    let mut e1 = (place.apply(o + r) - place.apply(o)).try_normalize()?;
+    if e1.x < -1e-9 || (e1.x.abs() <= 1e-9 && e1.y < 0.0) {
+        e1 = -e1;
+    }
+    let e2 = e1.perp();
+    let (lo, hi) = crate::geom::polygon::bounds(t.points().map(|q| {
+        let s = place.apply(q);
+        DVec2::new(s.dot(e1), s.dot(e2))
+    }))?;
+    let h = hi.y - lo.y;
+    (h > 0.0).then_some((e1 * lo.x + e2 * lo.y, h, e1.y.atan2(e1.x).to_degrees()))
+}
+
 /// The DXF text of one sheet of a layout.
 pub fn render(layout: &Layout, sheet: usize) -> String {
     let mut d = Dxf {
@@ -156,7 +177,7 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
             for n in &piece.notches {
                 d.polyline(if n.cut { "CUT" } else { "MARK" }, &map(&n.stroke), false);
             }
-            for f in &piece.folds {
+            for (i, f) in piece.folds.iter().enumerate() {
                 let (a, b) = (place.apply(f.a), place.apply(f.b));
                 let (layer, word) = match f.kind {
                     FoldKind::Valley => ("BEND_UP", "UP"),
@@ -166,19 +187,27 @@ pub fn render(layout: &Layout, sheet: usize) -> String {
                 if f.tab {
                     continue;
                 }
-                let dir = b - a;
-                let mut ang = dir.y.atan2(dir.x).to_degrees();
-                if !(-90.0..=90.0).contains(&ang) {
-                    ang += 180.0;
+                let words = format!("{:.1}%%d {word}", f.angle.to_degrees());
+                // Where the pattern wrote the bend's note, clear of the lines and the other
+                // texts; a bend whose note was left out gets its text on the line's middle.
+                let note = piece
+                    .note_folds
+                    .iter()
+                    .position(|&k| k == i)
+                    .and_then(|j| piece.notes.get(j))
+                    .and_then(|t| note_box(t, place));
+                match note {
+                    Some((at, h, ang)) => d.text("TEXT", at, h, ang, &words),
+                    None => {
+                        let dir = b - a;
+                        let mut ang = dir.y.atan2(dir.x).to_degrees();
+                        if !(-90.0..=90.0).contains(&ang) {
+                            ang += 180.0;
+                        }
+                        let h = (0.04 * a.distance(b)).clamp(1.0, 3.0);
+                        d.text("TEXT", 0.5 * (a + b), h, ang, &words);
+                    }
                 }
-                let h = (0.04 * a.distance(b)).clamp(1.0, 3.0);
-                d.text(
-                    "TEXT",
-                    0.5 * (a + b),
-                    h,
-                    ang,
-                    &format!("{:.1}%%d {word}", f.angle.to_degrees()),
-                );
             }
             for m in &piece.marks {
                 for s in &m.text.strokes {

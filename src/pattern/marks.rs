@@ -27,9 +27,10 @@
 //! **Grain line** (fabric): along the long side of the piece's minimum-area rectangle, the
 //! longest chord in that direction that keeps clear of the label, 70 % of it, with arrowheads
 //! at both ends. **Bend notes** (metal): `90° UP` (valley) or `90° DOWN` (mountain) beside each
-//! bend line: which way the flange goes with the marked side up.
+//! bend line: which way the flange goes with the marked side up; written, and every text here
+//! moved off the lines and texts it would cover, by [`super::legible`].
 
-use super::{EdgeMark, FoldKind, Notch, PatternOptions, Piece};
+use super::{EdgeMark, Notch, PatternOptions, Piece};
 use crate::flatten::Flat;
 use crate::geom::{font, polygon};
 use crate::surface::MaterialKind;
@@ -433,47 +434,23 @@ fn room_inward(p: &Piece, ring: usize, k: usize) -> f64 {
     }
 }
 
-/// Label, grain line, bend notes and notch strokes of a piece whose seams are known.
-pub(super) fn finish(flat: &Flat, p: &mut Piece, opts: &PatternOptions) {
-    let side = match opts.material {
-        MaterialKind::Fabric => "RIGHT SIDE UP",
-        _ => "OUTSIDE UP",
-    };
-    let (label, label_r) = label(p, side, opts.max_label_height);
+/// Label and grain line of a piece whose seams are known (bend notes are written once the
+/// folds are final, by [`super::legible`]).
+pub(super) fn finish(p: &mut Piece, opts: &PatternOptions) {
+    let (label, label_r) = label(p, side_up(opts.material), opts.max_label_height);
     p.label = label;
     if opts.grain {
         let (dir, strokes) = grain_line(p, label_r);
         p.grain = Some(dir.y.atan2(dir.x));
         p.grain_line = strokes;
     }
-    if opts.bend_notes {
-        let mesh = &flat.surface.mesh;
-        let topo = &flat.topology;
-        for f in p.folds.iter().filter(|f| !f.tab) {
-            let (face, _) = topo.edges[f.edge].uses[0];
-            let depth = 2.0 * mesh.face_area(face) / f.a.distance(f.b).max(f64::MIN_POSITIVE);
-            let way = match f.kind {
-                FoldKind::Mountain => "DOWN",
-                FoldKind::Valley => "UP",
-            };
-            let text = format!("{:.0}° {way}", f.angle.to_degrees());
-            // Beside the bend on either side, smaller if need be, but always on the piece: a
-            // note that sticks out of the outline would be drawn off the blank (and off the
-            // sheet, where the nest leaves no room for it). None fits: no note; the bend line
-            // and the DXF still carry the angle.
-            let fits = |t: &Text| {
-                !t.is_empty() && t.points().all(|q| polygon::contains_rings(&p.border, q))
-            };
-            let found = [1.0, 0.6, 0.36].into_iter().find_map(|k| {
-                [(f.a, f.b), (f.b, f.a)].into_iter().find_map(|(a, b)| {
-                    let t = edge_text(&text, a, b, depth, k * opts.max_mark_height);
-                    fits(&t).then_some(t)
-                })
-            });
-            if let Some(t) = found {
-                p.notes.push(t);
-            }
-        }
+}
+
+/// Which side of the material the label says faces up.
+pub(super) fn side_up(material: MaterialKind) -> &'static str {
+    match material {
+        MaterialKind::Fabric => "RIGHT SIDE UP",
+        _ => "OUTSIDE UP",
     }
 }
 
@@ -594,22 +571,9 @@ fn label(p: &Piece, side: &str, max_h: f64) -> (Text, f64) {
     // Two lines when they can be at least 1.5 mm high, else the name alone.
     let (w1, _) = block(1.0);
     let h2 = (1.8 * r / (w1 * w1 + 4.0).sqrt()).min(max_h);
-    let mut strokes = Vec::new();
     if h2 >= 1.5 {
-        // Line 1 (h) sits on the centre, 0.4 h above line 2 (0.6 h): a block 2 h high.
         let (w, hh) = block(h2);
-        let (s1, wa) = font::text_strokes(&line1, h2);
-        let (s2, wb) = font::text_strokes(&line2, 0.6 * h2);
-        let o1 = center + DVec2::new(-0.5 * wa, 0.0);
-        let o2 = center + DVec2::new(-0.5 * wb, -h2);
-        strokes.extend(
-            s1.into_iter()
-                .map(|s| s.into_iter().map(|q| q + o1).collect()),
-        );
-        strokes.extend(
-            s2.into_iter()
-                .map(|s| s.into_iter().map(|q| q + o2).collect()),
-        );
+        let strokes = label_block(&line1, Some(&line2), center, h2);
         return (Text { strokes, dir: None }, 0.5 * (w * w + hh * hh).sqrt());
     }
     let k = font::text_width(&line1, 1.0);
@@ -617,13 +581,41 @@ fn label(p: &Piece, side: &str, max_h: f64) -> (Text, f64) {
     if h.is_nan() || h <= 0.0 {
         return (Text::default(), 0.0);
     }
-    let (s1, w) = font::text_strokes(&line1, h);
-    let o = center - DVec2::new(0.5 * w, 0.5 * h);
-    strokes.extend(
-        s1.into_iter()
-            .map(|s| s.into_iter().map(|q| q + o).collect()),
-    );
+    let w = font::text_width(&line1, h);
+    let strokes = label_block(&line1, None, center, h);
     (Text { strokes, dir: None }, 0.5 * (w * w + h * h).sqrt())
+}
+
+/// The strokes of a label block at height `h` round `center`: with a second line, line 1 (`h`
+/// high) sits on the centre, 0.4 h above line 2 (0.6 h high), a block 2 h high; alone, line 1
+/// is centred on it. Linear in `center` and `h`.
+pub(super) fn label_block(
+    line1: &str,
+    line2: Option<&str>,
+    center: DVec2,
+    h: f64,
+) -> Vec<Vec<DVec2>> {
+    let mut strokes = Vec::new();
+    let mut put = |words: &str, h: f64, o: DVec2| {
+        let (s, _) = font::text_strokes(words, h);
+        strokes.extend(
+            s.into_iter()
+                .map(|s| s.into_iter().map(|q| q + o).collect()),
+        );
+    };
+    match line2 {
+        Some(line2) => {
+            let wa = font::text_width(line1, h);
+            let wb = font::text_width(line2, 0.6 * h);
+            put(line1, h, center + DVec2::new(-0.5 * wa, 0.0));
+            put(line2, 0.6 * h, center + DVec2::new(-0.5 * wb, -h));
+        }
+        None => {
+            let w = font::text_width(line1, h);
+            put(line1, h, center - DVec2::new(0.5 * w, 0.5 * h));
+        }
+    }
+    strokes
 }
 
 /// Grain direction (unit) and the arrow: the longest chord along it that keeps `label_r + 2`

@@ -28,6 +28,7 @@ use glam::DVec2;
 use serde::Serialize;
 
 pub mod allowance;
+pub mod legible;
 pub mod marks;
 pub mod simplify;
 pub mod split;
@@ -234,6 +235,8 @@ pub struct Piece {
     pub notches: Vec<Notch>,
     /// Bend notes (metal): angle and direction beside each bend line.
     pub notes: Vec<Text>,
+    /// The fold (index into `folds`) each note is written beside, in the order of `notes`.
+    pub note_folds: Vec<usize>,
     /// The sewing line, drawn, when the outline carries a seam allowance.
     pub seam_line: Vec<Vec<DVec2>>,
     /// The grain-line arrow (fabric).
@@ -247,6 +250,8 @@ pub struct Piece {
     pub grain: Option<f64>,
     /// What simplifying its seams did ([`simplify`]); `None` when they were not simplified.
     pub simplified: Option<simplify::Simplified>,
+    /// Texts left off for want of a clear place ([`legible`]).
+    pub left_out: Vec<legible::LeftOut>,
 }
 
 impl Piece {
@@ -274,11 +279,13 @@ impl Piece {
             seams: Vec::new(),
             notches: Vec::new(),
             notes: Vec::new(),
+            note_folds: Vec::new(),
             seam_line: Vec::new(),
             grain_line: Vec::new(),
             label: Text::default(),
             grain: None,
             simplified: None,
+            left_out: Vec::new(),
         }
     }
 
@@ -375,9 +382,14 @@ pub(crate) fn build_tagged(
         }
         marks::place(flat, mine, opts, simplified);
         for p in mine.iter_mut() {
-            marks::finish(flat, p, opts);
+            marks::finish(p, opts);
         }
         allowance::apply(flat, mine, opts);
+        // Texts last, once every stroke is final: moved off each other and off the lines.
+        let textured = flat.surface.texture.is_some();
+        for p in mine.iter_mut() {
+            legible::place(p, opts, textured);
+        }
     }
     Ok(pieces)
 }

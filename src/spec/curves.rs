@@ -19,7 +19,8 @@ use std::path::Path;
 use toml::{Spanned, Value};
 
 impl Ctx<'_> {
-    /// `bend_lines` of a strip or a bent sheet: "all" (default), "none" or a spacing in mm.
+    /// `bend_lines` of a strip or a bent sheet: "all" (default), "none", "shop" (equal shares
+    /// of the bend on lines at least 20 mm apart) or a spacing in mm.
     pub(super) fn bend_lines(
         &self,
         v: &Option<Spanned<Val>>,
@@ -32,11 +33,12 @@ impl Ctx<'_> {
         match v.get_ref() {
             Val::Str(t) if t.trim().eq_ignore_ascii_case("all") => Ok(BendLines::All),
             Val::Str(t) if t.trim().eq_ignore_ascii_case("none") => Ok(BendLines::None),
+            Val::Str(t) if t.trim().eq_ignore_ascii_case("shop") => Ok(BendLines::Shop),
             Val::Num(x) if x.is_finite() && *x > 0.0 => Ok(BendLines::Spacing(*x)),
             _ => Err(self.expected(
                 v,
                 &format!("{key}.bend_lines"),
-                "\"all\", \"none\" or a positive spacing in millimetres",
+                "\"all\", \"none\", \"shop\" or a positive spacing in millimetres",
             )),
         }
     }

@@ -77,6 +77,7 @@ pub struct FittingOptions {
     pub thickness: f64,
     /// Position of the neutral surface from the inside face, as a fraction of the thickness.
     pub k_factor: f64,
+    /// Which rulings become bend lines; default: a shop's ([`BendLines::Shop`]).
     pub bend_lines: BendLines,
     /// Chordal tolerance of the curves (mm).
     pub tolerance: f64,
@@ -87,7 +88,7 @@ impl Default for FittingOptions {
         FittingOptions {
             thickness: 0.0,
             k_factor: 0.4,
-            bend_lines: BendLines::All,
+            bend_lines: BendLines::Shop,
             tolerance: crate::geom::curve::DEFAULT_TOLERANCE,
         }
     }
@@ -467,7 +468,7 @@ mod tests {
         let slant = (70.0f64 * 70.0 + 200.0 * 200.0).sqrt();
         let exact = PI * (150.0 + 80.0) * slant;
         assert!((area(&s) - exact).abs() / exact < 1e-3, "{}", area(&s));
-        // Rulings: all bend lines, each a mountain, adding up to the cone's total turn.
+        // A shop's bend lines (the default), each a mountain.
         let bends = s.bends.as_ref().unwrap();
         assert!(bends.iter().all(|b| b.angle_deg > 0.0));
         // 2 mm, K 0.4: the neutral radii are 1.2 mm / cos(β) smaller.
@@ -500,7 +501,13 @@ mod tests {
             height: 200.0,
             offset: 0.0,
         };
-        let all = surface(&cone, &FittingOptions::default());
+        let all = surface(
+            &cone,
+            &FittingOptions {
+                bend_lines: BendLines::All,
+                ..FittingOptions::default()
+            },
+        );
         let total: f64 = all
             .bends
             .as_ref()

@@ -1,5 +1,6 @@
 //! Features a device cannot make, found before anything is cut (issue 21): a piece smaller
-//! than the blade can turn in, seam ids or a label smaller than 2 mm, and slits (narrow gaps of
+//! than the blade can turn in, seam ids or a label smaller than 2 mm, texts the pattern stage
+//! left out for want of a clear place (issue 20, `pattern::legible`), and slits (narrow gaps of
 //! a piece's border) narrower than the kerf. Each is a [`Warning`] naming the piece, printed
 //! and listed in `report.json`; nothing is refused (a model of implausible size as a whole is
 //! refused earlier, by `surface::size`).
@@ -20,8 +21,9 @@ use crate::geom::polygon;
 use crate::pattern::{Piece, Text};
 use glam::DVec2;
 
-/// Smallest height of text (mm) a knife scores or a pen draws legibly.
-pub const MIN_TEXT_MM: f64 = 2.0;
+/// Smallest height of text (mm) a knife scores or a pen draws legibly: the pattern stage's
+/// floor, below which it shrinks no text to make room.
+pub use crate::pattern::legible::MIN_TEXT_MM;
 /// Border rings with more segments than this are not searched for slits.
 pub const MAX_SLIT_SEGMENTS: usize = 4000;
 
@@ -95,6 +97,7 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
                 ),
             ));
         }
+        out.extend(left_out(p).into_iter().map(|m| warn("text-left-out", m)));
         if o.kerf > 0.0 {
             if let Some((gap, at)) = narrowest_slit(p, o.kerf) {
                 out.push(warn(
@@ -108,6 +111,33 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
         }
     }
     out
+}
+
+/// One message per text the pattern stage left off a piece (`pattern::legible`), the same
+/// text left out several times (a bend note on many lines) said once with the count: warnings
+/// of kind `text-left-out`.
+fn left_out(p: &Piece) -> Vec<String> {
+    let mut seen: Vec<(&str, &str, usize)> = Vec::new();
+    for l in &p.left_out {
+        match seen.iter_mut().find(|s| s.0 == l.what && s.1 == l.words) {
+            Some(s) => s.2 += 1,
+            None => seen.push((l.what, &l.words, 1)),
+        }
+    }
+    seen.into_iter()
+        .map(|(what, words, n)| {
+            let times = if n > 1 { format!(" ({n} times)") } else { String::new() };
+            let hint = if what == "bend note" {
+                "make the model larger (--size) or mark fewer bend lines (--bend-lines shop or a spacing in mm)"
+            } else {
+                "make the model larger (--size)"
+            };
+            format!(
+                "piece {}: {what} \"{words}\" left out{times}: no place clear of the other text and the lines at {MIN_TEXT_MM} mm or more; {hint}",
+                p.name
+            )
+        })
+        .collect()
 }
 
 /// The smaller side of the smallest enclosing rectangle of a piece's outer outline.
@@ -211,7 +241,23 @@ mod tests {
             strokes: vec![vec![DVec2::new(10.0, 10.0), DVec2::new(10.0, 11.5)]],
             dir: None,
         };
+        p.left_out.push(crate::pattern::legible::LeftOut {
+            what: "bend note",
+            words: "2° DOWN".into(),
+        });
+        p.left_out.push(crate::pattern::legible::LeftOut {
+            what: "bend note",
+            words: "2° DOWN".into(),
+        });
         let w = check(&[p], &o);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(w[1].kind, "text-left-out");
+        assert!(
+            w[1].message
+                .starts_with("piece 3: bend note \"2° DOWN\" left out (2 times)"),
+            "{}",
+            w[1].message
+        );
         assert_eq!(w[0].kind, "text-too-small");
         assert!(w[0].message.contains("1.50 mm high"), "{}", w[0].message);
         // A U with a 0.2 mm slot between its arms, 20 mm deep.

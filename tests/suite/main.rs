@@ -18,6 +18,7 @@ mod gpgl;
 mod grbl_firmware;
 mod house;
 mod knife;
+mod legible;
 mod nest;
 mod param;
 mod pattern;

@@ -330,14 +330,32 @@ fn strip_dxf_reads_back_with_outline_on_cut_and_bends_on_bend_layers() {
     assert!(text.contains("AC1015"));
     let drawing = dxf::Drawing::load_file(out.join("cone.dxf")).expect("dxf crate reads it");
     let (mut cut, mut down, mut up, mut texts) = (Vec::new(), 0, 0, 0);
+    let (mut lines, mut at) = (Vec::new(), Vec::new());
     for e in drawing.entities() {
         match (&e.specific, e.common.layer.as_str()) {
             (dxf::entities::EntityType::LwPolyline(p), "CUT") => cut.push(p.clone()),
-            (dxf::entities::EntityType::Line(_), "BEND_DOWN") => down += 1,
+            (dxf::entities::EntityType::Line(l), "BEND_DOWN") => {
+                down += 1;
+                lines.push((
+                    glam::DVec2::new(l.p1.x, l.p1.y),
+                    glam::DVec2::new(l.p2.x, l.p2.y),
+                ));
+            }
             (dxf::entities::EntityType::Line(_), "BEND_UP") => up += 1,
-            (dxf::entities::EntityType::Text(_), "TEXT") => texts += 1,
+            (dxf::entities::EntityType::Text(t), "TEXT") => {
+                texts += 1;
+                at.push(glam::DVec2::new(t.location.x, t.location.y));
+            }
             _ => {}
         }
+    }
+    // Each angle text starts beside its bend line, where the note is, not on it.
+    for q in &at {
+        let d = lines
+            .iter()
+            .map(|(a, b)| flatcut::geom::polygon::segment_distance(*q, *a, *b))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d > 0.5, "angle text at {q}, {d:.3} mm from a bend line");
     }
     assert_eq!(cut.len(), 1);
     assert!(cut[0].is_closed());

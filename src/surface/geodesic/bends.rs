@@ -2,7 +2,7 @@
 //!
 //! Bend lines: every fold is a ruling and a bend line with its angle (`bend_lines = "all"`),
 //! none, or one every `spacing` mm along each line carrying the angle accumulated since the
-//! previous one, as strips do.
+//! previous one, as strips do, or a shop's equal shares ([`crate::surface::strip::shop`]).
 //!
 //! A bend's angle is signed: positive for a mountain seen from the printed side (+z).
 
@@ -37,6 +37,9 @@ pub(super) fn pick_bends(rulings: &[Ruling], forward_left: &[bool], lines: BendL
     let mut acc = 0.0;
     let mut last: Option<(usize, f64)> = None;
     let mut pending: Option<usize> = None;
+    if lines == BendLines::Shop {
+        return shop_bends(rulings, forward_left);
+    }
     for (r, &fl) in rulings.iter().zip(forward_left) {
         let Some(piece) = r.piece else { continue };
         let deg = signed_deg(r, fl);
@@ -73,11 +76,46 @@ pub(super) fn pick_bends(rulings: &[Ruling], forward_left: &[bool], lines: BendL
                     last = Some((piece, r.s));
                 }
             }
+            BendLines::Shop => {}
         }
     }
     if let Some(i) = pending {
         add_to_last(&mut out, i, acc);
     }
+    out
+}
+
+/// A shop's bend lines ([`crate::surface::strip::shop`]), each piece on its own: equal
+/// shares of its bend on rulings at least the shop spacing apart along the line.
+fn shop_bends(rulings: &[Ruling], forward_left: &[bool]) -> Vec<Bend> {
+    let mut out = Vec::new();
+    let mut group: Vec<(&Ruling, f64)> = Vec::new();
+    let flush = |group: &mut Vec<(&Ruling, f64)>, out: &mut Vec<Bend>| {
+        let along_deg: Vec<crate::surface::strip::shop::Ruling> = group
+            .iter()
+            .map(|(r, d)| crate::surface::strip::shop::Ruling::at(r.s, *d))
+            .collect();
+        for (k, angle_deg) in crate::surface::strip::shop::picks(&along_deg) {
+            for e in &group[k].0.edges {
+                out.push(Bend {
+                    verts: *e,
+                    angle_deg,
+                });
+            }
+        }
+        group.clear();
+    };
+    for (r, &fl) in rulings.iter().zip(forward_left) {
+        let Some(piece) = r.piece else { continue };
+        if group.first().is_some_and(|(g, _)| g.piece != Some(piece)) {
+            flush(&mut group, &mut out);
+        }
+        // A ruling with no edges on the mesh cannot carry a line: left out.
+        if !r.edges.is_empty() {
+            group.push((r, signed_deg(r, fl)));
+        }
+    }
+    flush(&mut group, &mut out);
     out
 }
 

@@ -726,8 +726,8 @@ fn angle_defect(mesh: &Mesh, verts: &[usize]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Bend lines on the rulings per `lines` (as strips pick them: all, none, or a spacing with
-/// the angles in between summed).
+/// Bend lines on the rulings per `lines` (as strips pick them: all, none, a spacing with the
+/// angles in between summed, or a shop's equal shares).
 fn bends(mesh: &Mesh, rulings: &[(usize, usize, usize)], lines: BendLines) -> Vec<Bend> {
     const EPS_DEG: f64 = 0.01;
     let mut out: Vec<Bend> = Vec::new();
@@ -735,6 +735,8 @@ fn bends(mesh: &Mesh, rulings: &[(usize, usize, usize)], lines: BendLines) -> Ve
     let mut along = 0.0;
     let mut last_pick = 0.0;
     let mut prev_mid: Option<DVec3> = None;
+    // Shop: every ruling (vertices, mm along, signed degrees), picked after the walk.
+    let mut seen: Vec<([usize; 2], f64, f64)> = Vec::new();
     for &(f, g, corner) in rulings {
         let (va, vb) = crate::geom::mesh::Topology::corner_verts(mesh, f, corner);
         let mid = 0.5 * (mesh.vertices[va] + mesh.vertices[vb]);
@@ -768,10 +770,24 @@ fn bends(mesh: &Mesh, rulings: &[(usize, usize, usize)], lines: BendLines) -> Ve
                     last_pick = along;
                 }
             }
+            BendLines::Shop => seen.push((verts, along, deg)),
         }
     }
     if let (BendLines::Spacing(_), Some(last)) = (lines, out.last_mut()) {
         last.angle_deg += f64::to_degrees(acc);
+    }
+    if lines == BendLines::Shop {
+        let along_deg: Vec<super::strip::shop::Ruling> = seen
+            .iter()
+            .map(|s| super::strip::shop::Ruling::at(s.1, s.2))
+            .collect();
+        out = super::strip::shop::picks(&along_deg)
+            .into_iter()
+            .map(|(k, angle_deg)| Bend {
+                verts: seen[k].0,
+                angle_deg,
+            })
+            .collect();
     }
     out
 }

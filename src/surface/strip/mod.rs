@@ -39,6 +39,7 @@ mod global;
 mod lanes;
 mod local;
 mod offset;
+pub mod shop;
 
 use super::Bend;
 use crate::geom::curve::Polyline;
@@ -91,6 +92,9 @@ pub enum BendLines {
     /// bends after it). Only rulings that bend themselves are picked, so no bend line falls
     /// inside a flat triangle.
     Spacing(f64),
+    /// As a sheet-metal shop marks them ([`shop`]): equal shares of the whole bend, on lines
+    /// at least [`shop::SHOP_MIN_MM`] apart. The default of `flatcut fitting`.
+    Shop,
 }
 
 /// Two boundary polylines ready to triangulate.
@@ -422,6 +426,20 @@ impl Strip {
         let mid = |k: usize| 0.5 * (self.p[b[k].0] + self.q[b[k].1]);
         let mut along = 0.0;
         let mut last_pick = 0.0;
+        // Shop: every ruling (vertices, where it is), picked after the walk.
+        let mut seen: Vec<([usize; 2], shop::Ruling)> = Vec::new();
+        let arc = |pts: &[DVec3]| -> Vec<f64> {
+            let mut out = vec![0.0];
+            for w in pts.windows(2) {
+                out.push(out[out.len() - 1] + w[0].distance(w[1]));
+            }
+            out
+        };
+        let (arc_p, arc_q) = if lines == BendLines::Shop {
+            (arc(&self.p), arc(&self.q))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         for k in 1..steps.len() {
             along += mid(k).distance(mid(k - 1));
             let (i, j) = b[k];
@@ -456,7 +474,28 @@ impl Strip {
                         last_pick = along;
                     }
                 }
+                BendLines::Shop => seen.push((
+                    verts,
+                    shop::Ruling {
+                        along,
+                        ends: [
+                            arc_p.get(i).copied().unwrap_or(along),
+                            arc_q.get(j).copied().unwrap_or(along),
+                        ],
+                        deg: signed.to_degrees(),
+                    },
+                )),
             }
+        }
+        if lines == BendLines::Shop {
+            let rulings: Vec<shop::Ruling> = seen.iter().map(|s| s.1).collect();
+            out = shop::picks(&rulings)
+                .into_iter()
+                .map(|(k, angle_deg)| Bend {
+                    verts: seen[k].0,
+                    angle_deg,
+                })
+                .collect();
         }
         // What bent after the last pick belongs to it (so the angles add up to the total).
         if let (BendLines::Spacing(_), Some(last)) = (lines, out.last_mut()) {
