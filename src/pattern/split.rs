@@ -209,7 +209,8 @@ pub fn build_to_fit(
     }
     let mut last = pieces;
     let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
-    for round in 0..8 {
+    let mut stuck: HashMap<(usize, usize), u32> = HashMap::new();
+    for _round in 0..8 {
         let mut tags = Vec::new();
         let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
         let mut split_edges: Vec<HashSet<usize>> = Vec::new();
@@ -248,10 +249,19 @@ pub fn build_to_fit(
             }
             // Grown by the overflow (an island that fit as a whole now needs splitting too:
             // possible only when the piece changed, which the same faces cannot), doubled
-            // each round: the estimate can be short by much more than the overflow (a seam
-            // allowance mitred at a sharp corner reaches far past its width).
+            // each round the island still came out whole: the estimate can be short by much
+            // more than the overflow (a seam allowance mitred at a sharp corner reaches far
+            // past its width), while a part of a split island is only a little too large.
+            let whole = cache
+                .get(&(fi, ii))
+                .is_none_or(|(_, parts)| parts.len() <= 1);
+            let k = stuck.entry((fi, ii)).or_insert(0u32);
+            let factor = if whole { f64::from(1u32 << *k) } else { 1.0 };
+            if whole {
+                *k += 1;
+            }
             let g = grow[fi][ii].get_or_insert(base);
-            *g += (0.5 * over + 0.5) * f64::from(1u32 << round);
+            *g += (0.5 * over + 0.5) * factor;
             again = true;
         }
         let offset: Vec<usize> = flats
