@@ -17,6 +17,42 @@ pub(crate) const SMALL_SHARE: f64 = 0.01;
 /// Neighbours tried per small piece.
 pub(crate) const MERGE_TRIES: usize = 3;
 
+/// Lay `done[k]` and `done[part]` out as one chart (the cuts of both, more where the union is
+/// not a disk); when that is flip-free, within the tolerance and without overlap, it becomes
+/// `done[k]` and true is returned (`done[part]` is left for the caller to drop).
+pub(super) fn merge_into(
+    ctx: &Charts,
+    done: &mut [Laid],
+    k: usize,
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> bool {
+    let mut faces = done[k].faces.clone();
+    faces.extend(&done[part].faces);
+    let mut cuts = done[k].cuts.clone();
+    cuts.extend(&done[part].cuts);
+    cuts.sort_unstable();
+    cuts.dedup();
+    let Some(cuts) = ctx.disk(&faces, &cuts) else {
+        return false;
+    };
+    let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
+        return false;
+    };
+    if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
+        return false;
+    }
+    done[k] = Laid {
+        faces,
+        cuts,
+        uv,
+        stretch: s,
+        gusset: false,
+    };
+    true
+}
+
 /// Merge the small pieces of `done` into neighbours (see the module doc).
 pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     let nf = ctx.mesh.faces.len();
@@ -53,33 +89,13 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
         let mut cands: Vec<(f64, usize)> = shared.into_iter().map(|(k, l)| (l, k)).collect();
         cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
         for &(_, k) in cands.iter().take(MERGE_TRIES) {
-            let mut faces = done[k].faces.clone();
-            faces.extend(&done[si].faces);
-            let mut cuts = done[k].cuts.clone();
-            cuts.extend(&done[si].cuts);
-            cuts.sort_unstable();
-            cuts.dedup();
-            let Some(cuts) = ctx.disk(&faces, &cuts) else {
-                continue;
-            };
-            let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
-                continue;
-            };
-            if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
-                continue;
+            if merge_into(ctx, done, k, si, opts, eps) {
+                for &f in &done[si].faces {
+                    owner[f] = k;
+                }
+                gone[si] = true;
+                break;
             }
-            for &f in &done[si].faces {
-                owner[f] = k;
-            }
-            done[k] = Laid {
-                faces,
-                cuts,
-                uv,
-                stretch: s,
-                gusset: false,
-            };
-            gone[si] = true;
-            break;
         }
     }
     let mut k = 0;

@@ -388,31 +388,12 @@ pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions
                 Some(err) if err < opts.reattach_eta => {}
                 _ => continue,
             }
-            let mut faces = done[k].faces.clone();
-            faces.extend(&done[gi].faces);
-            let mut cuts = done[k].cuts.clone();
-            cuts.extend(&done[gi].cuts);
-            cuts.sort_unstable();
-            cuts.dedup();
-            let Some(cuts) = ctx.disk(&faces, &cuts) else {
-                continue;
-            };
-            let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
-                continue;
-            };
-            if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
+            if !super::merge::merge_into(ctx, done, k, gi, opts, eps) {
                 continue;
             }
             for &f in &done[gi].faces {
                 owner[f] = k;
             }
-            done[k] = Laid {
-                faces,
-                cuts,
-                uv,
-                stretch: s,
-                gusset: false,
-            };
             gone[gi] = true;
             break;
         }
