@@ -196,8 +196,10 @@ fn check(name: &str, mesh: &str, scale: f64, tol: f64) {
         let (h0, h1) = (id_heights(p0), id_heights(p1));
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         min_id_mean = min_id_mean.min(mean(&h1));
+        // Legibility (`pattern::legible`) may shrink an id that would cross a line; the
+        // average stays within 10 % of the unsimplified piece's.
         assert!(
-            mean(&h1) >= mean(&h0) - 1e-9,
+            mean(&h1) >= 0.9 * mean(&h0) - 1e-9,
             "{}: seam ids {:.2} mm high on average, {:.2} before simplifying",
             p1.name,
             mean(&h1),

@@ -8,50 +8,14 @@
 //! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too.
 //! The merged chart keeps the cuts of both (and more where it is not a disk).
 
-use super::overlap::self_overlap;
-use super::{Charts, FlattenOptions, Laid, Layout};
+use super::overlap::merge_into;
+use super::{Charts, FlattenOptions, Laid};
 use std::collections::BTreeMap;
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
 /// Neighbours tried per small piece.
 pub(crate) const MERGE_TRIES: usize = 3;
-
-/// Lay `done[k]` and `done[part]` out as one chart (the cuts of both, more where the union is
-/// not a disk); when that is flip-free, within the tolerance and without overlap, it becomes
-/// `done[k]` and true is returned (`done[part]` is left for the caller to drop).
-pub(super) fn merge_into(
-    ctx: &Charts,
-    done: &mut [Laid],
-    k: usize,
-    part: usize,
-    opts: &FlattenOptions,
-    eps: f64,
-) -> bool {
-    let mut faces = done[k].faces.clone();
-    faces.extend(&done[part].faces);
-    let mut cuts = done[k].cuts.clone();
-    cuts.extend(&done[part].cuts);
-    cuts.sort_unstable();
-    cuts.dedup();
-    let Some(cuts) = ctx.disk(&faces, &cuts) else {
-        return false;
-    };
-    let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
-        return false;
-    };
-    if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
-        return false;
-    }
-    done[k] = Laid {
-        faces,
-        cuts,
-        uv,
-        stretch: s,
-        gusset: false,
-    };
-    true
-}
 
 /// Merge the small pieces of `done` into neighbours (see the module doc).
 pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {

@@ -328,6 +328,42 @@ impl Sides {
     }
 }
 
+/// Lay `done[k]` and `done[part]` out as one chart (the cuts of both, more where the union is
+/// not a disk); when that is flip-free, within the tolerance and without overlap, it becomes
+/// `done[k]` and true is returned (`done[part]` is left for the caller to drop).
+pub(super) fn merge_into(
+    ctx: &Charts,
+    done: &mut [Laid],
+    k: usize,
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> bool {
+    let mut faces = done[k].faces.clone();
+    faces.extend(&done[part].faces);
+    let mut cuts = done[k].cuts.clone();
+    cuts.extend(&done[part].cuts);
+    cuts.sort_unstable();
+    cuts.dedup();
+    let Some(cuts) = ctx.disk(&faces, &cuts) else {
+        return false;
+    };
+    let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
+        return false;
+    };
+    if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
+        return false;
+    }
+    done[k] = Laid {
+        faces,
+        cuts,
+        uv,
+        stretch: s,
+        gusset: false,
+    };
+    true
+}
+
 /// Re-attach each gusset (and each part cut off for overlapping) to an adjacent piece when
 /// the merging criterion of §5.2.3 holds and the merge creates no new overlap (§5.3): the
 /// neighbours are tried by the length of the common boundary, longest first (ties: lower
@@ -388,7 +424,7 @@ pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions
                 Some(err) if err < opts.reattach_eta => {}
                 _ => continue,
             }
-            if !super::merge::merge_into(ctx, done, k, gi, opts, eps) {
+            if !merge_into(ctx, done, k, gi, opts, eps) {
                 continue;
             }
             for &f in &done[gi].faces {
