@@ -171,6 +171,12 @@ fn place_item(
     best
 }
 
+/// The first item (in index order) that does not fit alone in an empty container `max_len`
+/// long: what to name when no search could place everything.
+pub(crate) fn unplaceable(ctx: &mut Ctx, max_len: f64) -> Option<usize> {
+    (0..ctx.prob.items.len()).find(|&i| place_item(ctx, i, &[], max_len, &mut false).is_none())
+}
+
 /// Bottom-left fill of a strip.
 pub(crate) fn fill_strip(ctx: &mut Ctx, order: &[usize]) -> Option<State> {
     let mut st = State::default();

@@ -55,9 +55,20 @@ pub(crate) fn solve(prob: &Problem, cfg: &Config) -> Result<Solution, Unfit> {
             best = Some(r);
         }
     }
-    best.ok_or(Unfit {
-        item: 0,
-        size: DVec2::ZERO,
+    best.ok_or_else(|| {
+        // Name the item that does not fit alone (the searches only say that one failed).
+        let max_len = match prob.container {
+            Container::Strip { .. } => f64::INFINITY,
+            Container::Bins { length, .. } => length,
+        };
+        let mut ctx = Ctx::new(prob, cfg.seed, cfg.seconds);
+        let item = construct::unplaceable(&mut ctx, max_len).unwrap_or(0);
+        let size = prob
+            .items
+            .get(item)
+            .and_then(|it| it.shapes.first())
+            .map_or(DVec2::ZERO, |s| s.size);
+        Unfit { item, size }
     })
 }
 
