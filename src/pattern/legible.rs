@@ -785,7 +785,7 @@ fn free_label(
 /// within `precision` mm: polylabel's best-first search over square cells on that clearance
 /// (1-Lipschitz, so a cell cannot beat its centre's value plus its half diagonal).
 fn clearest(room: &mut Room, cap: f64, precision: f64, within: Within) -> Option<(DVec2, f64)> {
-    use std::cmp::Ordering;
+    use crate::geom::heap::Lowest;
     use std::collections::BinaryHeap;
     let rings = match within {
         Within::Border => &room.border,
@@ -797,40 +797,16 @@ fn clearest(room: &mut Room, cap: f64, precision: f64, within: Within) -> Option
     if !(cell.is_finite() && cell > 0.0 && cap > 0.0) {
         return None;
     }
-    struct Cell {
-        c: DVec2,
-        h: f64,
-        d: f64,
-        max: f64,
-        n: u64,
-    }
-    impl PartialEq for Cell {
-        fn eq(&self, o: &Self) -> bool {
-            self.cmp(o) == Ordering::Equal
-        }
-    }
-    impl Eq for Cell {}
-    impl PartialOrd for Cell {
-        fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-            Some(self.cmp(o))
-        }
-    }
-    impl Ord for Cell {
-        // Largest bound first; among equals the cell made first.
-        fn cmp(&self, o: &Self) -> Ordering {
-            self.max.total_cmp(&o.max).then(o.n.cmp(&self.n))
-        }
-    }
-    let mut made = 0u64;
+    // Largest bound first (the smallest key of `Lowest` is its negation); among equals the
+    // cell made first. Each cell carries its centre, half side and clearance.
+    let mut made = 0usize;
     let mut make = |room: &mut Room, c: DVec2, h: f64| {
         let d = room.clearance(c, cap, within);
         made += 1;
-        Cell {
-            c,
-            h,
-            d,
-            max: (d + h * std::f64::consts::SQRT_2).min(cap),
-            n: made,
+        Lowest {
+            key: -(d + h * std::f64::consts::SQRT_2).min(cap),
+            id: made,
+            data: (c, h, d),
         }
     };
     let mut heap = BinaryHeap::new();
@@ -845,26 +821,31 @@ fn clearest(room: &mut Room, cap: f64, precision: f64, within: Within) -> Option
             heap.push(make(room, c, h));
         }
     }
-    let mut best: Option<Cell> = None;
+    let mut best: Option<(DVec2, f64)> = None;
     let mut steps = 0usize;
-    while let Some(cell) = heap.pop() {
-        if best.as_ref().is_none_or(|b| cell.d > b.d) {
-            best = Some(Cell { ..cell });
+    while let Some(Lowest {
+        key,
+        data: (c, h, d),
+        ..
+    }) = heap.pop()
+    {
+        if best.is_none_or(|b| d > b.1) {
+            best = Some((c, d));
         }
-        let top = best.as_ref().map_or(0.0, |b| b.d);
+        let top = best.map_or(0.0, |b| b.1);
         if top >= cap {
             break;
         }
-        if cell.max - top <= precision || steps > 20_000 {
+        if -key - top <= precision || steps > 20_000 {
             continue;
         }
         steps += 1;
-        let h = 0.5 * cell.h;
+        let h = 0.5 * h;
         for (dx, dy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
-            heap.push(make(room, cell.c + DVec2::new(dx * h, dy * h), h));
+            heap.push(make(room, c + DVec2::new(dx * h, dy * h), h));
         }
     }
-    best.filter(|b| b.d > 0.0).map(|b| (b.c, b.d))
+    best.filter(|b| b.1 > 0.0)
 }
 
 /// Height of a text: its tallest stroke across its reading direction (as the toolpath stage

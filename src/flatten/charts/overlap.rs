@@ -378,28 +378,11 @@ pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions
         return;
     }
     let nf = ctx.mesh.faces.len();
-    let mut owner = vec![usize::MAX; nf];
-    for (k, l) in done.iter().enumerate() {
-        for &f in &l.faces {
-            owner[f] = k;
-        }
-    }
-    let mut gone = vec![false; done.len()];
+    let mut owners = Owners::new(nf, done);
     let mut order: Vec<usize> = (0..done.len()).filter(|&k| done[k].gusset).collect();
     order.sort_by_key(|&k| done[k].faces.iter().copied().min().unwrap_or(0));
     for gi in order {
-        let mut shared: std::collections::BTreeMap<usize, f64> = Default::default();
-        for &f in &done[gi].faces {
-            for &(h, len) in &ctx.graph.adj[f] {
-                let k = owner[h];
-                if k != gi && k != usize::MAX && !gone[k] {
-                    *shared.entry(k).or_default() += len;
-                }
-            }
-        }
-        let mut cands: Vec<(f64, usize)> = shared.into_iter().map(|(k, l)| (l, k)).collect();
-        cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-        for (_, k) in cands {
+        for k in owners.neighbours(ctx, done, gi) {
             // Two rings of the neighbour around the common boundary, and the gusset.
             let mut region: Vec<usize> = done[gi].faces.clone();
             let mut mark = vec![false; nf];
@@ -411,7 +394,7 @@ pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions
                 let mut next = Vec::new();
                 for &f in &front {
                     for &(h, _) in &ctx.graph.adj[f] {
-                        if owner[h] == k && !mark[h] {
+                        if owners.owner[h] == k && !mark[h] {
                             mark[h] = true;
                             next.push(h);
                         }
@@ -424,19 +407,67 @@ pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions
                 Some(err) if err < opts.reattach_eta => {}
                 _ => continue,
             }
-            if !merge_into(ctx, done, k, gi, opts, eps) {
-                continue;
+            if merge_into(ctx, done, k, gi, opts, eps) {
+                owners.absorb(done, k, gi);
+                break;
             }
-            for &f in &done[gi].faces {
-                owner[f] = k;
-            }
-            gone[gi] = true;
-            break;
         }
     }
-    let mut k = 0;
-    done.retain(|_| {
-        k += 1;
-        !gone[k - 1]
-    });
+    owners.drop_gone(done);
+}
+
+/// Which laid chart owns each face while charts are merged ([`reattach`], `merge`), and
+/// which charts a merge has emptied.
+pub(super) struct Owners {
+    pub(super) owner: Vec<usize>,
+    pub(super) gone: Vec<bool>,
+}
+
+impl Owners {
+    pub(super) fn new(nf: usize, done: &[Laid]) -> Owners {
+        let mut owner = vec![usize::MAX; nf];
+        for (k, l) in done.iter().enumerate() {
+            for &f in &l.faces {
+                owner[f] = k;
+            }
+        }
+        Owners {
+            owner,
+            gone: vec![false; done.len()],
+        }
+    }
+
+    /// The charts next to `done[part]`, by the length of boundary they share with it
+    /// (longest first, ties: lower chart).
+    pub(super) fn neighbours(&self, ctx: &Charts, done: &[Laid], part: usize) -> Vec<usize> {
+        let mut shared: std::collections::BTreeMap<usize, f64> = Default::default();
+        for &f in &done[part].faces {
+            for &(h, len) in &ctx.graph.adj[f] {
+                let k = self.owner[h];
+                if k != part && k != usize::MAX && !self.gone[k] {
+                    *shared.entry(k).or_default() += len;
+                }
+            }
+        }
+        let mut cands: Vec<(f64, usize)> = shared.into_iter().map(|(k, l)| (l, k)).collect();
+        cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        cands.into_iter().map(|(_, k)| k).collect()
+    }
+
+    /// `done[part]` was merged into `done[k]`.
+    pub(super) fn absorb(&mut self, done: &[Laid], k: usize, part: usize) {
+        for &f in &done[part].faces {
+            self.owner[f] = k;
+        }
+        self.gone[part] = true;
+    }
+
+    /// Drop the charts merged into others.
+    pub(super) fn drop_gone(&self, done: &mut Vec<Laid>) {
+        let mut k = 0;
+        done.retain(|_| {
+            k += 1;
+            !self.gone[k - 1]
+        });
+    }
 }

@@ -840,16 +840,22 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
         return start.clone();
     }
     let nv = chart.pos.len();
-    let mut uv = vec![DVec2::ZERO; nv];
-    for (cs, pts) in chart.corners.iter().zip(&start.uv) {
-        for (&v, &p) in cs.iter().zip(pts) {
-            uv[v] = p;
-        }
-    }
+    let uv = vertex_uv(chart, &start.uv);
     match minimise_stretch(chart, uv, &vec![false; nv], STRETCH_SWEEPS) {
         Some(uv) => finish(mesh, faces, chart, start.method, uv),
         None => start.clone(),
     }
+}
+
+/// A layout per chart face corner as one position per local vertex.
+fn vertex_uv(chart: &Chart, face_uv: &[Vec<DVec2>]) -> Vec<DVec2> {
+    let mut uv = vec![DVec2::ZERO; chart.pos.len()];
+    for (cs, pts) in chart.corners.iter().zip(face_uv) {
+        for (&v, &p) in cs.iter().zip(pts) {
+            uv[v] = p;
+        }
+    }
+    uv
 }
 
 /// The sweeps of [`refine`] on a flip-free layout `uv` (per local vertex), the vertices marked

@@ -22,7 +22,7 @@
 //!   nearer the 3D lengths; else the start is returned as it was. A chart whose boundary is
 //!   within [`EXACT`] of its 3D lengths is returned at once (an exactly developable chart).
 
-use super::{build_chart, minimise_stretch, shapes_from_3d, ChartParam};
+use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
 use faer::linalg::solvers::Solve;
@@ -55,12 +55,7 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
         return start.clone();
     };
     let nv = chart.pos.len();
-    let mut uv = vec![DVec2::ZERO; nv];
-    for (cs, pts) in chart.corners.iter().zip(&start.uv) {
-        for (&v, &p) in cs.iter().zip(pts) {
-            uv[v] = p;
-        }
-    }
+    let uv = vertex_uv(&chart, &start.uv);
     let bl = &chart.boundary_loop;
     let edges: Vec<(usize, usize, f64)> = (0..bl.len())
         .map(|k| {
@@ -239,12 +234,7 @@ mod tests {
         let chart = build_chart(&mesh, &faces).expect("chart");
         let rim = |uv: &[Vec<DVec2>]| -> (f64, f64) {
             // Flat and 3D length of the rim (the last ring of faces' outer edges).
-            let mut flat = vec![DVec2::ZERO; chart.pos.len()];
-            for (cs, pts) in chart.corners.iter().zip(uv) {
-                for (&v, &q) in cs.iter().zip(pts) {
-                    flat[v] = q;
-                }
-            }
+            let flat = vertex_uv(&chart, uv);
             let bl = &chart.boundary_loop;
             let (mut a, mut b) = (0.0, 0.0);
             for k in 0..bl.len() {
