@@ -89,6 +89,11 @@ pub struct Surface {
     /// The textures of a mesh read from an OBJ with materials and `vt` (printed onto the
     /// flat faces by the output stage); `None` for none.
     pub texture: Option<std::sync::Arc<texture::Texture>>,
+    /// A mesh's shape at [`size::SHAPE_MM`] across, as its segmentation saw it: the flatten
+    /// stage decides on these vertices and scales what it lays out to the millimetres of
+    /// `mesh`, so that the same model at any size gives the same pieces (issue 20, item 5).
+    /// `None` for surfaces not read from a mesh (their sizes are part of their design).
+    pub shape: Option<size::Shape>,
 }
 
 /// A bend line chosen by the surface source: a mesh edge (its two vertices) and the signed
@@ -174,11 +179,15 @@ fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             let mut raw = import::read(&spec.path)?;
             let texture = raw.texture.take().map(std::sync::Arc::new);
             let texture_warnings = std::mem::take(&mut raw.texture_warnings);
+            let raw_extent = size::extent(&raw.mesh);
             let scale = match spec.size {
-                Some(s) => size::factor_for(size::extent(&raw.mesh), s),
+                Some(s) => size::factor_for(raw_extent, s),
                 None => spec.scale * spec.units.mm(),
             };
-            let (mesh, mut warnings) = obj::validate(raw, scale)?;
+            // Checked, repaired and segmented at one size whatever the size asked for (the
+            // checks' thresholds are relative; the segmentation's decisions then are too).
+            let canonical = size::factor_for(raw_extent, size::SHAPE_MM);
+            let (mesh, mut warnings) = obj::validate(raw, canonical)?;
             warnings.extend(texture_warnings);
             let mut surface = Surface {
                 name: spec.name.clone(),
@@ -192,6 +201,11 @@ fn build_as_given(spec: &SurfaceSpec) -> Result<Surface, SurfaceError> {
             };
             // Smooth meshes (issue 7): DCS approximation and D-Charts segmentation.
             dcharts::apply(&mut surface, &spec.segment)?;
+            surface.shape = Some(size::Shape {
+                vertices: surface.mesh.vertices.clone(),
+                to_mm: 1.0,
+            });
+            surface.scale(scale / canonical);
             Ok(surface)
         }
         SurfaceKind::Strip => build_strip(spec),

@@ -12,6 +12,10 @@
 //!   spec `size`) is never refused.
 //! - Scaling a built surface scales its mesh and alternatives; bend angles, charts and cuts
 //!   are unchanged (a uniform scale keeps angles).
+//! - A mesh is checked, segmented and flattened at one size, [`SHAPE_MM`] across, whatever
+//!   size it is cut at ([`Shape`]; issue 20, item 5): the same model at 30 mm and at 3 m gives
+//!   the same pieces, bit for bit, and only the finishing in millimetres (seam
+//!   simplification, tabs, splitting to fit the sheet) differs.
 
 use super::{Surface, SurfaceError, Units};
 use crate::geom::mesh::Mesh;
@@ -22,6 +26,18 @@ use std::path::Path;
 pub const MIN_MM: f64 = 10.0;
 /// Largest plausible model, mm across.
 pub const MAX_MM: f64 = 10_000.0;
+
+/// The size (mm across) at which a mesh's shape is checked, segmented and laid flat
+/// ([`Shape`]).
+pub const SHAPE_MM: f64 = 300.0;
+
+/// A mesh's vertices at [`SHAPE_MM`] across and the factor from them to the surface's
+/// millimetres.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shape {
+    pub vertices: Vec<DVec3>,
+    pub to_mm: f64,
+}
 
 /// The bounding box's sides (x, y, z) of the vertices used by faces; zero for no faces.
 pub fn extent(mesh: &Mesh) -> DVec3 {
@@ -75,8 +91,12 @@ pub fn factor_for(extent: DVec3, size: f64) -> f64 {
 }
 
 impl Surface {
-    /// Scale the surface (its mesh and alternatives) uniformly by `f`.
+    /// Scale the surface (its mesh and alternatives) uniformly by `f`; its [`Shape`] stays
+    /// as it is, with `f` more to the millimetres.
     pub fn scale(&mut self, f: f64) {
+        if let Some(s) = &mut self.shape {
+            s.to_mm *= f;
+        }
         for v in &mut self.mesh.vertices {
             *v *= f;
         }

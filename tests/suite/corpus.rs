@@ -168,3 +168,63 @@ fn corpus_every_mesh_in_every_material() {
         }
     }
 }
+
+/// Issue 20, item 5: the pieces are decided on the shape, not on its size. The same mesh at
+/// 30 mm, 300 mm and 3 m gives the same pieces, face for face, and each layout is the 300 mm
+/// one scaled (to rounding); the mushroom is charted, the pig is charted with darts and
+/// merges, fandisk goes through D-Charts' creases.
+#[test]
+fn corpus_pieces_do_not_depend_on_the_size() {
+    for name in ["mushroom.obj", "pig.obj", "fandisk.obj"] {
+        let mesh = shared_data("meshes").join(name);
+        let flat_at = |size: f64| {
+            let mut spec = Spec::from_mesh(&mesh);
+            spec.size = Some(size);
+            let mut surfaces = flatcut::pipeline::sized_surfaces(&spec).unwrap();
+            let opts = charts::FlattenOptions::for_material(MaterialKind::Paper);
+            charts::flatten(surfaces.remove(0), &opts).unwrap()
+        };
+        let base = flat_at(300.0);
+        assert!(
+            base.islands.len() > 1,
+            "{name}: {} pieces",
+            base.islands.len()
+        );
+        for size in [30.0, 3000.0] {
+            let flat = flat_at(size);
+            let what = format!("{name} at {size} mm");
+            assert_eq!(
+                flat.islands, base.islands,
+                "{what}: other pieces than at 300 mm"
+            );
+            assert_eq!(flat.joined, base.joined, "{what}: other folds and seams");
+            let k = size / 300.0;
+            let worst = flat
+                .face_2d
+                .iter()
+                .flatten()
+                .zip(base.face_2d.iter().flatten())
+                .map(|(p, q)| p.distance(*q * k) / size)
+                .fold(0.0, f64::max);
+            assert!(
+                worst < 1e-12,
+                "{what}: layout off the 300 mm one by {worst:e} of the size"
+            );
+            // The layout is in the surface's millimetres: its edges as long as in 3D.
+            let m = &flat.surface.mesh;
+            let mut sum = (0.0, 0.0);
+            for (f, face) in m.faces.iter().enumerate() {
+                let n = face.verts.len();
+                for i in 0..n {
+                    let (a, b) = (face.verts[i], face.verts[(i + 1) % n]);
+                    sum.0 += m.vertices[a].distance(m.vertices[b]);
+                    sum.1 += flat.face_2d[f][i].distance(flat.face_2d[f][(i + 1) % n]);
+                }
+            }
+            assert!(
+                (sum.1 / sum.0 - 1.0).abs() < 0.01,
+                "{what}: flat edges {sum:?} vs 3D"
+            );
+        }
+    }
+}

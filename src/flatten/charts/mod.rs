@@ -142,7 +142,29 @@ fn material_tolerance(kind: MaterialKind) -> f64 {
 }
 
 /// Lay a surface flat: its charts parameterised when it has them, else unfolded exactly.
-pub fn flatten(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+/// A mesh with a [`Surface::shape`] is laid out at that shape's size and the layout scaled to
+/// the surface's millimetres, so that its pieces do not depend on its size (issue 20, item 5).
+pub fn flatten(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+    let shape = surface
+        .shape
+        .take()
+        .filter(|s| s.vertices.len() == surface.mesh.vertices.len() && s.to_mm.is_finite());
+    let Some(shape) = shape else {
+        return flatten_as_is(surface, opts);
+    };
+    let mm = std::mem::replace(&mut surface.mesh.vertices, shape.vertices.clone());
+    let mut flat = flatten_as_is(surface, opts)?;
+    let k = shape.to_mm;
+    flat.surface.mesh.vertices = mm;
+    flat.surface.shape = Some(shape);
+    for c in flat.face_2d.iter_mut().flatten() {
+        *c *= k;
+    }
+    flat.tolerance *= k;
+    Ok(flat)
+}
+
+fn flatten_as_is(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
     if surface.charts.is_some() {
         charts(surface, opts)
     } else {
