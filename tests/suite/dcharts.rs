@@ -1297,3 +1297,77 @@ fn gussets_fill_the_slits_of_a_saddle() {
     let (again, _, _) = lay(2);
     assert_eq!(again.face_2d, gus.face_2d);
 }
+
+/// Issue 20 (few pieces): a plane folded by 60° along a line, finely triangulated, given as
+/// two charts (its flat halves). The halves' layouts fit together along the fold, so the
+/// flatten stage joins them into one piece, the fold edges joined.
+#[test]
+fn charts_that_fit_together_are_joined() {
+    let (n, cell, fold) = (12usize, 10.0, 60f64.to_radians());
+    let mut vertices = Vec::new();
+    for j in 0..=n {
+        for i in 0..=2 * n {
+            let x = (i as f64 - n as f64) * cell;
+            let y = j as f64 * cell;
+            vertices.push(if x <= 0.0 {
+                DVec3::new(x, y, 0.0)
+            } else {
+                DVec3::new(x * fold.cos(), y, x * fold.sin())
+            });
+        }
+    }
+    let w = 2 * n + 1;
+    let (mut faces, mut chart) = (Vec::new(), Vec::new());
+    for j in 0..n {
+        for i in 0..2 * n {
+            let a = j * w + i;
+            push_quad(&mut faces, [a, a + 1, a + 1 + w, a + w]);
+            chart.extend([usize::from(i >= n); 2]);
+        }
+    }
+    let mesh = Mesh { vertices, faces };
+    let flat = fcharts::flatten(surface(mesh, Some(chart)), &FlattenOptions::default()).unwrap();
+    check_flat(&flat);
+    let along: Vec<usize> = (0..flat.topology.edges.len())
+        .filter(|&e| flat.dihedral[e].abs() > 1f64.to_radians())
+        .collect();
+    println!(
+        "folded plane in two charts: {} pieces, {} of {} fold edges joined",
+        flat.islands.len(),
+        along.iter().filter(|&&e| flat.joined[e]).count(),
+        along.len()
+    );
+    assert_eq!(flat.islands.len(), 1);
+    assert_eq!(along.len(), n);
+    assert!(along.iter().all(|&e| flat.joined[e]));
+}
+
+/// Issue 20: fandisk's D-Charts charts meet at its sharp creases; where the flatten stage joins
+/// two charts (small pieces merged, layouts that fit together), the crease between them is a
+/// fold line like a crease inside a chart: every joined edge bending by more than 20° is
+/// scored, with its angle.
+#[test]
+fn fandisk_creases_are_scored_wherever_a_piece_keeps_both_sides() {
+    let mut spec = flatcut::spec::Spec::from_mesh(&shared_data("meshes/fandisk.obj"));
+    spec.size = Some(300.0);
+    spec.sheet.width = 2000.0;
+    spec.sheet.height = Some(2000.0);
+    let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
+    let flat = &flats[0];
+    let sharp: Vec<usize> = (0..flat.topology.edges.len())
+        .filter(|&e| flat.joined[e] && flat.dihedral[e].abs() > 20f64.to_radians())
+        .collect();
+    let folds: Vec<f64> = pieces
+        .iter()
+        .flat_map(|p| p.folds.iter().filter(|f| !f.tab).map(|f| f.angle))
+        .collect();
+    println!(
+        "fandisk: {} pieces, {} joined edges over 20°, {} fold lines",
+        pieces.len(),
+        sharp.len(),
+        folds.len()
+    );
+    assert!(sharp.len() > 50, "{}", sharp.len());
+    assert_eq!(folds.len(), sharp.len());
+    assert!(folds.iter().all(|a| a.to_degrees() > 20.0));
+}

@@ -7,14 +7,33 @@
 //! in order of the boundary length they share with it (longest first, ties by index), at most
 //! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too.
 //! The merged chart keeps the cuts of both (and more where it is not a disk).
+//!
+//! Then any two neighbouring pieces are joined where their layouts already fit together
+//! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
+//! thesis' Table 5.1: 4 charts) comes out in few pieces. Both sides of a fold of a developable
+//! are the same curve laid flat, so one layout is moved onto the other by the rigid motion
+//! that best fits their common boundary (2D Kabsch, least squares); the join is kept when
+//! no common vertex is further off than [`NEAR_SHARE`] of the material's stretch tolerance
+//! times the common boundary's length, and, the common vertices put where the larger piece has
+//! them, the two as one have no flip, no overlap and an L2 stretch within [`NEAR_SHARE`] of the
+//! tolerance (paper 1.001, metal 1.00033, fabric 1.01; the rest of the tolerance is left to
+//! the small pieces). Nothing is laid out again, so a failed join costs a pass over the two
+//! pieces. Pieces are tried smallest first, with the same neighbours as above, in rounds until
+//! none joins; a pair that failed is not tried again unless one of the two has grown since.
 
-use super::overlap::{merge_into, Owners};
+use super::overlap::{merge_into, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid};
+use crate::flatten::distortion;
+use glam::DVec2;
+use std::collections::HashMap;
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
 /// Neighbours tried per small piece.
 pub(crate) const MERGE_TRIES: usize = 3;
+/// Share of the material's tolerance (of L2 − 1) that a merge of two pieces of any size may
+/// use ([`merge_near`]).
+pub(crate) const NEAR_SHARE: f64 = 1.0 / 3.0;
 
 /// Merge the small pieces of `done` into neighbours (see the module doc).
 pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
@@ -45,4 +64,164 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
         }
     }
     owners.drop_gone(done);
+}
+
+/// Join neighbouring pieces of any size whose layouts fit together (see the module doc).
+pub(super) fn merge_near(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    let near = 1.0 + (opts.tolerance - 1.0) * NEAR_SHARE;
+    let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
+    let mut owners = Owners::new(ctx.mesh.faces.len(), done);
+    // Pairs that failed, with both pieces' face counts at the time.
+    let mut failed = std::collections::HashSet::new();
+    loop {
+        let mut order: Vec<(f64, usize)> = (0..done.len())
+            .filter(|&k| !owners.gone[k])
+            .map(|k| (area(&done[k].faces), k))
+            .collect();
+        order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let mut merged = false;
+        for (_, si) in order {
+            if owners.gone[si] {
+                continue;
+            }
+            for k in owners
+                .neighbours(ctx, done, si)
+                .into_iter()
+                .take(MERGE_TRIES)
+            {
+                let key = (k, done[k].faces.len(), si, done[si].faces.len());
+                if failed.contains(&key) {
+                    continue;
+                }
+                if attach(ctx, done, k, si, near, eps) {
+                    owners.absorb(done, k, si);
+                    merged = true;
+                    break;
+                }
+                failed.insert(key);
+            }
+        }
+        if !merged {
+            break;
+        }
+    }
+    owners.drop_gone(done);
+}
+
+/// Join `done[part]` to `done[k]` by moving its layout onto `done[k]`'s along their common
+/// boundary (see the module doc); false, leaving both as they were, when it does not fit.
+fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps: f64) -> bool {
+    let in_k: HashMap<usize, usize> = done[k]
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| (f, i))
+        .collect();
+    // The common edges: each end as `part` has it and where `done[k]` has it.
+    let mut pairs: Vec<(DVec2, DVec2)> = Vec::new();
+    let mut at: HashMap<usize, DVec2> = HashMap::new();
+    let (mut edges, mut length) = (0usize, 0.0);
+    for (pi, &f) in done[part].faces.iter().enumerate() {
+        let n = ctx.mesh.faces[f].verts.len();
+        for i in 0..n {
+            let e = &ctx.topo.edges[ctx.topo.face_edges[f][i]];
+            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
+                continue;
+            };
+            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
+                continue;
+            };
+            let m = ctx.mesh.faces[g].verts.len();
+            let (a, b) = (
+                ctx.mesh.faces[f].verts[i],
+                ctx.mesh.faces[f].verts[(i + 1) % n],
+            );
+            let here = [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]];
+            // The edge runs the other way round in `g`.
+            let there = [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]];
+            for (v, (p, q)) in [a, b].into_iter().zip(here.into_iter().zip(there)) {
+                match at.get(&v) {
+                    Some(old) if old.distance(q) > 1e-9 * (1.0 + q.length()) => return false,
+                    Some(_) => {}
+                    None => {
+                        at.insert(v, q);
+                        pairs.push((p, q));
+                    }
+                }
+            }
+            edges += 1;
+            length += ctx.mesh.vertices[a].distance(ctx.mesh.vertices[b]);
+        }
+    }
+    // One path or one loop of common edges.
+    if edges == 0 || !(at.len() == edges || at.len() == edges + 1) {
+        return false;
+    }
+    let Some((turn, shift)) = fit(&pairs) else {
+        return false;
+    };
+    let moved = |p: DVec2| turn.rotate(p) + shift;
+    let worst = pairs
+        .iter()
+        .map(|&(p, q)| moved(p).distance(q))
+        .fold(0.0, f64::max);
+    if worst > (near - 1.0) * length {
+        return false;
+    }
+    let mut faces = done[k].faces.clone();
+    let mut uv = done[k].uv.clone();
+    for (&f, corners) in done[part].faces.iter().zip(&done[part].uv) {
+        let verts = &ctx.mesh.faces[f].verts;
+        faces.push(f);
+        uv.push(
+            verts
+                .iter()
+                .zip(corners)
+                .map(|(v, &p)| {
+                    let p = moved(p);
+                    match at.get(v) {
+                        Some(&q) if q.distance(p) <= 2.0 * worst + 1e-9 * (1.0 + q.length()) => q,
+                        _ => p,
+                    }
+                })
+                .collect(),
+        );
+    }
+    let s = distortion::stretch(ctx.mesh, &faces, &uv);
+    if s.flipped > 0 || s.l2 > near || self_overlap(&uv, eps).is_some() {
+        return false;
+    }
+    let mut cuts = done[k].cuts.clone();
+    cuts.extend(&done[part].cuts);
+    cuts.sort_unstable();
+    cuts.dedup();
+    done[k] = Laid {
+        faces,
+        cuts,
+        uv,
+        stretch: s,
+        gusset: false,
+    };
+    true
+}
+
+/// The rotation (as a unit complex number) and shift that best move the first points of
+/// `pairs` onto the second (least squares); `None` for fewer than two distinct points.
+fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
+    let n = pairs.len() as f64;
+    let cp = pairs.iter().map(|p| p.0).sum::<DVec2>() / n;
+    let cq = pairs.iter().map(|p| p.1).sum::<DVec2>() / n;
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for &(p, q) in pairs {
+        let (a, b) = (p - cp, q - cq);
+        dot += a.dot(b);
+        cross += a.perp_dot(b);
+    }
+    let r = DVec2::new(dot, cross);
+    let len = r.length();
+    if len <= 1e-300 || !len.is_finite() {
+        return None;
+    }
+    let turn = r / len;
+    Some((turn, cq - turn.rotate(cp)))
 }

@@ -550,6 +550,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     }
     reattach(&ctx, &mut done, opts, overlap_eps);
     merge::merge_small(&ctx, &mut done, opts, overlap_eps);
+    merge::merge_near(&ctx, &mut done, opts, overlap_eps);
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {

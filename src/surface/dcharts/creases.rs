@@ -1,7 +1,7 @@
 //! Which meshes are segmented, and what a pattern scores inside a chart: [`is_smooth`] tells a
 //! mesh sampled from a smooth surface (segmented into charts) from a polyhedral model
-//! (unfolded face by face), and [`creases`] lists the edges inside a chart that bend sharply
-//! enough to be scored as fold lines (the thesis' §5.3 pattern keeps chart boundaries as cuts
+//! (unfolded face by face), and [`creases`] lists the edges that bend sharply enough to be
+//! scored as fold lines where a piece keeps both their faces (the thesis' §5.3 pattern keeps chart boundaries as cuts
 //! and says nothing of creases inside a chart: they are flatcut's choice, see [`CREASE_DEG`]).
 
 use crate::geom::mesh::Mesh;
@@ -73,19 +73,18 @@ pub const GENTLE_DEG: f64 = 10.0;
 /// Share of the bent edges that must bend gently for a mesh to be smooth ([`is_smooth`]).
 pub const GENTLE_SHARE: f64 = 0.3;
 
-/// Edges inside a chart that bend by more than `min_deg` degrees: the creases a pattern should
-/// score (the smooth bends in between need no fold line). Signed angle in degrees, positive for
-/// a mountain (convex seen from the printed side).
-pub(super) fn creases(mesh: &Mesh, chart: &[usize], min_deg: f64) -> Vec<Bend> {
+/// Edges that bend by more than `min_deg` degrees: the creases a pattern should score where
+/// the piece keeps both faces (the smooth bends in between need no fold line). Edges between
+/// two charts are listed too, since the flatten stage may merge the charts (the pattern stage
+/// folds only joined edges). Signed angle in degrees, positive for a mountain (convex seen
+/// from the printed side).
+pub(super) fn creases(mesh: &Mesh, min_deg: f64) -> Vec<Bend> {
     let topo = mesh.topology();
     let mut out = Vec::new();
     for e in &topo.edges {
         let [(f, i), (g, _)] = e.uses[..] else {
             continue;
         };
-        if chart.get(f) != chart.get(g) {
-            continue;
-        }
         let Some(signed) = mesh.signed_dihedral(f, i, g) else {
             continue;
         };

@@ -288,7 +288,7 @@ pub fn apply(
         ..d
     };
     let s = segment(&surface.mesh, &opts).map_err(|e| invalid(format!("D-Charts: {e}")))?;
-    surface.bends = Some(creases(&surface.mesh, &s.chart, CREASE_DEG));
+    surface.bends = Some(creases(&surface.mesh, CREASE_DEG));
     surface.charts = Some(s.chart);
     surface.cuts = s.cuts;
     Ok(())
