@@ -308,6 +308,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Pattern(e) if e.is_bug() => 2,
+            Error::Flatten(flatten::FlattenError::Overlap { .. }) => 2,
             Error::Nest(nest::NestError::Infeasible(_)) => 2,
             Error::In { source, .. } | Error::At { source, .. } => source.exit_code(),
             _ => 1,

@@ -60,4 +60,12 @@ pub enum FlattenError {
         face: usize,
         line: Option<usize>,
     },
+    /// Two faces of one piece overlap when laid flat: the stage's own fault, never output.
+    #[error("surface `{surface}`, piece {piece}: faces {a} and {b} overlap when laid flat (flatcut bug)")]
+    Overlap {
+        surface: String,
+        piece: usize,
+        a: usize,
+        b: usize,
+    },
 }

@@ -364,8 +364,9 @@ fn faces_overlap(
     })
 }
 
-/// Whether any two faces of an unfolding overlap (deeper than `eps`); O(n log n) with a sweep
-/// over x. For tests and reports.
+/// Two faces of one island of an unfolding that overlap (deeper than the flat's tolerance),
+/// if any: the exact triangle test over each island's faces, found by a sweep over x within
+/// the island (O(n log n) for pieces that are not one long column of faces).
 pub fn find_overlap(flat: &Flat) -> Option<(usize, usize)> {
     let eps = flat.tolerance;
     let tris: Vec<Vec<[usize; 3]>> = flat
@@ -373,22 +374,22 @@ pub fn find_overlap(flat: &Flat) -> Option<(usize, usize)> {
         .iter()
         .map(|p| polygon::triangulate(p))
         .collect();
-    let mut boxes: Vec<(f64, f64, usize)> = flat
-        .face_2d
-        .iter()
-        .enumerate()
-        .filter_map(|(f, p)| polygon::bounds(p.iter().copied()).map(|(lo, hi)| (lo.x, hi.x, f)))
-        .collect();
-    boxes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (k, &(_, hx, f)) in boxes.iter().enumerate() {
-        for &(lx, _, g) in &boxes[k + 1..] {
-            if lx >= hx {
-                break;
-            }
-            if flat.face_island[f] == flat.face_island[g]
-                && faces_overlap(&flat.face_2d[f], &tris[f], &flat.face_2d[g], &tris[g], eps)
-            {
-                return Some((f, g));
+    for faces in &flat.islands {
+        let mut boxes: Vec<(f64, f64, usize)> = faces
+            .iter()
+            .filter_map(|&f| {
+                polygon::bounds(flat.face_2d[f].iter().copied()).map(|(lo, hi)| (lo.x, hi.x, f))
+            })
+            .collect();
+        boxes.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+        for (k, &(_, hx, f)) in boxes.iter().enumerate() {
+            for &(lx, _, g) in &boxes[k + 1..] {
+                if lx >= hx {
+                    break;
+                }
+                if faces_overlap(&flat.face_2d[f], &tris[f], &flat.face_2d[g], &tris[g], eps) {
+                    return Some((f.min(g), f.max(g)));
+                }
             }
         }
     }

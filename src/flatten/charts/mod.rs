@@ -164,11 +164,27 @@ pub fn flatten(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flat
     Ok(flat)
 }
 
+/// [`flatten`] at the surface's own size. A layout in which two faces of one piece overlap
+/// is refused as the stage's own fault (issue 20, item 1): the unfolder and the chart
+/// flattener cut or split where faces would overlap, so one left is a bug, never output.
 fn flatten_as_is(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
-    if surface.charts.is_some() {
-        charts(surface, opts)
+    refuse_overlap(if surface.charts.is_some() {
+        charts(surface, opts)?
     } else {
-        unfold(surface, &opts.unfold)
+        unfold(surface, &opts.unfold)?
+    })
+}
+
+/// `flat`, or the error naming its first two overlapping faces (see [`flatten_as_is`]).
+fn refuse_overlap(flat: Flat) -> Result<Flat, FlattenError> {
+    match super::unfold::find_overlap(&flat) {
+        Some((f, g)) => Err(FlattenError::Overlap {
+            surface: flat.surface.name.clone(),
+            piece: flat.face_island[f] + 1,
+            a: f + 1,
+            b: g + 1,
+        }),
+        None => Ok(flat),
     }
 }
 
@@ -711,3 +727,27 @@ const CUT_OFF_AREA: f64 = 0.25;
 /// Rounds of matching the seams of charts left over the tolerance (halving those whose
 /// matched layout overlaps or flips) after all charts are laid.
 const MATCH_ROUNDS: usize = 3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles of one piece laid over each other: refused as a bug (exit code 2), naming
+    /// the surface, the piece and both faces; laid apart, the flat passes.
+    #[test]
+    fn an_overlapping_piece_is_refused_as_a_bug() {
+        let cube = crate::flatten::unfold::tests::cube(10.0);
+        let mut flat = unfold(cube, &crate::flatten::UnfoldOptions::default()).unwrap();
+        assert!(refuse_overlap(flat.clone()).is_ok());
+        let island = flat.face_island[0];
+        let g = (1..flat.face_2d.len())
+            .find(|&g| flat.face_island[g] == island)
+            .unwrap();
+        flat.face_2d[g] = flat.face_2d[0].clone();
+        let e = refuse_overlap(flat).unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains(&format!("faces 1 and {}", g + 1)), "{text}");
+        assert!(text.contains(&format!("piece {}", island + 1)), "{text}");
+        assert_eq!(crate::Error::from(e).exit_code(), 2);
+    }
+}
