@@ -348,8 +348,14 @@ pub fn notch_positions(len: f64, spacing: f64) -> Vec<f64> {
     if at.is_empty() {
         at.push(len / 3.0);
     }
-    let extra = at[0] + 3f64.min(0.1 * len);
-    at.insert(1, extra);
+    let d = 3f64.min(0.1 * len);
+    // The extra notch goes after the first, unless the two would then sit where they sit with
+    // the seam turned end for end (len = 2 × first + d); then before it.
+    if at.len() == 1 && (2.0 * at[0] + d - len).abs() < 1.0 {
+        at.insert(0, at[0] - d);
+    } else {
+        at.insert(1, at[0] + d);
+    }
     at
 }
 
@@ -670,4 +676,26 @@ fn grain_line(p: &Piece, label_r: f64) -> (DVec2, Vec<Vec<DVec2>>) {
         vec![tip + r1 * head, tip, tip + r2 * head]
     };
     (dir, vec![vec![a, b], wing(a, dir), wing(b, -dir)])
+}
+
+#[cfg(test)]
+mod notch_tests {
+    use super::notch_positions;
+
+    /// Turned end for end, a seam's notches never land on themselves (so the two sides cannot
+    /// be sewn or glued the wrong way round), at any length and spacing; all lie on the seam.
+    #[test]
+    fn notches_are_never_symmetric() {
+        for spacing in [10.0, 25.0, 40.0] {
+            for k in 500..40_000 {
+                let len = k as f64 * 0.01;
+                let at = notch_positions(len, spacing);
+                assert!(at.len() >= 2, "{len} / {spacing}: {at:?}");
+                assert!(at.iter().all(|&s| s > 0.0 && s < len), "{len}: {at:?}");
+                let n = at.len();
+                let turned = (0..n).any(|i| (at[i] - (len - at[n - 1 - i])).abs() > 0.5);
+                assert!(turned, "{len} / {spacing}: {at:?}");
+            }
+        }
+    }
 }

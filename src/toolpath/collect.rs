@@ -90,17 +90,24 @@ pub(super) fn strokes(layout: &Layout, sheet: &Sheet, opts: &ToolpathOptions) ->
 /// mirrored piece the text is set again in its (symmetric) box so that it never reads
 /// mirrored. The box is centred where the piece puts it, so the text stays where it was.
 fn upright(t: &Text, at: &Placement) -> Vec<Vec<DVec2>> {
-    let Some((lo, hi)) = crate::geom::polygon::bounds(t.points()) else {
+    // The text's axes in the piece; the centre of its box along them (the box the pattern
+    // stage kept clear, so that the half turn lands the text on itself; the centre of the
+    // axis-aligned bounds would not, for text set at an angle).
+    let (r, up) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
+        Some(r) => (r, r.perp()),
+    };
+    let along = t.points().map(|q| DVec2::new(q.dot(r), q.dot(up)));
+    let Some((lo, hi)) = crate::geom::polygon::bounds(along) else {
         return Vec::new();
     };
-    let c = 0.5 * (lo + hi);
+    let mid = 0.5 * (lo + hi);
+    let c = r * mid.x + up * mid.y;
     let cs = at.apply(c);
-    // The text's axes in the piece, and its box's axes on the sheet.
-    let (r, up, mut e1, mut e2) = match t.dir {
-        None => (DVec2::X, DVec2::Y, DVec2::X, DVec2::Y),
+    // Its box's axes on the sheet.
+    let (mut e1, mut e2) = match t.dir {
+        None => (DVec2::X, DVec2::Y),
         Some(r) => (
-            r,
-            r.perp(),
             (at.apply(c + r) - cs).normalize_or_zero(),
             (at.apply(c + r.perp()) - cs).normalize_or_zero(),
         ),
@@ -176,5 +183,35 @@ mod tests {
                 assert!((0.5 * (l2 + h2) - c).length() < 1e-9);
             }
         }
+    }
+
+    /// Text set along a slanted edge, on a piece turned half a turn: it is turned back about
+    /// the centre of its own box (along its edge), so it covers exactly the box the pattern
+    /// stage kept clear (fandisk: a seam id turned about the centre of its axis-aligned
+    /// bounds poked 0.008 mm out of its piece).
+    #[test]
+    fn slanted_text_turned_back_stays_in_its_box() {
+        let t =
+            crate::pattern::marks::edge_text("17", DVec2::ZERO, DVec2::new(10.0, 4.0), 10.0, 3.0);
+        let r = t.dir.unwrap();
+        let frame = |pts: &mut dyn Iterator<Item = DVec2>| {
+            crate::geom::polygon::bounds(pts.map(|q| DVec2::new(q.dot(r), q.dot(r.perp()))))
+                .unwrap()
+        };
+        let (lo, hi) = frame(&mut t.points());
+        let at = Placement {
+            sheet: 0,
+            rotation: std::f64::consts::PI,
+            mirror: false,
+            offset: DVec2::ZERO,
+        };
+        let s = upright(&t, &at);
+        // Back in the piece's frame, the turned text spans the same box.
+        let back: Vec<DVec2> = s.iter().flatten().map(|q| -*q).collect();
+        let (l2, h2) = frame(&mut back.into_iter());
+        assert!(
+            (l2 - lo).length() < 1e-9 && (h2 - hi).length() < 1e-9,
+            "{lo} {hi} vs {l2} {h2}"
+        );
     }
 }

@@ -18,7 +18,9 @@ fn fandisk_unfolds_isometrically_without_overlap_inside_the_sheet() {
     let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).expect("pieces");
     let flat = &flats[0];
     assert_eq!(flat.surface.mesh.faces.len(), 12_946);
-    assert!(flat.islands.len() <= 7, "{} islands", flat.islands.len());
+    // Unfolded at one size whatever the spec says (issue 20, item 5), where the unfolder's
+    // 0.02 mm tolerance is relatively finer than at the spec's 100×: 8 islands, was 7.
+    assert!(flat.islands.len() <= 8, "{} islands", flat.islands.len());
     assert!(flatcut::flatten::unfold::find_overlap(flat).is_none());
 
     let opts = flatcut::nest::NestOptions {

@@ -830,3 +830,21 @@ fn split_parts_at_spacing_zero_nest_apart() {
             .unwrap();
     assert!(report["pieces"].as_array().unwrap().len() >= 2, "{report}");
 }
+
+/// Issue 20, item 1: a piece whose faces overlap when laid flat is the flatten stage's own
+/// fault, reported as a flatcut bug (exit code 2), never output.
+#[test]
+fn a_flatten_overlap_is_a_bug() {
+    let e = flatcut::Error::from(flatcut::flatten::FlattenError::Overlap {
+        surface: "s".into(),
+        piece: 3,
+        a: 10,
+        b: 12,
+    });
+    assert_eq!(e.exit_code(), 2);
+    let text = e.to_string();
+    assert!(
+        text.contains("piece 3") && text.contains("faces 10 and 12"),
+        "{text}"
+    );
+}
