@@ -103,7 +103,8 @@ fn full_example_parses_exactly() {
             }],
             material: Material {
                 kind: MaterialKind::Paper,
-                thickness: 0.25
+                thickness: 0.25,
+                ..Material::default()
             },
             sheet: SheetSpec {
                 width: 210.0,
@@ -163,7 +164,8 @@ fold_threshold = 179.5
         spec.material,
         Material {
             kind: MaterialKind::Metal,
-            thickness: 1.0
+            thickness: 1.0,
+            ..Material::default()
         }
     );
     assert_eq!(
@@ -206,7 +208,8 @@ fn minimal_spec_gets_all_defaults() {
         spec.material,
         Material {
             kind: MaterialKind::Paper,
-            thickness: 0.25
+            thickness: 0.25,
+            ..Material::default()
         }
     );
     assert_eq!(
@@ -586,7 +589,8 @@ fn obj_path_gives_mesh_defaults() {
             spec.material,
             Material {
                 kind: MaterialKind::Paper,
-                thickness: 0.25
+                thickness: 0.25,
+                ..Material::default()
             }
         );
         assert_eq!(
