@@ -25,6 +25,9 @@
 //! 100 − BD between its bend lines, one with a fold and a free edge 100 − BD/2 from the bend
 //! line to the edge. Faces keep their corners (a developed face is the same polygon, its
 //! corners moved), so seams, marks and splitting work on the developed piece as on any other.
+//! A seam of a developed piece is as long as its sides are flat, shorter than in 3D by the
+//! bends it runs into (and its two sides by different bends): it is not a seam mismatch
+//! (`marks::seam_mismatches` leaves it out).
 //!
 //! **Corners** (where nothing says; the choices are a shop's). Where a bend line ends on the
 //! border between two faces of one fold, the two trimmed corners both lie on the bend line and
@@ -203,104 +206,202 @@ fn island(
     sheet: &SheetBend,
 ) -> Result<IslandOut, String> {
     let faces = &flat.islands[k];
-    let topo = &flat.topology;
-    let mesh = &flat.surface.mesh;
-    let tol = 1e-6 + 2.0 * flat.tolerance;
-    let local: HashMap<usize, usize> = faces.iter().enumerate().map(|(i, &f)| (f, i)).collect();
-    let other = |e: usize, u: (usize, usize)| topo.edges[e].uses.iter().copied().find(|&w| w != u);
-    let len = |f: usize| mesh.faces[f].verts.len();
-    let fold = |e: usize| flat.joined[e] && fold_at[e].is_some();
-    let flat_join = |e: usize| flat.joined[e] && fold_at[e].is_none();
-
-    // The bends, each once (from the face listed first on its edge).
-    let mut bends = Vec::new();
-    for &f in faces {
-        for (i, &e) in topo.face_edges[f].iter().enumerate() {
-            if let (true, Some(d), true) =
-                (flat.joined[e], fold_at[e], topo.edges[e].uses[0] == (f, i))
-            {
-                let mold = if d > 0.0 {
-                    MoldLine::Outside
-                } else {
-                    MoldLine::Inside
-                };
-                bends.push(BendFigure {
-                    edge: e,
-                    angle: d.abs(),
-                    mold,
-                    allowance: sheet.allowance(d),
-                    setback: sheet.setback(d, mold),
-                    deduction: sheet.deduction(d, mold),
-                });
-            }
-        }
+    let mut cx = Ctx {
+        flat,
+        faces,
+        local: faces.iter().enumerate().map(|(i, &f)| (f, i)).collect(),
+        fold_at,
+        bends: Vec::new(),
+        tol: 1e-6 + 2.0 * flat.tolerance,
+    };
+    cx.bends = cx.figures(sheet);
+    let shift = cx.shifts()?;
+    let dev = cx.developed_faces(&shift)?;
+    // The border, with the corners between trimmed faces, and the check that folds meet
+    // only on it.
+    let loops = super::walk(flat, faces).ok_or("its outline could not be traced")?;
+    cx.check_inside(&loops, &dev)?;
+    let mut rings = Vec::with_capacity(loops.len());
+    let mut reliefs = Vec::new();
+    for l in &loops {
+        rings.push(cx.ring(l, &dev, &mut reliefs)?);
     }
-    bends.sort_by_key(|b| b.edge);
-    let figure = |e: usize| {
-        bends
+    if crosses(&rings) {
+        return Err("its outline would cross itself".into());
+    }
+    let folds = cx.bend_lines(&dev, &rings);
+    Ok(IslandOut {
+        faces: dev.into_iter().collect(),
+        rings,
+        folds,
+        bends: cx.bends,
+        reliefs,
+    })
+}
+
+/// One island being developed.
+struct Ctx<'a> {
+    flat: &'a Flat,
+    faces: &'a [usize],
+    /// Each face's index in `faces`.
+    local: HashMap<usize, usize>,
+    fold_at: &'a [Option<f64>],
+    /// The island's bends, by edge.
+    bends: Vec<BendFigure>,
+    /// How far (mm) two positions of one point may differ: the unfolding's own tolerance.
+    tol: f64,
+}
+
+impl Ctx<'_> {
+    /// The other use (face, corner) of edge `e` than `u`.
+    fn other(&self, e: usize, u: (usize, usize)) -> Option<(usize, usize)> {
+        self.flat.topology.edges[e]
+            .uses
+            .iter()
+            .copied()
+            .find(|&w| w != u)
+    }
+
+    fn len(&self, f: usize) -> usize {
+        self.flat.surface.mesh.faces[f].verts.len()
+    }
+
+    /// A fold of this island: a joined edge bending past the threshold.
+    fn fold(&self, e: usize) -> bool {
+        self.flat.joined[e] && self.fold_at[e].is_some()
+    }
+
+    /// A joined edge inside a panel.
+    fn flat_join(&self, e: usize) -> bool {
+        self.flat.joined[e] && self.fold_at[e].is_none()
+    }
+
+    fn figure(&self, e: usize) -> Option<&BendFigure> {
+        self.bends
             .binary_search_by_key(&e, |b| b.edge)
             .ok()
-            .map(|i| &bends[i])
-    };
-    let half = |e: usize| figure(e).map_or(0.0, |b| 0.5 * b.deduction);
+            .map(|i| &self.bends[i])
+    }
 
-    // Each face moved with its panel: by BD across every fold from the first face.
-    let mut shift: Vec<Option<DVec2>> = vec![None; faces.len()];
-    let root = *faces.first().ok_or("the piece has no faces")?;
-    shift[0] = Some(DVec2::ZERO);
-    let mut queue = VecDeque::from([root]);
-    while let Some(f) = queue.pop_front() {
-        let Some(tf) = shift[local[&f]] else { continue };
-        for (i, &e) in topo.face_edges[f].iter().enumerate() {
-            if !flat.joined[e] {
-                continue;
-            }
-            let Some((g, _)) = other(e, (f, i)) else {
-                continue;
-            };
-            let Some(&lg) = local.get(&g) else { continue };
-            let want = if fold(e) {
-                let (a, b) = flat.corner_edge(f, i);
-                tf + (b - a).normalize_or_zero().perp() * (2.0 * half(e))
-            } else {
-                tf
-            };
-            match shift[lg] {
-                None => {
-                    shift[lg] = Some(want);
-                    queue.push_back(g);
+    /// How far (mm) a panel's edge along `e` moves in: half the bend deduction of a fold.
+    fn half(&self, e: usize) -> f64 {
+        self.figure(e).map_or(0.0, |b| 0.5 * b.deduction)
+    }
+
+    /// The bends, each once (from the face listed first on its edge), by edge.
+    fn figures(&self, sheet: &SheetBend) -> Vec<BendFigure> {
+        let topo = &self.flat.topology;
+        let mut bends = Vec::new();
+        for &f in self.faces {
+            for (i, &e) in topo.face_edges[f].iter().enumerate() {
+                let first = topo.edges[e].uses.first() == Some(&(f, i));
+                if let (true, Some(d), true) = (self.flat.joined[e], self.fold_at[e], first) {
+                    let mold = if d > 0.0 {
+                        MoldLine::Outside
+                    } else {
+                        MoldLine::Inside
+                    };
+                    bends.push(BendFigure {
+                        edge: e,
+                        angle: d.abs(),
+                        mold,
+                        allowance: sheet.allowance(d),
+                        setback: sheet.setback(d, mold),
+                        deduction: sheet.deduction(d, mold),
+                    });
                 }
-                Some(tg) if tg.distance(want) > tol => {
-                    return Err(format!(
-                        "its folds close a loop (through mesh edge {}) whose bend deductions do not add up",
-                        e + 1
-                    ))
-                }
-                Some(_) => {}
             }
         }
+        bends.sort_by_key(|b| b.edge);
+        bends
     }
-    let shift: Vec<DVec2> = shift
-        .into_iter()
-        .map(|t| t.ok_or("its faces are not all joined"))
-        .collect::<Result<_, _>>()?;
 
-    // Every corner where its panel, trimmed, puts it.
-    let guard: usize = faces.iter().map(|&f| len(f)).sum::<usize>() + 1;
-    let corner = |f: usize, c: usize| -> Result<DVec2, String> {
-        let t = shift[local[&f]];
-        let here = flat.face_2d[f][c] + t;
+    /// Each face's move with its panel, by its index in `faces`: by BD across every fold
+    /// from the first face, towards the panel it is joined to.
+    fn shifts(&self) -> Result<Vec<DVec2>, String> {
+        let topo = &self.flat.topology;
+        let mut shift: Vec<Option<DVec2>> = vec![None; self.faces.len()];
+        let root = *self.faces.first().ok_or("the piece has no faces")?;
+        shift[0] = Some(DVec2::ZERO);
+        let mut queue = VecDeque::from([root]);
+        while let Some(f) = queue.pop_front() {
+            let Some(tf) = shift[self.local[&f]] else {
+                continue;
+            };
+            for (i, &e) in topo.face_edges[f].iter().enumerate() {
+                let Some((g, _)) = self.other(e, (f, i)).filter(|_| self.flat.joined[e]) else {
+                    continue;
+                };
+                let Some(&lg) = self.local.get(&g) else {
+                    continue;
+                };
+                let want = if self.fold(e) {
+                    let (a, b) = self.flat.corner_edge(f, i);
+                    tf + (b - a).normalize_or_zero().perp() * (2.0 * self.half(e))
+                } else {
+                    tf
+                };
+                match shift[lg] {
+                    None => {
+                        shift[lg] = Some(want);
+                        queue.push_back(g);
+                    }
+                    Some(tg) if tg.distance(want) > self.tol => {
+                        return Err(format!(
+                            "its folds close a loop (through mesh edge {}) whose bend deductions do not add up",
+                            e + 1
+                        ))
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+        shift
+            .into_iter()
+            .map(|t| t.ok_or_else(|| "its faces are not all joined".to_string()))
+            .collect()
+    }
+
+    /// Every face's corners where its panel, trimmed and moved, puts them; a face that
+    /// would turn over is an error.
+    fn developed_faces(&self, shift: &[DVec2]) -> Result<HashMap<usize, Vec<DVec2>>, String> {
+        let mut dev = HashMap::with_capacity(self.faces.len());
+        for &f in self.faces {
+            let pts = (0..self.len(f))
+                .map(|c| self.corner(shift, f, c))
+                .collect::<Result<Vec<_>, _>>()?;
+            let orig = &self.flat.face_2d[f];
+            let n = pts.len();
+            let kept =
+                (0..n).all(|c| (pts[(c + 1) % n] - pts[c]).dot(orig[(c + 1) % n] - orig[c]) > 0.0);
+            if !kept || polygon::signed_area(&pts) <= 0.0 {
+                return Err(format!(
+                    "face {} is narrower than the bend deductions of its folds",
+                    f + 1
+                ));
+            }
+            dev.insert(f, pts);
+        }
+        Ok(dev)
+    }
+
+    /// Corner `c` of face `f` developed: where the two border edges of its panel at that
+    /// vertex (reached about it through flat joins), each moved in by half its deduction,
+    /// meet; unchanged inside a panel or between two edges that do not move.
+    fn corner(&self, shift: &[DVec2], f: usize, c: usize) -> Result<DVec2, String> {
+        let topo = &self.flat.topology;
+        let t = shift[self.local[&f]];
+        let here = self.flat.face_2d[f][c] + t;
         let broken = || "its faces do not close around a vertex".to_string();
+        let guard: usize = self.faces.iter().map(|&g| self.len(g)).sum::<usize>() + 1;
         // About the vertex through flat joins, each way, to the panel's border edges.
         let (mut g, mut j) = (f, c);
         let mut n = 0;
-        loop {
-            let e = topo.face_edges[g][j];
-            if !flat_join(e) {
-                break;
-            }
-            let (h, kk) = other(e, (g, j)).ok_or_else(broken)?;
-            (g, j) = (h, (kk + 1) % len(h));
+        while self.flat_join(topo.face_edges[g][j]) {
+            let (h, kk) = self
+                .other(topo.face_edges[g][j], (g, j))
+                .ok_or_else(broken)?;
+            (g, j) = (h, (kk + 1) % self.len(h));
             if (g, j) == (f, c) {
                 return Ok(here); // inside the panel
             }
@@ -310,169 +411,195 @@ fn island(
             }
         }
         let (go, jo) = (g, j);
-        let (mut g, mut j) = (f, c);
-        loop {
-            let i = (j + len(g) - 1) % len(g);
-            let e = topo.face_edges[g][i];
-            if !flat_join(e) {
-                break;
-            }
-            (g, j) = other(e, (g, i)).ok_or_else(broken)?;
+        let (mut g, mut i) = (f, (c + self.len(f) - 1) % self.len(f));
+        while self.flat_join(topo.face_edges[g][i]) {
+            let (h, kk) = self
+                .other(topo.face_edges[g][i], (g, i))
+                .ok_or_else(broken)?;
+            (g, i) = (h, (kk + self.len(h) - 1) % self.len(h));
             n += 1;
             if n > guard {
                 return Err(broken());
             }
         }
-        let (gi, ji) = (g, (j + len(g) - 1) % len(g));
-        let (d_in, d_out) = (half(topo.face_edges[gi][ji]), half(topo.face_edges[go][jo]));
+        let (gi, ji) = (g, i);
+        let (d_in, d_out) = (
+            self.half(topo.face_edges[gi][ji]),
+            self.half(topo.face_edges[go][jo]),
+        );
         if d_in == 0.0 && d_out == 0.0 {
             return Ok(here);
         }
-        let (p0, p1) = flat.corner_edge(gi, ji);
-        let (q0, q1) = flat.corner_edge(go, jo);
+        let (p0, p1) = self.flat.corner_edge(gi, ji);
+        let (q0, q1) = self.flat.corner_edge(go, jo);
         let (u_in, u_out) = ((p1 - p0).normalize_or_zero(), (q1 - q0).normalize_or_zero());
         let (a, b) = (p0 + t + u_in.perp() * d_in, q0 + t + u_out.perp() * d_out);
-        let parallel = || {
-            let (oi, oo) = (u_in.perp() * d_in, u_out.perp() * d_out);
-            here + if d_in != 0.0 && d_out != 0.0 {
+        let (oi, oo) = (u_in.perp() * d_in, u_out.perp() * d_out);
+        let parallel = here
+            + if d_in != 0.0 && d_out != 0.0 {
                 0.5 * (oi + oo)
             } else {
                 oi + oo
-            }
-        };
+            };
         let cross = u_in.perp_dot(u_out);
         if cross.abs() < 1e-9 {
-            return Ok(parallel());
+            return Ok(parallel);
         }
         let at = a + u_in * ((b - a).perp_dot(u_out) / cross);
         if at.distance(here) > MITER_LIMIT * d_in.abs().max(d_out.abs()) {
-            return Ok(parallel());
+            return Ok(parallel);
         }
         Ok(at)
-    };
-    let mut dev: HashMap<usize, Vec<DVec2>> = HashMap::with_capacity(faces.len());
-    for &f in faces {
-        let pts = (0..len(f))
-            .map(|c| corner(f, c))
-            .collect::<Result<Vec<_>, _>>()?;
-        let orig = &flat.face_2d[f];
-        let n = pts.len();
-        let kept =
-            (0..n).all(|c| (pts[(c + 1) % n] - pts[c]).dot(orig[(c + 1) % n] - orig[c]) > 0.0);
-        if !kept || polygon::signed_area(&pts) <= 0.0 {
-            return Err(format!(
-                "face {} is narrower than the bend deductions of its folds",
-                f + 1
-            ));
-        }
-        dev.insert(f, pts);
     }
 
-    // The border, with the corners between trimmed faces, and the check that folds meet
-    // only on it.
-    let loops = super::walk(flat, faces).ok_or("its outline could not be traced")?;
-    let vert = |f: usize, c: usize| mesh.faces[f].verts[c % len(f)];
-    let on_border: HashSet<usize> = loops.iter().flatten().map(|s| vert(s.f, s.i + 1)).collect();
-    let mut seen: HashMap<usize, DVec2> = HashMap::new();
-    for &f in faces {
-        for (c, &p) in dev[&f].iter().enumerate() {
-            let v = vert(f, c);
-            if on_border.contains(&v) {
+    /// Folds meet only on the border: every vertex inside the island keeps one position.
+    fn check_inside(
+        &self,
+        loops: &[Vec<Step>],
+        dev: &HashMap<usize, Vec<DVec2>>,
+    ) -> Result<(), String> {
+        let mesh = &self.flat.surface.mesh;
+        let vert = |f: usize, c: usize| mesh.faces[f].verts[c % self.len(f)];
+        let on_border: HashSet<usize> =
+            loops.iter().flatten().map(|s| vert(s.f, s.i + 1)).collect();
+        let mut seen: HashMap<usize, DVec2> = HashMap::new();
+        for &f in self.faces {
+            for (c, &p) in dev[&f].iter().enumerate() {
+                let v = vert(f, c);
+                if on_border.contains(&v) {
+                    continue;
+                }
+                let first = *seen.entry(v).or_insert(p);
+                if first.distance(p) > self.tol {
+                    return Err(format!(
+                        "folds meet inside the piece (at mesh vertex {})",
+                        v + 1
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Bend lines: the part of each bend centre line both faces reach, within the blank.
+    fn bend_lines(
+        &self,
+        dev: &HashMap<usize, Vec<DVec2>>,
+        rings: &[Ring],
+    ) -> HashMap<usize, (DVec2, DVec2)> {
+        let pts: Vec<Vec<DVec2>> = rings.iter().map(|r| r.0.clone()).collect();
+        let mut folds = HashMap::new();
+        for b in &self.bends {
+            let e = b.edge;
+            let (f, i) = self.flat.topology.edges[e].uses[0];
+            let Some((g, j)) = self.other(e, (f, i)) else {
+                continue;
+            };
+            let (a0, a1) = (dev[&f][i], dev[&f][(i + 1) % self.len(f)]);
+            let length = a0.distance(a1);
+            if length <= 0.0 {
                 continue;
             }
-            let first = *seen.entry(v).or_insert(p);
-            if first.distance(p) > tol {
-                return Err(format!(
-                    "folds meet inside the piece (at mesh vertex {})",
-                    v + 1
-                ));
+            let u = (a1 - a0) / length;
+            let (s0, s1) = (
+                (dev[&g][j] - a0).dot(u),
+                (dev[&g][(j + 1) % self.len(g)] - a0).dot(u),
+            );
+            let (lo, hi) = (s0.min(s1).max(0.0), s0.max(s1).min(length));
+            let inside = polygon::line_intervals(&pts, a0, u)
+                .into_iter()
+                .map(|(t0, t1)| (t0.max(lo), t1.min(hi)))
+                .filter(|(t0, t1)| t1 > t0)
+                .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)));
+            let (t0, t1) = inside.unwrap_or((lo, hi));
+            if t1 - t0 > 1e-9 {
+                folds.insert(e, (a0 + u * t0, a0 + u * t1));
             }
         }
-    }
-    let mut rings = Vec::with_capacity(loops.len());
-    let mut reliefs = Vec::new();
-    for l in &loops {
-        rings.push(ring(l, &dev, &fold, &figure, &mut reliefs)?);
-    }
-    if crosses(&rings) {
-        return Err("its outline would cross itself".into());
+        folds
     }
 
-    // Bend lines: the part of the bend centre line both faces reach, within the blank.
-    let pts: Vec<Vec<DVec2>> = rings.iter().map(|r| r.0.clone()).collect();
-    let mut folds = HashMap::new();
-    for b in &bends {
-        let e = b.edge;
-        let (f, i) = topo.edges[e].uses[0];
-        let Some((g, j)) = other(e, (f, i)) else {
-            continue;
+    /// One border ring of a developed island: each boundary half-edge from its trimmed
+    /// start, and between two of them what their corners need: nothing when they meet, the
+    /// segment along the bend line from one to the other across one fold, a corner relief
+    /// where two or more folds meet (its radius pushed onto `reliefs`).
+    fn ring(
+        &self,
+        steps: &[Step],
+        dev: &HashMap<usize, Vec<DVec2>>,
+        reliefs: &mut Vec<f64>,
+    ) -> Result<Ring, String> {
+        let n = steps.len();
+        let at = |f: usize, c: usize| {
+            let p = &dev[&f];
+            p[c % p.len()]
         };
-        let (a0, a1) = (dev[&f][i], dev[&f][(i + 1) % len(f)]);
-        let length = a0.distance(a1);
-        if length <= 0.0 {
-            continue;
-        }
-        let u = (a1 - a0) / length;
-        let (s0, s1) = (
-            (dev[&g][j] - a0).dot(u),
-            (dev[&g][(j + 1) % len(g)] - a0).dot(u),
-        );
-        let (lo, hi) = (s0.min(s1).max(0.0), s0.max(s1).min(length));
-        let inside = polygon::line_intervals(&pts, a0, u)
-            .into_iter()
-            .map(|(t0, t1)| (t0.max(lo), t1.min(hi)))
-            .filter(|(t0, t1)| t1 > t0)
-            .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)));
-        let (t0, t1) = inside.unwrap_or((lo, hi));
-        if t1 - t0 > 1e-9 {
-            folds.insert(e, (a0 + u * t0, a0 + u * t1));
-        }
-    }
-    Ok(IslandOut {
-        faces: dev.into_iter().collect(),
-        rings,
-        folds,
-        bends,
-        reliefs,
-    })
-}
-
-/// One border ring of a developed island: each boundary half-edge from its trimmed start, and
-/// between two of them what their corners need: nothing when they meet, the segment along the
-/// bend line from one to the other across one fold, a corner relief where two or more folds
-/// meet (its radius pushed onto `reliefs`).
-fn ring<'a>(
-    steps: &[Step],
-    dev: &HashMap<usize, Vec<DVec2>>,
-    fold: &dyn Fn(usize) -> bool,
-    figure: &dyn Fn(usize) -> Option<&'a BendFigure>,
-    reliefs: &mut Vec<f64>,
-) -> Result<Ring, String> {
-    let n = steps.len();
-    let at = |f: usize, c: usize| {
-        let p = &dev[&f];
-        p[c % p.len()]
-    };
-    let seg: Vec<(DVec2, DVec2)> = steps
-        .iter()
-        .map(|s| (at(s.f, s.i), at(s.f, s.i + 1)))
-        .collect();
-    let mut lo = vec![0.0_f64; n];
-    let mut hi = vec![1.0_f64; n];
-    let mut extra: Vec<Vec<DVec2>> = vec![Vec::new(); n];
-    for k in 0..n {
-        let s = &steps[k];
-        let next = (k + 1) % n;
-        let (end_a, start_b) = (seg[k].1, seg[next].0);
-        let folds: Vec<usize> = (0..s.turn.len()).filter(|&q| fold(s.turn[q].0)).collect();
-        if folds.len() < 2 {
-            if end_a.distance(start_b) > 1e-9 {
-                extra[k].push(end_a);
+        let seg: Vec<(DVec2, DVec2)> = steps
+            .iter()
+            .map(|s| (at(s.f, s.i), at(s.f, s.i + 1)))
+            .collect();
+        let mut lo = vec![0.0_f64; n];
+        let mut hi = vec![1.0_f64; n];
+        let mut extra: Vec<Vec<DVec2>> = vec![Vec::new(); n];
+        for k in 0..n {
+            let next = (k + 1) % n;
+            let folds: Vec<usize> = (0..steps[k].turn.len())
+                .filter(|&q| self.fold(steps[k].turn[q].0))
+                .collect();
+            if folds.len() < 2 {
+                if seg[k].1.distance(seg[next].0) > 1e-9 {
+                    extra[k].push(seg[k].1);
+                }
+                continue;
             }
-            continue;
+            let (c, r) = self.relief(&steps[k], &folds, dev, seg[k], seg[next]);
+            let swallowed = || "a corner relief takes a whole edge of the piece".to_string();
+            let (ta, _) = circle_hits(seg[k], c, r).ok_or_else(swallowed)?;
+            let (_, tb) = circle_hits(seg[next], c, r).ok_or_else(swallowed)?;
+            if !(0.0..=1.0).contains(&ta) || !(0.0..=1.0).contains(&tb) {
+                return Err(swallowed());
+            }
+            hi[k] = hi[k].min(ta);
+            lo[next] = lo[next].max(tb);
+            let pa = seg[k].0 + (seg[k].1 - seg[k].0) * ta;
+            let pb = seg[next].0 + (seg[next].1 - seg[next].0) * tb;
+            extra[k] = arc(c, r, pa, pb);
+            reliefs.push(r);
         }
-        // A corner relief: centred where the bend lines meet (the corners of the faces
-        // between the first and the last fold), clearing the bend zones' overlaps.
+        let (mut pts, mut edges, mut owners) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..n {
+            if lo[k] >= hi[k] - 1e-9 {
+                return Err("the corner reliefs at both ends of an edge overlap".into());
+            }
+            let (a, b) = seg[k];
+            pts.push(if lo[k] == 0.0 { a } else { a + (b - a) * lo[k] });
+            edges.push(steps[k].e);
+            owners.push(steps[k].f);
+            for &p in &extra[k] {
+                pts.push(p);
+                edges.push(NO_EDGE);
+                owners.push(steps[k].f);
+            }
+        }
+        Ok((pts, edges, owners))
+    }
+
+    /// The corner relief after border step `s`, whose turn crosses the folds `folds` (two or
+    /// more): centred where the bend lines meet (the corners of the faces between the first
+    /// and the last fold), of the radius that clears the bend zones' overlaps, the trimmed
+    /// corners and a crossing of the flanges' sides `a` and `b`.
+    fn relief(
+        &self,
+        s: &Step,
+        folds: &[usize],
+        dev: &HashMap<usize, Vec<DVec2>>,
+        a: (DVec2, DVec2),
+        b: (DVec2, DVec2),
+    ) -> (DVec2, f64) {
+        let at = |f: usize, c: usize| {
+            let p = &dev[&f];
+            p[c % p.len()]
+        };
         let mids: Vec<DVec2> = folds[..folds.len() - 1]
             .iter()
             .map(|&q| {
@@ -483,13 +610,14 @@ fn ring<'a>(
         let c = mids.iter().copied().sum::<DVec2>() / mids.len() as f64;
         let mut r = mids
             .iter()
-            .chain([&end_a, &start_b])
+            .chain([&a.1, &b.0])
             .map(|p| p.distance(c))
             .fold(0.0, f64::max);
+        // Each bend zone: BA wide about its bend line (the fold's edge in the face after it).
         let zone = |q: usize| {
             let (e, g, j) = s.turn[q];
-            let (p0, p1) = (at(g, j + dev[&g].len() - 1), at(g, j));
-            let w = figure(e).map_or(0.0, |b| 0.5 * b.allowance);
+            let (p0, p1) = (at(g, j + self.len(g) - 1), at(g, j));
+            let w = self.figure(e).map_or(0.0, |b| 0.5 * b.allowance);
             (p1, (p1 - p0).normalize_or_zero().perp(), w)
         };
         for w in folds.windows(2) {
@@ -506,49 +634,26 @@ fn ring<'a>(
                 }
             }
         }
-        // Flanges whose trimmed sides cross: the relief takes the crossing too.
-        if let Some(x) = crossing(seg[k], seg[next]) {
+        if let Some(x) = crossing(a, b) {
             r = r.max(x.distance(c));
         }
-        r = r * (1.0 + 1e-9) + 1e-6;
-        let swallowed = || "a corner relief takes a whole edge of the piece".to_string();
-        let (ta, _) = circle_hits(seg[k], c, r).ok_or_else(swallowed)?;
-        let (_, tb) = circle_hits(seg[next], c, r).ok_or_else(swallowed)?;
-        if !(0.0..=1.0).contains(&ta) || !(0.0..=1.0).contains(&tb) {
-            return Err(swallowed());
-        }
-        hi[k] = hi[k].min(ta);
-        lo[next] = lo[next].max(tb);
-        let pa = seg[k].0 + (seg[k].1 - seg[k].0) * ta;
-        let pb = seg[next].0 + (seg[next].1 - seg[next].0) * tb;
-        // Clockwise about the centre: the hole on the right of the border, the material left.
-        let (fa, fb) = ((pa - c).to_angle(), (pb - c).to_angle());
-        let sweep = (fa - fb).rem_euclid(std::f64::consts::TAU);
-        let step = (2.0 * (1.0 - 0.01 / r).max(-1.0).acos()).clamp(1e-3, 15f64.to_radians());
-        let parts = (sweep / step).ceil().max(1.0) as usize;
-        extra[k].push(pa);
-        for m in 1..parts {
-            let phi = fa - sweep * m as f64 / parts as f64;
-            extra[k].push(c + DVec2::from_angle(phi) * r);
-        }
-        reliefs.push(r);
+        (c, r * (1.0 + 1e-9) + 1e-6)
     }
-    let (mut pts, mut edges, mut owners) = (Vec::new(), Vec::new(), Vec::new());
-    for k in 0..n {
-        if lo[k] >= hi[k] - 1e-9 {
-            return Err("the corner reliefs at both ends of an edge overlap".into());
-        }
-        let (a, b) = seg[k];
-        pts.push(if lo[k] == 0.0 { a } else { a + (b - a) * lo[k] });
-        edges.push(steps[k].e);
-        owners.push(steps[k].f);
-        for &p in &extra[k] {
-            pts.push(p);
-            edges.push(NO_EDGE);
-            owners.push(steps[k].f);
-        }
+}
+
+/// The arc of a corner relief from `pa` to just before `pb`, clockwise about `c` (the hole on
+/// the right of the border, the material on its left), within 0.01 mm of the circle.
+fn arc(c: DVec2, r: f64, pa: DVec2, pb: DVec2) -> Vec<DVec2> {
+    let (fa, fb) = ((pa - c).to_angle(), (pb - c).to_angle());
+    let sweep = (fa - fb).rem_euclid(std::f64::consts::TAU);
+    let step = (2.0 * (1.0 - 0.01 / r).max(-1.0).acos()).clamp(1e-3, 15f64.to_radians());
+    let parts = (sweep / step).ceil().max(1.0) as usize;
+    let mut out = vec![pa];
+    for m in 1..parts {
+        let phi = fa - sweep * m as f64 / parts as f64;
+        out.push(c + DVec2::from_angle(phi) * r);
     }
-    Ok((pts, edges, owners))
+    out
 }
 
 /// Where the segment `s` (from `s.0` to `s.1`) meets the circle about `c` of radius `r`: the
