@@ -33,14 +33,20 @@
 //! border between two faces of one fold, the two trimmed corners both lie on the bend line and
 //! the border runs along it from one to the other (nothing when the free edges are square to
 //! the bend, a jog where they are not). Where two or more folds meet at a border vertex — a
-//! box's corner, where the base's two bends meet — the flanges' bend zones overlap and their
-//! trimmed corners overlap each other; a shop cuts a corner relief there: a round hole (FreeCAD
-//! SheetMetal's "circle" corner relief, centred where it puts it) centred where the bend centre
-//! lines meet (the corner of the panel between the folds), of the least radius that clears
-//! the intersection of the bend zones (each BA wide about its bend line), the trimmed corners
-//! and any overlap of the flanges. The flanges keep their outside width up to the relief: two
-//! walls of a box meet on the outside line at their seam, as the mesh says; a butt joint
-//! takes the thickness off one of them (left to the user, the mesh cannot say which).
+//! box's corner, where the base's two bends meet — the flanges' bend zones overlap and so do
+//! their trimmed corners; a shop cuts a corner relief there, and so does flatcut: a round hole
+//! (FreeCAD SheetMetal's "circle" corner relief) centred where the bend centre lines meet (the
+//! corner of the panel between the folds; the mean of those corners for three folds or more),
+//! of the least radius that clears the intersection of the bend zones (each BA wide about its
+//! bend line), the trimmed corners and any overlap of the flanges' sides: BA/√2 at a box's
+//! corner. Its arc is cut within 0.01 mm of the circle; the bend lines stop on it. The flanges
+//! keep their outside width up to the relief: two walls of a box meet on the outside line at
+//! their seam, as the mesh says; a butt joint takes the thickness off one of them (left to the
+//! user: the mesh cannot say which). Where a bend ends on a free edge that runs straight on (a
+//! flange narrower than the wall it hangs from), the wall's corner moves onto the bend line
+//! and its free edge leans by BD/2 over its length; a shop would cut a bend relief slot there
+//! (not made). A corner moved further than ten times its offset (two nearly parallel edges)
+//! is moved square to them instead.
 //!
 //! **What is not developed.** Pieces laid out from charts of a smooth mesh (their bends are
 //! gradual, not brake bends), strips, fittings and spline surfaces (developed on their neutral
@@ -50,6 +56,8 @@
 //! panels around a closed loop of folds whose deductions do not agree, a face narrower than
 //! the deductions of its folds, or an outline that would cross itself. A fold the split cut
 //! (`split`) is a seam between two parts, not a bend: the parts are developed one by one.
+//! The flat the pipeline keeps (`--uv-obj`, texture painting) is the one laid out, not
+//! developed.
 
 use super::{PatternOptions, Ring, Step};
 use crate::flatten::Flat;

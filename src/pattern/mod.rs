@@ -5,7 +5,10 @@
 //! up, a grain line for fabric, bend notes for metal, and the material's finishing: glue tabs
 //! for paper, seam allowance for fabric, kerf compensation ([`allowance`]). Pieces laid out
 //! from D-Charts have the seams between them simplified first ([`simplify`], thesis §5.3):
-//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge.
+//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge. The folds of
+//! a metal mesh are developed as brake bends first ([`develop`]: each wall shorter by half
+//! the bend deduction of each of its bends, bend lines on the bend centre lines, corner
+//! reliefs), and every later step works on the developed piece.
 //!
 //! Conventions: pieces are drawn as seen from the printed side, which is the outside of a
 //! closed mesh; a convex edge therefore folds away from the viewer and is a mountain fold, a
@@ -237,7 +240,9 @@ pub struct Piece {
     pub outline: Vec<Vec<DVec2>>,
     /// The piece's edges on the surface, as `outline` (outer first, counter-clockwise).
     pub border: Vec<Vec<DVec2>>,
-    /// Mesh edge of each border segment (segment `k` runs from point `k` to `k + 1`).
+    /// Mesh edge of each border segment (segment `k` runs from point `k` to `k + 1`), or
+    /// [`develop::NO_EDGE`] for a segment of a developed metal piece that is no mesh edge (a
+    /// corner relief, the step between two trimmed corners on a bend line).
     pub border_edges: Vec<Vec<usize>>,
     /// Mesh face each border segment belongs to.
     pub border_faces: Vec<Vec<usize>>,

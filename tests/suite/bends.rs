@@ -42,28 +42,67 @@ fn pieces(path: &Path) -> Vec<Piece> {
     flatcut::pipeline::pieces(&spec, true).unwrap().1
 }
 
-/// Across the bend lines parallel to `dir`: the distances from the blank's edge to the first
-/// bend line, between consecutive bend lines, and from the last to the other edge (mm).
-fn gaps_across(p: &Piece, dir: DVec2) -> Vec<f64> {
+/// Across the bend lines (`lines`) parallel to `dir`: the distances from the blank's edge
+/// (`outline`) to the first bend line, between consecutive bend lines, and from the last to
+/// the other edge (mm). Each bend line is straight across, its ends within `tol` of one offset.
+fn gaps(lines: &[(DVec2, DVec2)], outline: &[DVec2], dir: DVec2, tol: f64) -> Vec<f64> {
     let n = dir.perp();
-    let mut at: Vec<f64> = p
-        .folds
+    let mut at: Vec<f64> = lines
         .iter()
-        .filter(|f| !f.tab && (f.b - f.a).normalize().perp_dot(dir).abs() < 1e-9)
-        .map(|f| {
-            // A bend line is straight across: both ends at one offset.
-            assert!((f.a.dot(n) - f.b.dot(n)).abs() < 1e-9, "{f:?}");
-            f.a.dot(n)
+        .filter(|(a, b)| (*b - *a).normalize().perp_dot(dir).abs() < tol / 100.0)
+        .map(|(a, b)| {
+            assert!((a.dot(n) - b.dot(n)).abs() < tol, "{a} {b}");
+            a.dot(n)
         })
         .collect();
     at.sort_by(f64::total_cmp);
-    let across = p.outline[0].iter().map(|q| q.dot(n));
+    let across = outline.iter().map(|q| q.dot(n));
     let lo = across.clone().fold(f64::INFINITY, f64::min);
     let hi = across.fold(f64::NEG_INFINITY, f64::max);
     let mut edges = vec![lo];
     edges.extend(at);
     edges.push(hi);
     edges.windows(2).map(|w| w[1] - w[0]).collect()
+}
+
+/// [`gaps`] of a piece's bend lines and outline.
+fn gaps_across(p: &Piece, dir: DVec2) -> Vec<f64> {
+    let lines: Vec<_> = p
+        .folds
+        .iter()
+        .filter(|f| !f.tab)
+        .map(|f| (f.a, f.b))
+        .collect();
+    gaps(&lines, &p.outline[0], dir, 1e-9)
+}
+
+/// Checks the gaps across the box's bend lines both ways (three bend lines one way, two the
+/// other): 100 − BD between two bend lines, 100 − BD/2 from a bend line to a free edge.
+fn check_box_gaps(lines: &[(DVec2, DVec2)], outline: &[DVec2], deduction: f64, tol: f64) {
+    let d0 = (lines[0].1 - lines[0].0).normalize();
+    let mut counts = Vec::new();
+    for dir in [d0, d0.perp()] {
+        let gaps = gaps(lines, outline, dir, tol);
+        counts.push(gaps.len() - 1);
+        let last = gaps.len() - 1;
+        for (i, g) in gaps.iter().enumerate() {
+            let want = if i == 0 || i == last {
+                100.0 - deduction / 2.0
+            } else {
+                100.0 - deduction
+            };
+            assert!(
+                (g - want).abs() < 0.05,
+                "gap {i} across {dir}: {g} for {want}"
+            );
+            assert!(
+                (g - want).abs() < tol,
+                "gap {i} across {dir}: {g} for {want}"
+            );
+        }
+    }
+    counts.sort();
+    assert_eq!(counts, [2, 3]);
 }
 
 /// Extent (mm) of the blank along `dir`.
@@ -103,30 +142,9 @@ fn a_100_mm_box_in_2_mm_steel_is_shorter_by_the_bend_deductions_of_its_folds() {
     // Every face: 100 − BD between two bend lines, 100 − BD/2 from a bend line to a free
     // edge, in both directions of the cross-shaped net (five folds: three one way, two the
     // other).
+    let lines: Vec<_> = p.folds.iter().map(|f| (f.a, f.b)).collect();
+    check_box_gaps(&lines, &p.outline[0], deduction, 1e-6);
     let d0 = (p.folds[0].b - p.folds[0].a).normalize();
-    let mut counts = Vec::new();
-    for dir in [d0, d0.perp()] {
-        let gaps = gaps_across(p, dir);
-        counts.push(gaps.len() - 1);
-        let last = gaps.len() - 1;
-        for (i, g) in gaps.iter().enumerate() {
-            let want = if i == 0 || i == last {
-                100.0 - deduction / 2.0
-            } else {
-                100.0 - deduction
-            };
-            assert!(
-                (g - want).abs() < 0.05,
-                "gap {i} across {dir}: {g} for {want}"
-            );
-            assert!(
-                (g - want).abs() < 1e-6,
-                "gap {i} across {dir}: {g} for {want}"
-            );
-        }
-    }
-    counts.sort();
-    assert_eq!(counts, [2, 3]);
     // The blank: 300 − 2 BD by 400 − 3 BD (the issue: it was 300 × 400 before).
     let mut sides = [extent_along(p, d0), extent_along(p, d0.perp())];
     sides.sort_by(f64::total_cmp);
@@ -221,6 +239,24 @@ fn the_box_from_the_command_line_reports_each_bends_allowance() {
     assert_eq!(d["corner_reliefs_mm"].as_array().unwrap().len(), 4);
     // Developed seams are not seam mismatches; nothing was left undeveloped.
     assert!(rep.get("warnings").is_none(), "{}", rep["warnings"]);
+
+    // The DXF a shop reads: the bend lines (BEND_DOWN: mountain folds) on the bend centre
+    // lines of the cut blank, to its 0.1 µm precision.
+    let drawing = dxf::Drawing::load_file(out.join("cube.dxf")).expect("dxf crate reads it");
+    let (mut cut, mut lines) = (Vec::new(), Vec::new());
+    for e in drawing.entities() {
+        match (&e.specific, e.common.layer.as_str()) {
+            (dxf::entities::EntityType::LwPolyline(p), "CUT") => {
+                cut.extend(p.vertices.iter().map(|v| DVec2::new(v.x, v.y)))
+            }
+            (dxf::entities::EntityType::Line(l), "BEND_DOWN") => {
+                lines.push((DVec2::new(l.p1.x, l.p1.y), DVec2::new(l.p2.x, l.p2.y)))
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(lines.len(), 5);
+    check_box_gaps(&lines, &cut, deduction, 1e-3);
 }
 
 /// Two rectangles, `a` and `b` mm deep and 100 mm wide, joined along a 100 mm edge and bent
