@@ -750,6 +750,13 @@ fn cuttable(
             message,
         });
     }
+    for (piece, message) in crate::pattern::develop::warnings(&layout.pieces) {
+        warnings.push(crate::toolpath::cuttable::Warning {
+            piece,
+            kind: "bend-development",
+            message,
+        });
+    }
     if !quiet {
         for w in &warnings {
             eprintln!("flatcut: warning: {}", w.message);

@@ -9,6 +9,60 @@ use crate::Error;
 use clap::Args;
 use std::path::PathBuf;
 
+/// How a metal sheet bends, on the command line (`cut`, `flatten`); they override the spec's
+/// `[material]` table (`--k-factor` also the `k_factor` of its strips and spline surfaces,
+/// as `flatcut fitting --k-factor` does for a fitting).
+#[derive(Debug, Clone, Default, Args)]
+pub struct MetalArgs {
+    /// Sheet thickness in mm (default: the spec's, else by material: paper 0.25, fabric 0.5,
+    /// metal 1).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub thickness: Option<f64>,
+    /// K factor of the metal's bends: the neutral surface's depth below the inside face over
+    /// the thickness, 0 to 1 (default 0.4).
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
+    pub k_factor: Option<f64>,
+    /// Inside bend radius in mm of the folds of metal meshes (default: the thickness).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub bend_radius: Option<f64>,
+}
+
+impl MetalArgs {
+    /// Puts the flags into the spec (flags win), refusing values that make no sense.
+    pub fn apply(&self, spec: &mut Spec) -> Result<(), Error> {
+        let bad = |flag: &str, v: f64, what: &str| {
+            Err(Error::Usage(format!("--{flag} {v}: must be {what}")))
+        };
+        if let Some(t) = self.thickness {
+            if !(t.is_finite() && t > 0.0) {
+                return bad("thickness", t, "a thickness in mm, more than 0");
+            }
+            spec.material.thickness = t;
+        }
+        if let Some(k) = self.k_factor {
+            if !(0.0..=1.0).contains(&k) {
+                return bad("k-factor", k, "a number from 0 to 1");
+            }
+            spec.material.k_factor = k;
+            for s in &mut spec.surfaces {
+                if let Some((_, sk)) = s.strip.as_mut().and_then(|st| st.sheet.as_mut()) {
+                    *sk = k;
+                }
+                if let Some(sp) = &mut s.spline {
+                    sp.sheet.1 = k;
+                }
+            }
+        }
+        if let Some(r) = self.bend_radius {
+            if !(r.is_finite() && r >= 0.0) {
+                return bad("bend-radius", r, "a radius in mm, at least 0");
+            }
+            spec.material.bend_radius = Some(r);
+        }
+        Ok(())
+    }
+}
+
 /// Pattern settings on the command line; they override the spec's `[pattern]` table.
 #[derive(Debug, Clone, Default, Args)]
 pub struct PatternArgs {

@@ -40,6 +40,8 @@ pub struct CutArgs {
     /// Material: paper, fabric or metal (overrides the spec).
     #[arg(long)]
     pub material: Option<MaterialKind>,
+    #[command(flatten)]
+    pub metal: super::args::MetalArgs,
     /// Write the program and pictures but send nothing.
     #[arg(long)]
     pub dry_run: bool,
@@ -88,6 +90,7 @@ pub fn run(a: &CutArgs) -> Result<(), Error> {
     if let Some(m) = a.material {
         spec.material.kind = m;
     }
+    a.metal.apply(&mut spec)?;
     a.pattern.apply(&mut spec)?;
     a.size.apply(&mut spec);
     ask_alternatives(&mut spec, a.alternatives);

@@ -255,6 +255,8 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             } else {
                 kind.default_thickness()
             },
+            k_factor: a.k_factor,
+            bend_radius: None,
         },
         sheet: SheetSpec {
             width: a.sheet_width,

@@ -21,6 +21,8 @@ pub struct FlattenArgs {
     #[arg(long)]
     pub material: Option<crate::spec::MaterialKind>,
     #[command(flatten)]
+    pub metal: super::args::MetalArgs,
+    #[command(flatten)]
     pub size: SizeArgs,
     #[command(flatten)]
     pub sheet: SheetArgs,
@@ -53,6 +55,7 @@ pub fn run(a: &FlattenArgs) -> Result<(), Error> {
     if let Some(m) = a.material {
         spec.material.kind = m;
     }
+    a.metal.apply(&mut spec)?;
     a.pattern.apply(&mut spec)?;
     a.size.apply(&mut spec);
     a.sheet.apply(&mut spec, None)?;

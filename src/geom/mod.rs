@@ -8,6 +8,8 @@
 //!   points, for the spline developables' solver.
 //! - [`polygon`], [`boolean`], [`segment`]: 2D polygons (area, triangulation, overlap, poles,
 //!   line crossings), their booleans and offsets, point and segment distances (2D and 3D).
+//! - [`bend`]: sheet-metal bend arithmetic: neutral surface depth, bend allowance, setback and
+//!   deduction (shared by the fittings and the development of metal meshes).
 //! - [`hull`]: 3D convex hulls and the local-convexity test of an edge.
 //! - [`cut`], [`proxy`]: cutting a mesh chart open into a disk, and the developable proxy fit
 //!   (D-Charts), shared by the surface and flatten stages.
@@ -19,6 +21,7 @@
 //! - [`input`]: reading a user's input file: a regular file under a size limit, UTF-8 with a
 //!   position.
 
+pub mod bend;
 pub mod boolean;
 pub mod bspline;
 pub mod curve;

@@ -13,7 +13,11 @@
 //! `{tolerance_mm, vertices_before, vertices_after, max_deviation_mm, max_seam_mismatch_mm}`
 //! (border vertices of all its rings; the largest distance of an original border vertex from
 //! the simplified border; the largest length difference between the two sides of one of its
-//! seams); exact unfoldings have no such key.
+//! seams); exact unfoldings have no such key. Pieces of a metal mesh carry
+//! `bend_development` (`pattern::develop`): `{thickness_mm, k_factor, inside_radius_mm, bends:
+//! [{kind, angle_deg, inside_radius_mm, k_factor, mold_line, allowance_mm, setback_mm,
+//! deduction_mm, length_mm}], corner_reliefs_mm}` (the bends in the order of `fold_lines`; the
+//! reliefs' radii), with `skipped` saying why when the piece could not be developed.
 //!
 //! When the device had no tool for some of a job's strokes, `dropped` lists per piece what was
 //! left out (`{piece, name, sheet, left_out: {label, edge_ids, …: count}, reason}`) and
@@ -112,6 +116,11 @@ pub fn build(info: &RunInfo, flats: &[Flat], layout: &Layout) -> Value {
                     "max_deviation_mm": r6(s.max_deviation),
                     "max_seam_mismatch_mm": r6(s.max_seam_mismatch),
                 });
+            }
+            // Metal meshes developed as bends: only there, so that other reports stay as
+            // they were.
+            if let Some(d) = &p.development {
+                v["bend_development"] = development_json(p, d);
             }
             v
         })
@@ -249,6 +258,43 @@ fn seams_json(layout: &Layout) -> Vec<Value> {
     }
     seams.sort_by_key(|s| s["id"].as_u64());
     seams
+}
+
+/// A developed metal piece (`pattern::develop`): the sheet, each bend line (in the order of
+/// `fold_lines`) with its angle, inside radius, K, allowance, setback and deduction, the
+/// corner reliefs' radii, or why it was not developed.
+fn development_json(p: &crate::pattern::Piece, d: &crate::pattern::develop::Development) -> Value {
+    let s = &d.sheet;
+    let bends: Vec<Value> = p
+        .folds
+        .iter()
+        .filter(|f| !f.tab)
+        .filter_map(|f| {
+            let b = d.bend(f.edge)?;
+            Some(json!({
+                "kind": f.kind,
+                "angle_deg": r6(b.angle.to_degrees()),
+                "inside_radius_mm": r6(s.inside_radius),
+                "k_factor": r6(s.k_factor),
+                "mold_line": b.mold.name(),
+                "allowance_mm": r6(b.allowance),
+                "setback_mm": r6(b.setback),
+                "deduction_mm": r6(b.deduction),
+                "length_mm": r6(f.a.distance(f.b)),
+            }))
+        })
+        .collect();
+    let mut v = json!({
+        "thickness_mm": r6(s.thickness),
+        "k_factor": r6(s.k_factor),
+        "inside_radius_mm": r6(s.inside_radius),
+        "bends": bends,
+        "corner_reliefs_mm": d.reliefs.iter().map(|&r| r6(r)).collect::<Vec<_>>(),
+    });
+    if let Some(why) = &d.skipped {
+        v["skipped"] = json!(why);
+    }
+    v
 }
 
 /// Stretch figures (issue 7): L2 and L∞ (1 = isometric), triangles flipped.

@@ -90,7 +90,12 @@ pub(super) fn find(flat: &Flat, pieces: &mut [Piece], next_id: &mut usize) {
     let mut at: HashMap<usize, Vec<Loc>> = HashMap::new();
     for (pi, p) in pieces.iter().enumerate() {
         for (r, ring) in p.border_edges.iter().enumerate() {
-            for (k, &e) in ring.iter().enumerate() {
+            // A corner of a developed metal piece is no mesh edge (`develop::NO_EDGE`).
+            for (k, &e) in ring
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| e < flat.topology.edges.len())
+            {
                 at.entry(e).or_default().push((pi, r, k));
             }
         }
@@ -293,7 +298,10 @@ pub fn seam_mismatches(pieces: &[Piece], kind: MaterialKind) -> Vec<(String, Str
     for [(pa, ia), (pb, ib)] in pairs(pieces) {
         let (a, b) = (&pieces[pa].seams[ia], &pieces[pb].seams[ib]);
         let l3 = a.length_3d;
-        if l3.is_nan() || l3 <= 0.0 || a.split {
+        // A seam of a developed metal piece is shorter than in 3D by the bends it reaches,
+        // and its two sides by different bends (`develop`): not a mismatch.
+        let developed = |p: &Piece| p.development.as_ref().is_some_and(|d| d.changed());
+        if l3.is_nan() || l3 <= 0.0 || a.split || developed(&pieces[pa]) || developed(&pieces[pb]) {
             continue;
         }
         let simplified = pieces[pa].simplified.is_some() || pieces[pb].simplified.is_some();

@@ -5,7 +5,10 @@
 //! up, a grain line for fabric, bend notes for metal, and the material's finishing: glue tabs
 //! for paper, seam allowance for fabric, kerf compensation ([`allowance`]). Pieces laid out
 //! from D-Charts have the seams between them simplified first ([`simplify`], thesis §5.3):
-//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge.
+//! their borders follow mesh edges and zig-zag; exact unfoldings keep every edge. The folds of
+//! a metal mesh are developed as brake bends first ([`develop`]: each wall shorter by half
+//! the bend deduction of each of its bends, bend lines on the bend centre lines, corner
+//! reliefs), and every later step works on the developed piece.
 //!
 //! Conventions: pieces are drawn as seen from the printed side, which is the outside of a
 //! closed mesh; a convex edge therefore folds away from the viewer and is a mountain fold, a
@@ -20,6 +23,7 @@
 //! [`Default`] adds nothing, for callers that only want the net.
 
 pub mod bends;
+pub mod develop;
 
 use crate::flatten::Flat;
 use crate::geom::polygon;
@@ -92,6 +96,10 @@ pub struct PatternOptions {
     pub simplify: f64,
     /// The spec's `simplify` of single surfaces, by surface name, over [`Self::simplify`].
     pub simplify_surfaces: Vec<(String, f64)>,
+    /// Surfaces whose folds are developed as sheet-metal bends ([`develop`]), by name, with
+    /// the sheet's thickness, K factor and inside bend radius: the mesh surfaces of a metal
+    /// job. Empty in the bare net.
+    pub develop: Vec<(String, crate::geom::bend::SheetBend)>,
 }
 
 impl Default for PatternOptions {
@@ -112,6 +120,7 @@ impl Default for PatternOptions {
             grain: false,
             simplify: 0.0,
             simplify_surfaces: Vec::new(),
+            develop: Vec::new(),
         }
     }
 }
@@ -156,6 +165,14 @@ impl PatternOptions {
             .iter()
             .find(|(n, _)| n == surface)
             .map_or(self.simplify, |(_, t)| *t)
+    }
+
+    /// The sheet a surface's folds are developed in, if they are ([`Self::develop`]).
+    pub fn develop_for(&self, surface: &str) -> Option<crate::geom::bend::SheetBend> {
+        self.develop
+            .iter()
+            .find(|(n, _)| n == surface)
+            .map(|(_, s)| *s)
     }
 }
 
@@ -223,7 +240,9 @@ pub struct Piece {
     pub outline: Vec<Vec<DVec2>>,
     /// The piece's edges on the surface, as `outline` (outer first, counter-clockwise).
     pub border: Vec<Vec<DVec2>>,
-    /// Mesh edge of each border segment (segment `k` runs from point `k` to `k + 1`).
+    /// Mesh edge of each border segment (segment `k` runs from point `k` to `k + 1`), or
+    /// [`develop::NO_EDGE`] for a segment of a developed metal piece that is no mesh edge (a
+    /// corner relief, the step between two trimmed corners on a bend line).
     pub border_edges: Vec<Vec<usize>>,
     /// Mesh face each border segment belongs to.
     pub border_faces: Vec<Vec<usize>>,
@@ -252,6 +271,9 @@ pub struct Piece {
     pub simplified: Option<simplify::Simplified>,
     /// Texts left off for want of a clear place ([`legible`]).
     pub left_out: Vec<legible::LeftOut>,
+    /// How a metal mesh piece was developed: each bend's allowance and deduction, its corner
+    /// reliefs ([`develop`]); `None` for pieces that are not (paper, fabric, strips, charts).
+    pub development: Option<develop::Development>,
 }
 
 impl Piece {
@@ -286,6 +308,7 @@ impl Piece {
             grain: None,
             simplified: None,
             left_out: Vec::new(),
+            development: None,
         }
     }
 
@@ -356,6 +379,10 @@ pub(crate) fn build_tagged(
     let mut next_seam = 1;
     let multi = flats.len() > 1;
     for (fi, flat) in flats.iter().enumerate() {
+        // Metal meshes: the faces trimmed to their bend centre lines, the borders with their
+        // corner reliefs ([`develop`]); every later step works on the developed flat.
+        let developed = develop::develop(flat, opts);
+        let flat = developed.as_ref().map_or(flat, |d| &d.flat);
         let first = pieces.len();
         for (k, faces) in flat.islands.iter().enumerate() {
             let id = pieces.len() + 1;
@@ -369,7 +396,8 @@ pub(crate) fn build_tagged(
             } else {
                 tag
             };
-            pieces.push(net(flat, faces, id, name, opts)?);
+            let dev = developed.as_ref().and_then(|d| d.islands.get(k));
+            pieces.push(net(flat, faces, id, name, opts, dev)?);
         }
         let mine = &mut pieces[first..];
         marks::find(flat, mine, &mut next_seam);
@@ -401,6 +429,7 @@ fn net(
     id: usize,
     name: String,
     opts: &PatternOptions,
+    dev: Option<&develop::Island>,
 ) -> Result<Piece, PatternError> {
     let topo = &flat.topology;
     let mesh = &flat.surface.mesh;
@@ -409,51 +438,20 @@ fn net(
         piece: name.clone(),
     };
 
-    // Outline: walk boundary half-edges around the island, turning about each vertex through
-    // joined edges.
-    let mut visited: std::collections::HashSet<(usize, usize)> = Default::default();
-    let total_corners: usize = faces.iter().map(|&f| mesh.faces[f].verts.len()).sum();
-    let mut loops: Vec<(Vec<DVec2>, Vec<usize>, Vec<usize>)> = Vec::new();
-    for &f0 in faces {
-        for i0 in 0..mesh.faces[f0].verts.len() {
-            if !is_boundary(flat, f0, i0) || visited.contains(&(f0, i0)) {
-                continue;
-            }
-            let (mut pts, mut edges, mut owners) = (Vec::new(), Vec::new(), Vec::new());
-            let (mut f, mut i) = (f0, i0);
-            loop {
-                visited.insert((f, i));
-                pts.push(flat.face_2d[f][i]);
-                edges.push(topo.face_edges[f][i]);
-                owners.push(f);
-                // Next boundary half-edge around the end vertex.
-                let mut steps = 0;
-                let (mut g, mut j) = (f, (i + 1) % mesh.faces[f].verts.len());
-                while !is_boundary(flat, g, j) {
-                    let e = topo.face_edges[g][j];
-                    let &(h, k) = topo.edges[e]
-                        .uses
-                        .iter()
-                        .find(|u| **u != (g, j))
-                        .ok_or_else(fail)?;
-                    g = h;
-                    j = (k + 1) % mesh.faces[h].verts.len();
-                    steps += 1;
-                    if steps > total_corners {
-                        return Err(fail());
-                    }
-                }
-                (f, i) = (g, j);
-                if (f, i) == (f0, i0) {
-                    break;
-                }
-                if pts.len() > total_corners {
-                    return Err(fail());
-                }
-            }
-            loops.push((pts, edges, owners));
-        }
-    }
+    // Outline: the boundary loops of the island, as laid flat or as developed (metal).
+    let mut loops: Vec<Ring> = match dev.and_then(|d| d.rings.clone()) {
+        Some(rings) => rings,
+        None => walk(flat, faces)
+            .ok_or_else(fail)?
+            .iter()
+            .map(|l| {
+                let pts = l.iter().map(|s| flat.face_2d[s.f][s.i]).collect();
+                let edges = l.iter().map(|s| s.e).collect();
+                let owners = l.iter().map(|s| s.f).collect();
+                (pts, edges, owners)
+            })
+            .collect(),
+    };
     if loops.is_empty() {
         return Err(fail());
     }
@@ -483,7 +481,14 @@ fn net(
                 continue;
             }
             if let Some(d) = fold_at[e] {
-                let (a, b) = flat.corner_edge(f, i);
+                let (a, b) = match dev.filter(|d| d.rings.is_some()) {
+                    // Developed: on the bend centre line, within the blank.
+                    Some(d) => match d.folds.get(&e) {
+                        Some(&ab) => ab,
+                        None => continue,
+                    },
+                    None => flat.corner_edge(f, i),
+                };
                 folds.push(Fold {
                     a,
                     b,
@@ -509,8 +514,76 @@ fn net(
         border_faces,
         folds,
         area,
+        development: dev.map(|d| d.development.clone()),
         ..Piece::from_outline(id, name, Vec::new())
     })
+}
+
+/// A border ring as `net` keeps it: points, the mesh edge of each segment (or
+/// [`develop::NO_EDGE`]) and the face it belongs to.
+pub(crate) type Ring = (Vec<DVec2>, Vec<usize>, Vec<usize>);
+
+/// One boundary half-edge of an island: corner `i` of face `f` (the edge from corner `i` to
+/// `i + 1`), and the joined edges crossed about its end vertex to reach the next one, each
+/// with the face entered and that face's corner at the vertex.
+#[derive(Debug, Clone)]
+pub(crate) struct Step {
+    pub f: usize,
+    pub i: usize,
+    /// The mesh edge of the half-edge.
+    pub e: usize,
+    pub turn: Vec<(usize, usize, usize)>,
+}
+
+/// The boundary loops of an island, in the order they are found: walk boundary half-edges
+/// around the island, turning about each vertex through joined edges. `None` when the walk
+/// does not close (a flatcut bug).
+pub(crate) fn walk(flat: &Flat, faces: &[usize]) -> Option<Vec<Vec<Step>>> {
+    let topo = &flat.topology;
+    let mesh = &flat.surface.mesh;
+    let mut visited: std::collections::HashSet<(usize, usize)> = Default::default();
+    let total_corners: usize = faces.iter().map(|&f| mesh.faces[f].verts.len()).sum();
+    let mut loops = Vec::new();
+    for &f0 in faces {
+        for i0 in 0..mesh.faces[f0].verts.len() {
+            if !is_boundary(flat, f0, i0) || visited.contains(&(f0, i0)) {
+                continue;
+            }
+            let mut steps: Vec<Step> = Vec::new();
+            let (mut f, mut i) = (f0, i0);
+            loop {
+                visited.insert((f, i));
+                let mut turn = Vec::new();
+                // Next boundary half-edge around the end vertex.
+                let (mut g, mut j) = (f, (i + 1) % mesh.faces[f].verts.len());
+                while !is_boundary(flat, g, j) {
+                    let e = topo.face_edges[g][j];
+                    let &(h, k) = topo.edges[e].uses.iter().find(|u| **u != (g, j))?;
+                    g = h;
+                    j = (k + 1) % mesh.faces[h].verts.len();
+                    turn.push((e, g, j));
+                    if turn.len() > total_corners {
+                        return None;
+                    }
+                }
+                steps.push(Step {
+                    f,
+                    i,
+                    e: topo.face_edges[f][i],
+                    turn,
+                });
+                (f, i) = (g, j);
+                if (f, i) == (f0, i0) {
+                    break;
+                }
+                if steps.len() > total_corners {
+                    return None;
+                }
+            }
+            loops.push(steps);
+        }
+    }
+    Some(loops)
 }
 
 fn is_boundary(flat: &Flat, f: usize, i: usize) -> bool {

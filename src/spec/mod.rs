@@ -22,6 +22,10 @@
 //! [material]               # optional table
 //! kind = "paper"           # "paper" | "fabric" | "metal"; default paper
 //! thickness = 0.25         # mm, > 0, finite; default by kind: paper 0.25, fabric 0.5, metal 1.0
+//! k_factor = 0.4           # metal meshes: K, the neutral surface's depth below the inside
+//!                          # face over the thickness, 0 to 1; default 0.4
+//! bend_radius = 2          # metal meshes: inside bend radius of the folds, mm >= 0;
+//!                          # default: the thickness (see `pattern::develop`)
 //!
 //! [sheet]                  # optional table; without it a roll-fed device's roll is used
 //! width = 210              # mm > 0; default 210 (A4 portrait)
@@ -328,7 +332,8 @@ impl Spec {
     }
 
     /// The pattern stage's options: the material's defaults with the spec's `[pattern]`
-    /// settings on top, and each mesh surface's `simplify`.
+    /// settings on top, each mesh surface's `simplify` and, in metal, the mesh surfaces to
+    /// develop with the material's bend settings.
     pub fn pattern_options(&self) -> PatternOptions {
         let spec = self;
         let p = &spec.pattern;
@@ -357,6 +362,16 @@ impl Spec {
             .iter()
             .filter_map(|s| s.segment.simplify.map(|t| (s.name.clone(), t)))
             .collect();
+        // Metal meshes are developed as a brake bends them (`pattern::develop`); strips and
+        // splines are developed on their neutral surface already.
+        if spec.material.kind == MaterialKind::Metal {
+            o.develop = spec
+                .surfaces
+                .iter()
+                .filter(|s| s.kind == SurfaceKind::Mesh)
+                .map(|s| (s.name.clone(), spec.material.sheet_bend()))
+                .collect();
+        }
         o
     }
 }
@@ -506,7 +521,28 @@ impl Ctx<'_> {
         let thickness = self
             .number(&m.thickness, "material.thickness", MM_POSITIVE, |v| v > 0.0)?
             .map_or(kind.default_thickness(), |(v, _)| v);
-        Ok(Material { kind, thickness })
+        let k_factor = self
+            .number(
+                &m.k_factor,
+                "material.k_factor",
+                "a number from 0 to 1",
+                |v| (0.0..=1.0).contains(&v),
+            )?
+            .map_or(Material::DEFAULT_K_FACTOR, |(v, _)| v);
+        let bend_radius = self
+            .number(
+                &m.bend_radius,
+                "material.bend_radius",
+                MM_NON_NEGATIVE,
+                |v| v >= 0.0,
+            )?
+            .map(|(v, _)| v);
+        Ok(Material {
+            kind,
+            thickness,
+            k_factor,
+            bend_radius,
+        })
     }
 
     fn sheet(&self, raw: &Option<Spanned<Tab<RawSheet>>>) -> Result<SheetSpec, SpecError> {

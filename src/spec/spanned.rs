@@ -85,6 +85,8 @@ pub(super) struct RawSurface {
 pub(super) struct RawMaterial {
     pub(super) kind: Option<Spanned<Val>>,
     pub(super) thickness: Option<Spanned<Val>>,
+    pub(super) k_factor: Option<Spanned<Val>>,
+    pub(super) bend_radius: Option<Spanned<Val>>,
 }
 
 #[derive(serde::Deserialize)]

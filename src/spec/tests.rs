@@ -103,7 +103,8 @@ fn full_example_parses_exactly() {
             }],
             material: Material {
                 kind: MaterialKind::Paper,
-                thickness: 0.25
+                thickness: 0.25,
+                ..Material::default()
             },
             sheet: SheetSpec {
                 width: 210.0,
@@ -163,7 +164,8 @@ fold_threshold = 179.5
         spec.material,
         Material {
             kind: MaterialKind::Metal,
-            thickness: 1.0
+            thickness: 1.0,
+            ..Material::default()
         }
     );
     assert_eq!(
@@ -206,7 +208,8 @@ fn minimal_spec_gets_all_defaults() {
         spec.material,
         Material {
             kind: MaterialKind::Paper,
-            thickness: 0.25
+            thickness: 0.25,
+            ..Material::default()
         }
     );
     assert_eq!(
@@ -238,6 +241,47 @@ fn material_thickness_defaults_by_kind() {
     ))
     .unwrap();
     assert_eq!(spec.material.thickness, 2.0);
+}
+
+#[test]
+fn material_bend_keys_default_to_k_04_and_the_thickness_and_are_checked() {
+    let spec = p(&format!(
+        "{MINIMAL}[material]\nkind = \"metal\"\nthickness = 2\n"
+    ))
+    .unwrap();
+    let bend = spec.material.sheet_bend();
+    assert_eq!(
+        (bend.thickness, bend.k_factor, bend.inside_radius),
+        (2.0, 0.4, 2.0)
+    );
+    // Metal mesh surfaces are developed with it; paper ones are not.
+    let o = spec.pattern_options();
+    assert_eq!(o.develop, vec![("lamp".to_string(), bend)]);
+    let paper = p(MINIMAL).unwrap().pattern_options();
+    assert!(paper.develop.is_empty());
+
+    let spec = p(&format!(
+        "{MINIMAL}[material]\nkind = \"metal\"\nthickness = 1.5\nk_factor = 0.33\nbend_radius = 0\n"
+    ))
+    .unwrap();
+    let bend = spec.material.sheet_bend();
+    assert_eq!(
+        (bend.thickness, bend.k_factor, bend.inside_radius),
+        (1.5, 0.33, 0.0)
+    );
+
+    let (line, key, message) = invalid(&format!("{MINIMAL}[material]\nk_factor = 1.2\n"));
+    assert_eq!((line, key.as_str()), (5, "material.k_factor"));
+    assert_eq!(message, "must be a number from 0 to 1, got 1.2");
+    let (line, key, message) = invalid(&format!("{MINIMAL}[material]\n\nbend_radius = -2\n"));
+    assert_eq!((line, key.as_str()), (6, "material.bend_radius"));
+    assert_eq!(
+        message,
+        "must be a number of millimetres, zero or more, got -2"
+    );
+    let (_, key, message) = invalid(&format!("{MINIMAL}[material]\nk_factor = nan\n"));
+    assert_eq!(key, "material.k_factor");
+    assert!(message.contains("not a finite number"), "{message}");
 }
 
 #[test]
@@ -586,7 +630,8 @@ fn obj_path_gives_mesh_defaults() {
             spec.material,
             Material {
                 kind: MaterialKind::Paper,
-                thickness: 0.25
+                thickness: 0.25,
+                ..Material::default()
             }
         );
         assert_eq!(

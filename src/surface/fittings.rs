@@ -422,7 +422,7 @@ impl Fitting {
             method: Method::GodtGmbt,
             bend_lines: opts.bend_lines,
             tolerance: opts.tolerance,
-            neutral_offset: (1.0 - k) * t,
+            neutral_offset: crate::geom::bend::neutral_below_outside(k, t),
             sheet: None,
         })
     }

@@ -1,9 +1,13 @@
-//! The material a pattern is cut from: its kind (paper, fabric, metal) and thickness. The
-//! surface stage reads it first (a metal strip is developed on its neutral surface, see
+//! The material a pattern is cut from: its kind (paper, fabric, metal), thickness and, for
+//! metal, how it bends (K factor and inside bend radius). The surface stage reads it first (a
+//! metal strip is developed on its neutral surface, see
 //! [`super::source::SurfaceSpec::for_material`]); flatten and pattern take their defaults
-//! from the kind.
+//! from the kind, and the pattern stage develops the folds of metal meshes with its bend
+//! settings ([`Material::sheet_bend`], `pattern::develop`).
 //!
-//! Choices: a thickness left out defaults by kind (paper 0.25 mm, fabric 0.5, metal 1.0).
+//! Choices: a thickness left out defaults by kind (paper 0.25 mm, fabric 0.5, metal 1.0); K
+//! defaults to 0.4 (as the fittings' and FreeCAD SheetMetal's tables for steel in air
+//! bending) and the inside bend radius to the thickness (a common punch for mild steel).
 
 use std::fmt;
 
@@ -13,6 +17,26 @@ pub struct Material {
     pub kind: MaterialKind,
     /// Thickness in millimetres.
     pub thickness: f64,
+    /// K factor of the folds of metal meshes: the neutral surface's depth below the inside
+    /// face over the thickness (0..1; default 0.4).
+    pub k_factor: f64,
+    /// Inside bend radius (mm) of the folds of metal meshes; `None`: the thickness.
+    pub bend_radius: Option<f64>,
+}
+
+impl Material {
+    /// The K factor used when none is given.
+    pub const DEFAULT_K_FACTOR: f64 = 0.4;
+
+    /// How this material's sheet bends: thickness, K factor and inside radius (the thickness
+    /// unless given).
+    pub fn sheet_bend(&self) -> crate::geom::bend::SheetBend {
+        crate::geom::bend::SheetBend {
+            thickness: self.thickness,
+            k_factor: self.k_factor,
+            inside_radius: self.bend_radius.unwrap_or(self.thickness),
+        }
+    }
 }
 
 /// Kinds of sheet material.
@@ -61,6 +85,8 @@ impl Default for Material {
         Material {
             kind: MaterialKind::Paper,
             thickness: MaterialKind::Paper.default_thickness(),
+            k_factor: Material::DEFAULT_K_FACTOR,
+            bend_radius: None,
         }
     }
 }

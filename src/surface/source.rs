@@ -93,9 +93,10 @@ impl SheetSide {
     /// How far inside the given surface the neutral surface lies (negative: outside) for a
     /// sheet `t` mm thick with K factor `k`.
     pub fn neutral_offset(self, k: f64, t: f64) -> f64 {
+        use crate::geom::bend::{neutral_below_outside, neutral_depth};
         match self {
-            SheetSide::Outside => (1.0 - k) * t,
-            SheetSide::Inside => -k * t,
+            SheetSide::Outside => neutral_below_outside(k, t),
+            SheetSide::Inside => -neutral_depth(k, t),
             SheetSide::Neutral => 0.0,
         }
     }

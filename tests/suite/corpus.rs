@@ -56,6 +56,7 @@ fn run(mesh: &std::path::Path, kind: MaterialKind) -> Row {
     spec.material = Material {
         kind,
         thickness: kind.default_thickness(),
+        ..Material::default()
     };
     let (flats, pieces) =
         flatcut::pipeline::pieces(&spec, true).unwrap_or_else(|e| panic!("{what}: {e}"));

@@ -6,6 +6,7 @@
 #[macro_use]
 mod common;
 
+mod bends;
 mod bent;
 mod boundary;
 mod cli;
