@@ -240,6 +240,7 @@ fn split_couplingdown_in_fabric_fits_every_part_on_a4() {
     spec.material = Material {
         kind: MaterialKind::Fabric,
         thickness: MaterialKind::Fabric.default_thickness(),
+        ..Material::default()
     };
     let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     let s = &spec.sheet;

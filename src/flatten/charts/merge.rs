@@ -21,7 +21,7 @@
 //! pieces. Pieces are tried smallest first, with the same neighbours as above, in rounds until
 //! none joins; a pair that failed is not tried again unless one of the two has grown since.
 
-use super::overlap::{merge_into, self_overlap, Owners};
+use super::overlap::{both_cuts, merge_into, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid};
 use crate::flatten::distortion;
 use glam::DVec2;
@@ -191,13 +191,9 @@ fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps
     if s.flipped > 0 || s.l2 > near || self_overlap(&uv, eps).is_some() {
         return false;
     }
-    let mut cuts = done[k].cuts.clone();
-    cuts.extend(&done[part].cuts);
-    cuts.sort_unstable();
-    cuts.dedup();
     done[k] = Laid {
         faces,
-        cuts,
+        cuts: both_cuts(&done[k], &done[part]),
         uv,
         stretch: s,
         gusset: false,

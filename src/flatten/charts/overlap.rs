@@ -341,11 +341,7 @@ pub(super) fn merge_into(
 ) -> bool {
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
-    let mut cuts = done[k].cuts.clone();
-    cuts.extend(&done[part].cuts);
-    cuts.sort_unstable();
-    cuts.dedup();
-    let Some(cuts) = ctx.disk(&faces, &cuts) else {
+    let Some(cuts) = ctx.disk(&faces, &both_cuts(&done[k], &done[part])) else {
         return false;
     };
     let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
@@ -362,6 +358,15 @@ pub(super) fn merge_into(
         gusset: false,
     };
     true
+}
+
+/// The cuts of two charts merged into one (sorted).
+pub(super) fn both_cuts(a: &Laid, b: &Laid) -> Vec<usize> {
+    let mut cuts = a.cuts.clone();
+    cuts.extend(&b.cuts);
+    cuts.sort_unstable();
+    cuts.dedup();
+    cuts
 }
 
 /// Re-attach each gusset (and each part cut off for overlapping) to an adjacent piece when
