@@ -15,6 +15,11 @@
 //! The port is taken exclusively while flatcut streams: `serialport` opens it with `TIOCEXCL`
 //! (further opens fail with `EBUSY`, except for root) and an exclusive `flock` (which other
 //! well-behaved programs honour); a port already held that way is reported as busy.
+//!
+//! Every port and pseudo-terminal flatcut opens is close-on-exec ([`close_on_exec`]):
+//! `serialport` opens them without `O_CLOEXEC`, so a program started meanwhile (by another
+//! thread, as the test suite does) inherited them and kept the line open after flatcut
+//! closed it: a simulated cutter that hung up went unnoticed until the other program ended.
 
 use crate::profile::{FlowControl, Parity, Profile};
 use serialport::SerialPort;
@@ -80,7 +85,11 @@ pub fn open(profile: &Profile, port: &str, baud: Option<u32>) -> Result<Link, Se
         .flow_control(flow)
         .timeout(POLL)
         .exclusive(true)
-        .open();
+        .open_native()
+        .map(|p| {
+            close_on_exec(&p);
+            Box::new(p) as Box<dyn SerialPort>
+        });
     let port_box = opened.map_err(|e| {
         let busy = {
             let d = e.description.to_ascii_lowercase();
@@ -115,6 +124,20 @@ pub fn open(profile: &Profile, port: &str, baud: Option<u32>) -> Result<Link, Se
         virtual_cts: None,
         written: 0,
     })
+}
+
+/// Mark a port's descriptor close-on-exec, so that no program started later inherits the line
+/// (see the module doc). Best effort: a descriptor it cannot mark stays as it was.
+pub fn close_on_exec(port: &impl std::os::fd::AsRawFd) {
+    let fd = port.as_raw_fd();
+    // SAFETY: fcntl on a descriptor the port owns and keeps open; F_GETFD/F_SETFD only read
+    // and set its flags.
+    unsafe {
+        let flags = libc::fcntl(fd, libc::F_GETFD);
+        if flags >= 0 {
+            libc::fcntl(fd, libc::F_SETFD, flags | libc::FD_CLOEXEC);
+        }
+    }
 }
 
 impl Link {

@@ -718,6 +718,8 @@ fn a_grbl_that_says_run_but_never_moves_times_out() {
     use std::io::{Read, Write};
     let p = grbl_profile("grbl-character-counting");
     let (mut master, slave) = serialport::TTYPort::pair().expect("pty pair");
+    serial::close_on_exec(&master);
+    serial::close_on_exec(&slave);
     let path = slave.name().unwrap();
     let peer = std::thread::spawn(move || {
         master.set_timeout(Duration::from_millis(20)).ok();
@@ -804,4 +806,64 @@ fn a_busy_hpgl_device_that_answers_esc_b_outlasts_the_timeout() {
     assert_eq!(r.garbage_bytes, 0);
     assert_eq!(rep.violations(), 0, "{rep:?}");
     assert_eq!(rep.bytes_received, s.len(), "the queries are not data");
+}
+
+/// A program started while flatcut streams (another thread spawning it, as this test suite
+/// does all the time) inherits none of the simulator's pseudo-terminal or the host's port:
+/// serialport opens them without `O_CLOEXEC`, and a child holding the master open hid the
+/// simulator's hang-up from the host (`hang_up_mid_job_says_how_far_it_got` timed out on CI
+/// at "stroke 9 of 30, byte 688" with the line silent instead of hung up).
+#[test]
+fn programs_started_meanwhile_inherit_no_port() {
+    let p = grbl_profile("grbl-character-counting");
+    let h = sim::spawn(SimConfig::new(p.clone())).unwrap();
+    let port = serial::open(&p, &h.path, None).unwrap();
+    let mut child = std::process::Command::new("sleep")
+        .arg("30")
+        .spawn()
+        .expect("sleep");
+    // Once it runs `sleep` (descriptors are closed on exec, not on fork).
+    let proc_dir = format!("/proc/{}", child.id());
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(format!("{proc_dir}/comm")).map_or(true, |c| c.trim() != "sleep")
+        && start.elapsed() < Duration::from_secs(10)
+    {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // Each descriptor's target and, for a pty master, the index of its pty (other tests'
+    // ptys are theirs to mind; this one's slave is /dev/pts/INDEX).
+    let fds: Vec<(String, Option<String>)> = std::fs::read_dir(format!("{proc_dir}/fd"))
+        .map(|d| {
+            d.filter_map(|e| {
+                let e = e.ok()?;
+                let link = std::fs::read_link(e.path()).ok()?;
+                let info = std::fs::read_to_string(format!(
+                    "{proc_dir}/fdinfo/{}",
+                    e.file_name().to_string_lossy()
+                ))
+                .unwrap_or_default();
+                let tty = info
+                    .lines()
+                    .find_map(|l| l.strip_prefix("tty-index:"))
+                    .map(|v| v.trim().to_string());
+                Some((link.to_string_lossy().into_owned(), tty))
+            })
+            .collect()
+        })
+        .unwrap_or_default();
+    let h_path = h.path.clone();
+    let index = h_path.strip_prefix("/dev/pts/").map(str::to_string);
+    let _ = child.kill();
+    let _ = child.wait();
+    drop(port);
+    h.stop().unwrap();
+    let leaked: Vec<&String> = fds
+        .iter()
+        .filter(|(link, tty)| *link == h_path || (link.as_str() == "/dev/ptmx" && *tty == index))
+        .map(|(link, _)| link)
+        .collect();
+    assert!(
+        leaked.is_empty(),
+        "the child holds {leaked:?}: ports must be close-on-exec"
+    );
 }

@@ -109,6 +109,9 @@ impl Firmware {
         let turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         let dir = scratch(&format!("grbl-fw-{name}"));
         let (master, slave) = serialport::TTYPort::pair().expect("pty pair");
+        // No other test's child inherits them (the firmware gets the master as its stdio).
+        flatcut::device::serial::close_on_exec(&master);
+        flatcut::device::serial::close_on_exec(&slave);
         let path = slave.name().expect("pty name");
         // SAFETY: `into_raw_fd` hands over the only owner of the master descriptor.
         let fd = unsafe { OwnedFd::from_raw_fd(master.into_raw_fd()) };
@@ -591,6 +594,7 @@ fn raw_port(path: &str) -> serialport::TTYPort {
         .timeout(Duration::from_millis(20))
         .open_native()
         .expect("open pty");
+    flatcut::device::serial::close_on_exec(&p);
     p.set_timeout(Duration::from_millis(20)).ok();
     p
 }

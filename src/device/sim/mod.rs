@@ -313,6 +313,10 @@ impl Drop for SimHandle {
 /// Open a pseudo-terminal and start the simulator on its master side.
 pub fn spawn(cfg: SimConfig) -> Result<SimHandle, SimError> {
     let (master, slave) = serialport::TTYPort::pair().map_err(|e| SimError::Pty(e.to_string()))?;
+    // Not inherited by programs started meanwhile: one that held the master open would hide
+    // the simulator's hang-up from the host.
+    super::serial::close_on_exec(&master);
+    super::serial::close_on_exec(&slave);
     let path = slave
         .name()
         .ok_or_else(|| SimError::Pty("the pty has no name".into()))?;
