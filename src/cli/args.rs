@@ -116,17 +116,7 @@ impl PatternArgs {
         }
         p.split = self.split.or(p.split);
         if let Some(lines) = self.bend_lines {
-            for s in &mut spec.surfaces {
-                if let Some(st) = &mut s.strip {
-                    st.bend_lines = lines;
-                }
-                if let Some(b) = &mut s.bent {
-                    b.bend_lines = lines;
-                }
-                if let Some(sp) = &mut s.spline {
-                    sp.bend_lines = lines;
-                }
-            }
+            spec.set_bend_lines(lines);
         }
         Ok(())
     }

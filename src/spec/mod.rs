@@ -301,6 +301,22 @@ fn stem_or(path: &Path, fallback: &str) -> String {
 }
 
 impl Spec {
+    /// Which rulings every strip, bent sheet and spline surface scores (`--bend-lines`, over
+    /// their own `bend_lines`).
+    pub fn set_bend_lines(&mut self, lines: crate::surface::strip::BendLines) {
+        for s in &mut self.surfaces {
+            if let Some(st) = &mut s.strip {
+                st.bend_lines = lines;
+            }
+            if let Some(b) = &mut s.bent {
+                b.bend_lines = lines;
+            }
+            if let Some(sp) = &mut s.spline {
+                sp.bend_lines = lines;
+            }
+        }
+    }
+
     /// A spec for a single mesh file with every default: paper, A4 portrait, 5 mm margin,
     /// 3 mm spacing, scale 1 in millimetres, named after the file's stem.
     pub fn from_mesh(path: &Path) -> Spec {

@@ -120,3 +120,17 @@ pub fn area_and_length(pts: &[(f64, f64)]) -> (f64, f64) {
     }
     (0.5 * area.abs(), per)
 }
+
+/// The spec `flatcut fitting ARGS` would cut.
+pub fn fitting_spec(args: &[&str]) -> flatcut::spec::Spec {
+    use clap::Parser;
+    let mut all = vec!["flatcut", "fitting"];
+    all.extend_from_slice(args);
+    let cli = flatcut::cli::Cli::try_parse_from(all).expect("valid flags");
+    match cli.command {
+        flatcut::cli::Command::Fitting(a) => {
+            flatcut::cli::fitting::spec(&a).expect("valid fitting")
+        }
+        _ => unreachable!(),
+    }
+}

@@ -296,18 +296,6 @@ fn no_text_overlaps_another_text_or_a_line_in_any_bundled_pattern() {
     assert_eq!(total, 0, "{total} collisions:\n{}", report.join("\n"));
 }
 
-/// The spec `flatcut fitting ARGS` would cut.
-fn fitting_spec(args: &[&str]) -> flatcut::spec::Spec {
-    use clap::Parser;
-    let mut all = vec!["flatcut", "fitting"];
-    all.extend_from_slice(args);
-    let cli = flatcut::cli::Cli::try_parse_from(all).expect("valid flags");
-    match cli.command {
-        flatcut::cli::Command::Fitting(a) => flatcut::cli::fitting::spec(&a).expect("fitting"),
-        _ => unreachable!(),
-    }
-}
-
 const CONE: [&str; 7] = [
     "cone",
     "--bottom-diameter",
@@ -393,8 +381,8 @@ fn fitting_cone_with_every_ruling_warns_of_the_notes_left_out() {
     // A small cone (Ø60 to Ø30, 30 mm high) with all its 87 rulings: 36 mm long lines 2 mm
     // apart cannot all carry a 2 mm note.
     let out = scratch("legible-cone-all");
-    let o = flatcut(&[
-        "fitting",
+    // A Ø60 cone with every ruling a bend line.
+    let cone = [
         "cone",
         "--bottom-diameter",
         "60",
@@ -404,10 +392,15 @@ fn fitting_cone_with_every_ruling_warns_of_the_notes_left_out() {
         "30",
         "--bend-lines",
         "all",
-        "--dry-run",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    ];
+    let o = flatcut(
+        &[
+            &["fitting"],
+            &cone[..],
+            &["--dry-run", "-o", out.to_str().unwrap()],
+        ]
+        .concat(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
@@ -434,17 +427,7 @@ fn fitting_cone_with_every_ruling_warns_of_the_notes_left_out() {
     }
     // Every line's note is drawn or said to be left out.
     let drawn = {
-        let spec = fitting_spec(&[
-            "cone",
-            "--bottom-diameter",
-            "60",
-            "--top-diameter",
-            "30",
-            "--height",
-            "30",
-            "--bend-lines",
-            "all",
-        ]);
+        let spec = fitting_spec(&cone);
         let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
         assert!(collisions(&pieces[0]).is_empty());
         pieces[0].notes.len()
@@ -479,17 +462,7 @@ fn shop_bend_lines_of_strips_bent_sheets_and_splines_share_the_whole_bend() {
         let base = flatcut::spec::load(&manifest(&format!("patterns/{name}.toml"))).unwrap();
         let with = |lines: BendLines| {
             let mut spec = base.clone();
-            for s in &mut spec.surfaces {
-                if let Some(st) = &mut s.strip {
-                    st.bend_lines = lines;
-                }
-                if let Some(b) = &mut s.bent {
-                    b.bend_lines = lines;
-                }
-                if let Some(sp) = &mut s.spline {
-                    sp.bend_lines = lines;
-                }
-            }
+            spec.set_bend_lines(lines);
             flatcut::pipeline::pieces(&spec, true).unwrap().1
         };
         let (all, shop) = (with(BendLines::All), with(BendLines::Shop));

@@ -3,23 +3,10 @@
 //! with the `dxf` crate), bad input gets exit 1 naming the flag or key.
 
 use crate::common::*;
-use flatcut::cli::{Cli, Command};
 use flatcut::output::hpgl;
 use flatcut::surface::strip::{Method, Strip};
 use glam::DVec3;
 use std::f64::consts::PI;
-
-/// The spec `flatcut fitting ARGS` would cut.
-fn fitting_spec(args: &[&str]) -> flatcut::spec::Spec {
-    use clap::Parser;
-    let mut all = vec!["flatcut", "fitting"];
-    all.extend_from_slice(args);
-    let cli = Cli::try_parse_from(all).expect("valid flags");
-    match cli.command {
-        Command::Fitting(a) => flatcut::cli::fitting::spec(&a).expect("valid fitting"),
-        _ => unreachable!(),
-    }
-}
 
 /// Area (mm²) and perimeter (mm) of the pen-1 (cut) contour of an HP-GL program at 40 units/mm.
 fn cut_contour(plt: &str) -> (f64, f64) {

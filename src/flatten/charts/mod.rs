@@ -152,11 +152,11 @@ pub fn flatten(mut surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flat
     let Some(shape) = shape else {
         return flatten_as_is(surface, opts);
     };
-    let mm = std::mem::replace(&mut surface.mesh.vertices, shape.vertices.clone());
-    let mut flat = flatten_as_is(surface, opts)?;
     let k = shape.to_mm;
-    flat.surface.mesh.vertices = mm;
-    flat.surface.shape = Some(shape);
+    let mm = std::mem::replace(&mut surface.mesh.vertices, shape.vertices);
+    let mut flat = flatten_as_is(surface, opts)?;
+    let vertices = std::mem::replace(&mut flat.surface.mesh.vertices, mm);
+    flat.surface.shape = Some(crate::surface::size::Shape { vertices, to_mm: k });
     for c in flat.face_2d.iter_mut().flatten() {
         *c *= k;
     }
