@@ -53,6 +53,11 @@
 //! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
 //! visible fault.
 //!
+//! The charts are laid on the machine's cores ([`crate::geom::par`]), each chart with what it
+//! is split or cut into as one job, and put back in their order, so the result does not depend
+//! on the number of cores; a layout made to decide (a part cut off, a dart tried) is kept and
+//! not made again when that chart's turn comes.
+//!
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
 //! and without overlap (`merge`).
@@ -211,7 +216,11 @@ struct Todo {
     cut_off: bool,
 }
 
+/// The error for a face that cannot be laid flat (shared by the threads that lay charts).
+type Degenerate<'a> = dyn Fn(usize) -> FlattenError + Sync + 'a;
+
 /// What [`Charts::lay`] made of a chart.
+#[derive(Clone)]
 enum Layout {
     Laid(Vec<Vec<DVec2>>, Stretch),
     /// The parameteriser refused it (not a disk, solver failure) or gave non-finite points.
@@ -227,12 +236,36 @@ struct Charts<'a> {
     /// Seams are matched ([`param::match_seams`]) on layouts whose L2 stretch is at most
     /// this: one over it is cut or split further, which matching would only delay.
     match_below: f64,
+    /// Layouts already made, by (faces, cuts, whether seams were matched over the tolerance):
+    /// a chart is often laid once to decide (a part cut off, a dart tried) and again when
+    /// its turn comes; [`Charts::lay`] is a function of these, so the copy is the same.
+    laid: &'a LayCache,
 }
+
+/// The key of a layout in [`Charts::laid`] and the layouts.
+type LayCache = std::sync::Mutex<std::collections::HashMap<(Vec<usize>, Vec<usize>, bool), Layout>>;
 
 impl Charts<'_> {
     /// The chart's faces opened along `cuts` and laid flat: the opened chart becomes a mesh of
     /// its own (vertices split along the cuts), parameterised, then turned counter-clockwise.
     fn lay(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
+        let key = (
+            faces.to_vec(),
+            cuts.to_vec(),
+            self.match_below.is_infinite(),
+        );
+        if let Some(l) = self.laid.lock().ok().and_then(|m| m.get(&key).cloned()) {
+            return Ok(l);
+        }
+        let l = self.lay_anew(faces, cuts)?;
+        if let Ok(mut m) = self.laid.lock() {
+            m.insert(key, l.clone());
+        }
+        Ok(l)
+    }
+
+    /// [`Charts::lay`] without the copies.
+    fn lay_anew(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
         let op = open(self.mesh, self.topo, faces, &|e| {
             cuts.binary_search(&e).is_ok()
         });
@@ -349,7 +382,7 @@ impl Charts<'_> {
         mut t: Todo,
         todo: &mut Vec<Todo>,
         done: &mut Vec<Laid>,
-        degenerate: &dyn Fn(usize) -> FlattenError,
+        degenerate: &Degenerate<'_>,
     ) -> Result<(), FlattenError> {
         let Some(cuts) = self.disk(&t.faces, &t.cuts) else {
             return self.split_or_fail(todo, &t, degenerate);
@@ -378,13 +411,42 @@ impl Charts<'_> {
         self.relieve(opts, eps, t, uv, stretch, todo, done)
     }
 
+    /// Lay every chart of `todo` (popped last to first, each with whatever it is split or cut
+    /// into laid before the next) and return what was laid, in that order. The charts are
+    /// independent, so they are shared out among the machine's cores, the largest first; the
+    /// result does not depend on how many there are. The first error in that order is
+    /// returned.
+    fn lay_all(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        mut todo: Vec<Todo>,
+        degenerate: &Degenerate<'_>,
+    ) -> Result<Vec<Laid>, FlattenError> {
+        todo.reverse();
+        let tree = |t: Todo| -> Result<Vec<Laid>, FlattenError> {
+            let (mut stack, mut done) = (vec![t], Vec::new());
+            while let Some(t) = stack.pop() {
+                self.lay_one(opts, eps, t, &mut stack, &mut done, degenerate)?;
+            }
+            Ok(done)
+        };
+        let sizes: Vec<usize> = todo.iter().map(|t| t.faces.len()).collect();
+        let results = crate::geom::par::map_largest_first(todo, &sizes, tree);
+        let mut done = Vec::new();
+        for r in results {
+            done.extend(r?);
+        }
+        Ok(done)
+    }
+
     /// Split a chart that cannot be laid flat in two, or fail on a single face (or a chart
     /// that does not split).
     fn split_or_fail(
         &self,
         todo: &mut Vec<Todo>,
         t: &Todo,
-        degenerate: &dyn Fn(usize) -> FlattenError,
+        degenerate: &Degenerate<'_>,
     ) -> Result<(), FlattenError> {
         if t.faces.len() == 1 || !self.split_in_two(todo, t, t.splits) {
             return Err(degenerate(t.faces[0]));
@@ -544,10 +606,10 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         graph: &graph,
         method: opts.method,
         match_below: opts.tolerance,
+        laid: &LayCache::default(),
     };
     let surface_cuts = edge_ids(&topology, &surface.cuts);
-    let mut todo = ctx.initial(&chart_of, &surface_cuts);
-    let mut done: Vec<Laid> = Vec::new();
+    let todo = ctx.initial(&chart_of, &surface_cuts);
     // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
     let mean_edge = topology
         .edges
@@ -561,9 +623,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         face: f + 1,
         line: mesh.faces[f].line,
     };
-    while let Some(t) = todo.pop() {
-        ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
-    }
+    let mut done = ctx.lay_all(opts, overlap_eps, todo, &degenerate)?;
     reattach(&ctx, &mut done, opts, overlap_eps);
     merge::merge_small(&ctx, &mut done, opts, overlap_eps);
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
@@ -573,6 +633,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         match_below: f64::INFINITY,
         ..ctx
     };
+    let mut todo = Vec::new();
     for _ in 0..MATCH_ROUNDS {
         let mut keep = Vec::with_capacity(done.len());
         for mut l in done.drain(..) {
@@ -601,9 +662,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         if todo.is_empty() {
             break;
         }
-        while let Some(t) = todo.pop() {
-            ctx.lay_one(opts, overlap_eps, t, &mut todo, &mut done, &degenerate)?;
-        }
+        done.extend(ctx.lay_all(opts, overlap_eps, std::mem::take(&mut todo), &degenerate)?);
     }
     Ok(assemble(surface, topology, done, opts))
 }
