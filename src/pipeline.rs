@@ -893,11 +893,27 @@ fn write_pictures(
 ) -> Result<(Vec<String>, Option<crate::output::print::Tiling>), Error> {
     let dpi = extras.dpi;
     let mut files = Vec::new();
+    let px_per_mm = dpi.map_or(crate::output::png::DEFAULT_PX_PER_MM, |d| d / 25.4);
+    // The pictures are independent: drawn on the machine's cores, written in order.
+    let images: Vec<_> = paint.map_or(Vec::new(), |p| p.images().collect());
+    let sheets: Vec<usize> = (0..job.sheets.len()).collect();
+    let weights: Vec<usize> = vec![1; sheets.len()];
+    let (pdf_bytes, pngs) = std::thread::scope(|s| {
+        let pdf = s.spawn(|| crate::output::pdf::render_painted(job, paint));
+        let pngs = crate::geom::par::map_largest_first(sheets, &weights, |i| {
+            let faces = paint.map_or(&[][..], |p| p.sheet(i));
+            crate::output::png::render_painted(&job.sheets[i], i + 1, px_per_mm, faces, &images)
+        });
+        let pdf = pdf
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
+        (pdf, pngs)
+    });
     let svg = format!("{name}.svg");
     run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);
     let pdf = format!("{name}.pdf");
-    run.write(&pdf, &crate::output::pdf::render_painted(job, paint))?;
+    run.write(&pdf, &pdf_bytes)?;
     files.push(pdf);
     let mut tiling = None;
     if let Some(opts) = &extras.print {
@@ -907,12 +923,9 @@ fn write_pictures(
         files.push(file);
         tiling = Some(plan);
     }
-    let px_per_mm = dpi.map_or(crate::output::png::DEFAULT_PX_PER_MM, |d| d / 25.4);
-    for (i, sheet) in job.sheets.iter().enumerate() {
+    for ((i, sheet), bytes) in job.sheets.iter().enumerate().zip(pngs) {
         let png = format!("{name}-{}.png", i + 1);
-        let images: Vec<_> = paint.map_or(Vec::new(), |p| p.images().collect());
-        let faces = paint.map_or(&[][..], |p| p.sheet(i));
-        let bytes = crate::output::png::render_painted(sheet, i + 1, px_per_mm, faces, &images)?;
+        let bytes = bytes?;
         let drawn = crate::output::png::drawn_px_per_mm(sheet, px_per_mm);
         if let (Some(d), false) = (dpi, extras.quiet) {
             if drawn < px_per_mm {
