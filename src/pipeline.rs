@@ -897,18 +897,15 @@ fn write_pictures(
     // The pictures are independent: drawn on the machine's cores, written in order.
     let images: Vec<_> = paint.map_or(Vec::new(), |p| p.images().collect());
     let sheets: Vec<usize> = (0..job.sheets.len()).collect();
-    let weights: Vec<usize> = vec![1; sheets.len()];
-    let (pdf_bytes, pngs) = std::thread::scope(|s| {
-        let pdf = s.spawn(|| crate::output::pdf::render_painted(job, paint));
-        let pngs = crate::geom::par::map_largest_first(sheets, &weights, |i| {
-            let faces = paint.map_or(&[][..], |p| p.sheet(i));
-            crate::output::png::render_painted(&job.sheets[i], i + 1, px_per_mm, faces, &images)
-        });
-        let pdf = pdf
-            .join()
-            .unwrap_or_else(|p| std::panic::resume_unwind(p));
-        (pdf, pngs)
-    });
+    let (pdf_bytes, pngs) = crate::geom::par::join(
+        || crate::output::pdf::render_painted(job, paint),
+        || {
+            crate::geom::par::map(sheets, &[], &|i| {
+                let faces = paint.map_or(&[][..], |p| p.sheet(i));
+                crate::output::png::render_painted(&job.sheets[i], i + 1, px_per_mm, faces, &images)
+            })
+        },
+    );
     let svg = format!("{name}.svg");
     run.write(&svg, crate::output::svg::render(job).as_bytes())?;
     files.push(svg);

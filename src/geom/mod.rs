@@ -17,8 +17,8 @@
 //!   point sets and its residuals (print-and-cut registration).
 //! - [`unionfind`], [`heap`]: disjoint sets and a smallest-first heap entry.
 //! - [`rng`]: the crate's one seeded random number generator.
-//! - [`par`]: a parallel map over independent jobs whose result does not depend on the
-//!   number of threads.
+//! - [`par`]: fork–join over the machine's cores (a join, a map over independent jobs) whose
+//!   results do not depend on the number of threads.
 //! - [`font`]: the single-stroke font for labels a pen or knife can draw.
 //! - [`input`]: reading a user's input file: a regular file under a size limit, UTF-8 with a
 //!   position.

@@ -1,59 +1,101 @@
-//! A parallel map whose result does not depend on the number of threads: independent jobs
-//! shared out among the machine's cores (`std::thread::scope`, no pool), largest first so
-//! that one big job does not start last, each result put back in the job's own slot.
+//! Fork–join parallelism whose results do not depend on the number of threads: [`join`] runs
+//! two closures, the second on a scoped thread when one of the process's spare threads is
+//! free (one fewer than the machine's cores, shared by every caller, nested calls included),
+//! else after the first on this one; [`map`] splits a list of independent jobs into halves
+//! of about equal weight and joins them, so a job may itself fork (a chart whose halves are
+//! laid in parallel). Results always come back in the jobs' order.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::OnceLock;
 
-/// `f` applied to every item, on up to [`std::thread::available_parallelism`] threads, the
-/// items started in decreasing `size` (ties in their order); the results in the items' order.
-/// A panic in `f` is raised again here.
-pub fn map_largest_first<T, R, F>(items: Vec<T>, size: &[usize], f: F) -> Vec<R>
+/// Threads that may run besides the callers' own (cores − 1), taken and given back by
+/// [`join`].
+fn spare() -> &'static AtomicUsize {
+    static SPARE: OnceLock<AtomicUsize> = OnceLock::new();
+    SPARE.get_or_init(|| {
+        let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
+        AtomicUsize::new(cores.saturating_sub(1))
+    })
+}
+
+/// Take a spare thread if one is free.
+fn take() -> bool {
+    spare()
+        .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| n.checked_sub(1))
+        .is_ok()
+}
+
+/// Gives a spare thread back when dropped (also when the job panics).
+struct Token;
+
+impl Drop for Token {
+    fn drop(&mut self) {
+        spare().fetch_add(1, Ordering::AcqRel);
+    }
+}
+
+/// `(a(), b())`, `b` on another thread when a spare one is free. A panic in either is raised
+/// again here.
+pub fn join<A, B, FA, FB>(a: FA, b: FB) -> (A, B)
+where
+    A: Send,
+    B: Send,
+    FA: FnOnce() -> A + Send,
+    FB: FnOnce() -> B + Send,
+{
+    if !take() {
+        let ra = a();
+        return (ra, b());
+    }
+    std::thread::scope(|s| {
+        let hb = s.spawn(move || {
+            let _token = Token;
+            b()
+        });
+        let ra = a();
+        let rb = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        (ra, rb)
+    })
+}
+
+/// `f` applied to every item, the list halved by `weight` (each half about half the total)
+/// and the halves [`join`]ed; the results in the items' order.
+pub fn map<T, R, F>(items: Vec<T>, weight: &[usize], f: &F) -> Vec<R>
 where
     T: Send,
     R: Send,
     F: Fn(T) -> R + Sync,
 {
-    let n = items.len();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |p| p.get())
-        .min(n);
-    if threads <= 1 {
+    let w: Vec<usize> = (0..items.len())
+        .map(|i| weight.get(i).copied().unwrap_or(1).max(1))
+        .collect();
+    map_weighted(items, &w, f)
+}
+
+fn map_weighted<T, R, F>(mut items: Vec<T>, w: &[usize], f: &F) -> Vec<R>
+where
+    T: Send,
+    R: Send,
+    F: Fn(T) -> R + Sync,
+{
+    if items.len() <= 1 {
         return items.into_iter().map(f).collect();
     }
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&i| std::cmp::Reverse(size.get(i).copied().unwrap_or(0)));
-    let jobs: Vec<Mutex<Option<T>>> = items.into_iter().map(|t| Mutex::new(Some(t))).collect();
-    let slots: Vec<Mutex<Option<R>>> = (0..n).map(|_| Mutex::new(None)).collect();
-    let next = AtomicUsize::new(0);
-    std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&i) = order.get(k) else { return };
-                    let job = jobs[i].lock().unwrap_or_else(|e| e.into_inner()).take();
-                    if let Some(job) = job {
-                        let r = f(job);
-                        *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
-                    }
-                })
-            })
-            .collect();
-        for w in workers {
-            if let Err(p) = w.join() {
-                std::panic::resume_unwind(p);
-            }
+    // The split that leaves the two halves' weights nearest each other (each non-empty).
+    let total: usize = w.iter().sum();
+    let (mut best, mut acc, mut best_gap) = (1, 0usize, usize::MAX);
+    for (k, &x) in w.iter().enumerate().take(w.len() - 1) {
+        acc += x;
+        let gap = acc.abs_diff(total - acc);
+        if gap < best_gap {
+            (best, best_gap) = (k + 1, gap);
         }
-    });
-    slots
-        .into_iter()
-        .map(|m| {
-            m.into_inner()
-                .unwrap_or_else(|e| e.into_inner())
-                .expect("every job ran: the workers took every index")
-        })
-        .collect()
+    }
+    let right = items.split_off(best);
+    let (wl, wr) = w.split_at(best);
+    let (mut l, r) = join(|| map_weighted(items, wl, f), || map_weighted(right, wr, f));
+    l.extend(r);
+    l
 }
 
 #[cfg(test)]
@@ -63,11 +105,12 @@ mod tests {
     #[test]
     fn results_come_back_in_the_items_order() {
         let items: Vec<u64> = (0..50).collect();
-        let size: Vec<usize> = (0..50).map(|i| (i * 37) % 11).collect();
-        let out = map_largest_first(items, &size, |x| {
-            // Uneven work, so that the threads finish out of order.
+        let weight: Vec<usize> = (0..50).map(|i| (i * 37) % 11).collect();
+        let out = map(items, &weight, &|x: u64| {
+            // Uneven work, so that the threads finish out of order; nested forks too.
             let busy = (0..(x % 7) * 1000).fold(0u64, |a, b| a.wrapping_add(b % 3));
-            (x * x, busy)
+            let (p, q) = join(|| x * x, || busy);
+            (p, q)
         });
         let squares: Vec<u64> = out.iter().map(|r| r.0).collect();
         assert_eq!(squares, (0..50u64).map(|x| x * x).collect::<Vec<_>>());
@@ -75,7 +118,15 @@ mod tests {
 
     #[test]
     fn no_items_no_threads() {
-        let out: Vec<u8> = map_largest_first(Vec::<u8>::new(), &[], |x| x);
+        let out: Vec<u8> = map(Vec::<u8>::new(), &[], &|x| x);
         assert!(out.is_empty());
+    }
+
+    #[test]
+    fn a_panic_comes_back_to_the_caller() {
+        let r = std::panic::catch_unwind(|| join(|| 1, || -> u8 { panic!("boom") }));
+        assert!(r.is_err());
+        // The spare thread was given back: a later join can still fork.
+        assert_eq!(join(|| 2, || 3), (2, 3));
     }
 }

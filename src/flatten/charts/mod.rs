@@ -412,10 +412,7 @@ impl Charts<'_> {
     }
 
     /// Lay every chart of `todo` (popped last to first, each with whatever it is split or cut
-    /// into laid before the next) and return what was laid, in that order. The charts are
-    /// independent, so they are shared out among the machine's cores, the largest first; the
-    /// result does not depend on how many there are. The first error in that order is
-    /// returned.
+    /// into laid before the next) and return what was laid, in that order.
     fn lay_all(
         &self,
         opts: &FlattenOptions,
@@ -424,17 +421,31 @@ impl Charts<'_> {
         degenerate: &Degenerate<'_>,
     ) -> Result<Vec<Laid>, FlattenError> {
         todo.reverse();
+        self.lay_trees(opts, eps, todo, degenerate)
+    }
+
+    /// Each chart of `todo` in turn laid, then what it was split or cut into (in the order
+    /// [`Charts::lay_one`] would pop them); what was laid, in that order. The charts are
+    /// independent, so they are forked over the machine's cores ([`crate::geom::par`]), the
+    /// halves of a split too; the result does not depend on how many cores there are. The
+    /// first error in that order is returned.
+    fn lay_trees(
+        &self,
+        opts: &FlattenOptions,
+        eps: f64,
+        todo: Vec<Todo>,
+        degenerate: &Degenerate<'_>,
+    ) -> Result<Vec<Laid>, FlattenError> {
         let tree = |t: Todo| -> Result<Vec<Laid>, FlattenError> {
-            let (mut stack, mut done) = (vec![t], Vec::new());
-            while let Some(t) = stack.pop() {
-                self.lay_one(opts, eps, t, &mut stack, &mut done, degenerate)?;
-            }
+            let (mut parts, mut done) = (Vec::new(), Vec::new());
+            self.lay_one(opts, eps, t, &mut parts, &mut done, degenerate)?;
+            parts.reverse();
+            done.extend(self.lay_trees(opts, eps, parts, degenerate)?);
             Ok(done)
         };
         let sizes: Vec<usize> = todo.iter().map(|t| t.faces.len()).collect();
-        let results = crate::geom::par::map_largest_first(todo, &sizes, tree);
         let mut done = Vec::new();
-        for r in results {
+        for r in crate::geom::par::map(todo, &sizes, &tree) {
             done.extend(r?);
         }
         Ok(done)
