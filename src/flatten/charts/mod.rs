@@ -53,10 +53,11 @@
 //! takes up more). L∞ is reported but not used: one sliver triangle makes it large without a
 //! visible fault.
 //!
-//! The charts are laid on the machine's cores ([`crate::geom::par`]), each chart with what it
-//! is split or cut into as one job, and put back in their order, so the result does not depend
-//! on the number of cores; a layout made to decide (a part cut off, a dart tried) is kept and
-//! not made again when that chart's turn comes.
+//! The charts are laid on the machine's cores ([`crate::geom::par`]): each chart, then the
+//! parts it is split or cut into (forked in turn), the results put back in the order one core
+//! would make them, so the output does not depend on the number of cores. A layout made to
+//! decide (a part cut off, a dart tried) is kept, up to a bound, and not made again when that
+//! chart's turn comes.
 //!
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
@@ -80,6 +81,7 @@ use crate::geom::polygon;
 use crate::surface::MaterialKind;
 use crate::surface::Surface;
 use glam::DVec2;
+use std::collections::HashMap;
 
 mod darts;
 mod merge;
@@ -242,8 +244,12 @@ struct Charts<'a> {
     laid: &'a LayCache,
 }
 
-/// The key of a layout in [`Charts::laid`] and the layouts.
-type LayCache = std::sync::Mutex<std::collections::HashMap<(Vec<usize>, Vec<usize>, bool), Layout>>;
+/// The layouts of [`Charts::laid`] by key, and the faces they hold in all.
+type LayCache = std::sync::Mutex<(HashMap<(Vec<usize>, Vec<usize>, bool), Layout>, usize)>;
+
+/// Faces the kept layouts may hold in all (about 80 bytes each); past it layouts are made
+/// again instead of kept, so memory stays bounded on any mesh.
+const LAY_CACHE_FACES: usize = 2_000_000;
 
 impl Charts<'_> {
     /// The chart's faces opened along `cuts` and laid flat: the opened chart becomes a mesh of
@@ -254,12 +260,15 @@ impl Charts<'_> {
             cuts.to_vec(),
             self.match_below.is_infinite(),
         );
-        if let Some(l) = self.laid.lock().ok().and_then(|m| m.get(&key).cloned()) {
+        if let Some(l) = self.laid.lock().ok().and_then(|m| m.0.get(&key).cloned()) {
             return Ok(l);
         }
         let l = self.lay_anew(faces, cuts)?;
         if let Ok(mut m) = self.laid.lock() {
-            m.insert(key, l.clone());
+            if m.1 + faces.len() <= LAY_CACHE_FACES {
+                m.1 += faces.len();
+                m.0.insert(key, l.clone());
+            }
         }
         Ok(l)
     }
