@@ -5,8 +5,10 @@
 //!
 //! Choices where the thesis is silent: small pieces are tried smallest first; the neighbours
 //! in order of the boundary length they share with it (longest first, ties by index), at most
-//! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too.
-//! The merged chart keeps the cuts of both (and more where it is not a disk).
+//! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too;
+//! then another round, while the last one merged any (a piece that failed early may fit a
+//! neighbour a later merge has changed). The merged chart keeps the cuts of both (and more
+//! where it is not a disk).
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
@@ -30,13 +32,27 @@ use std::collections::HashMap;
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
 /// Neighbours tried per small piece.
-pub(crate) const MERGE_TRIES: usize = 3;
+pub(crate) const MERGE_TRIES: usize = 8;
+/// Rounds of [`merge_small`] at most (the corpus needs three).
+const MERGE_ROUNDS: usize = 10;
 /// Share of the material's tolerance (of L2 − 1) that a merge of two pieces of any size may
 /// use ([`merge_near`]).
 pub(crate) const NEAR_SHARE: f64 = 1.0 / 3.0;
 
-/// Merge the small pieces of `done` into neighbours (see the module doc).
+/// Merge the small pieces of `done` into neighbours (see the module doc), in rounds until
+/// none merges (at most [`MERGE_ROUNDS`]).
 pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    for _ in 0..MERGE_ROUNDS {
+        let before = done.len();
+        merge_small_once(ctx, done, opts, eps);
+        if done.len() == before {
+            break;
+        }
+    }
+}
+
+/// One round of [`merge_small`]: each small piece, smallest first, tried with its neighbours.
+fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
     let total: f64 = done.iter().map(|l| area(&l.faces)).sum();
     let small = SMALL_SHARE * total;
