@@ -359,15 +359,14 @@ impl Charts<'_> {
             .collect()
     }
 
-    /// The charts of `chart_of` to lay flat, each with the surface's cuts inside it, the
-    /// first chart last (it is popped first).
+    /// The charts of `chart_of` to lay flat, in order, each with the surface's cuts inside it.
     fn initial(&self, chart_of: &[usize], surface_cuts: &[usize]) -> Vec<Todo> {
         let count = chart_of.iter().copied().max().map_or(0, |m| m + 1);
         let mut groups: Vec<Vec<usize>> = vec![Vec::new(); count];
         for (f, &c) in chart_of.iter().enumerate() {
             groups[c].push(f);
         }
-        let mut todo: Vec<Todo> = groups
+        groups
             .into_iter()
             .filter(|g| !g.is_empty())
             .map(|faces| Todo {
@@ -376,9 +375,7 @@ impl Charts<'_> {
                 splits: 0,
                 cut_off: false,
             })
-            .collect();
-        todo.reverse();
-        todo
+            .collect()
     }
 
     /// Lay one chart flat (see the module doc): cut into a disk and laid; split or cut where
@@ -418,19 +415,6 @@ impl Charts<'_> {
             }
         }
         self.relieve(opts, eps, t, uv, stretch, todo, done)
-    }
-
-    /// Lay every chart of `todo` (popped last to first, each with whatever it is split or cut
-    /// into laid before the next) and return what was laid, in that order.
-    fn lay_all(
-        &self,
-        opts: &FlattenOptions,
-        eps: f64,
-        mut todo: Vec<Todo>,
-        degenerate: &Degenerate<'_>,
-    ) -> Result<Vec<Laid>, FlattenError> {
-        todo.reverse();
-        self.lay_trees(opts, eps, todo, degenerate)
     }
 
     /// Each chart of `todo` in turn laid, then what it was split or cut into (in the order
@@ -643,7 +627,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         face: f + 1,
         line: mesh.faces[f].line,
     };
-    let mut done = ctx.lay_all(opts, overlap_eps, todo, &degenerate)?;
+    let mut done = ctx.lay_trees(opts, overlap_eps, todo, &degenerate)?;
     reattach(&ctx, &mut done, opts, overlap_eps);
     merge::merge_small(&ctx, &mut done, opts, overlap_eps);
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
@@ -653,8 +637,8 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         match_below: f64::INFINITY,
         ..ctx
     };
-    let mut todo = Vec::new();
     for _ in 0..MATCH_ROUNDS {
+        let mut todo = Vec::new();
         let mut keep = Vec::with_capacity(done.len());
         for mut l in done.drain(..) {
             if l.stretch.l2 <= opts.tolerance {
@@ -682,7 +666,9 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         if todo.is_empty() {
             break;
         }
-        done.extend(ctx.lay_all(opts, overlap_eps, std::mem::take(&mut todo), &degenerate)?);
+        // Popped last to first, as the halves were pushed.
+        todo.reverse();
+        done.extend(ctx.lay_trees(opts, overlap_eps, todo, &degenerate)?);
     }
     Ok(assemble(surface, topology, done, opts))
 }
