@@ -38,6 +38,7 @@ fn chain(curves: usize, count: usize, folds: bool) -> Model {
         } else {
             Vec::new()
         },
+        folds: Vec::new(),
         target: None,
         handles: Vec::new(),
         outline: None,
@@ -68,6 +69,7 @@ fn sheet_fold() -> Model {
         basis: BSpline::new(3, 12, false).expect("cubic"),
         fixed: (0..12).map(|j| (0, j)).collect(),
         creases: vec![Crease::Fold],
+        folds: Vec::new(),
         target: None,
         handles: vec![
             (c[2][0], DVec3::new(f64::NAN, f64::NAN, 60.0)),

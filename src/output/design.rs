@@ -1,7 +1,7 @@
 //! `--spline-json`: the solved spline designs (issue 24, Tang et al. 2016) as JSON that other
 //! software can read back: per spline surface its B-spline space (degree, closed, knots), the
 //! solved control points of every curve (and a cone's apex), the strips (pairs of curves), the
-//! crease condition on every interior curve, the figures, and the development: where each
+//! crease condition on every interior curve (with its stated fold), the figures, and the development: where each
 //! sampled curve lies on the flat pieces.
 //!
 //! Choices: millimetres throughout, 1-based curve numbers as in the spec and in messages;
@@ -54,7 +54,17 @@ fn surface_json(flat: &Flat) -> Option<Value> {
             .map_or("free", |(n, _)| *n)
     };
     let creases: Vec<Value> = (1..m.curves.len().saturating_sub(1))
-        .map(|c| json!({ "curve": c + 1, "condition": name(m.crease(c)) }))
+        .map(|c| {
+            let mut v = json!({ "curve": c + 1, "condition": name(m.crease(c)) });
+            // A stated fold (`folds`): its direction and the mean angle asked for.
+            if let Some(f) = m.folds.get(c - 1).copied().flatten() {
+                v["fold"] = json!(if f.valley { "valley" } else { "mountain" });
+                if let Some(a) = f.angle {
+                    v["fold_angle_deg"] = json!(r9(a.to_degrees()));
+                }
+            }
+            v
+        })
         .collect();
     let figures: serde_json::Map<String, Value> = flat
         .surface

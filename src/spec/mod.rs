@@ -164,7 +164,10 @@
 //! `creases` (one per interior curve of a chain of three or more: "fold" (the sheet folds
 //! along it), "geodesic" (a geodesic of both sides: it unfolds to a straight line), "smooth"
 //! (no crease) or "free" (no condition: the sides may not unfold in one piece); default all
-//! "free"), `fixed` (control points the solve keeps: curve numbers for whole curves,
+//! "free"), `folds` (per interior curve "mountain", "valley", "none" or `{ kind, angle_deg }`:
+//! which way a `fold` or `geodesic` crease folds, seen from the printed side, and the mean
+//! angle along it; a direction alone folds it by at least 1°), `fixed` (control points the
+//! solve keeps: curve numbers for whole curves,
 //! `[curve, point]` counted from 1, or "apex"), `target` (a shape to approximate: a mesh file
 //! or a CSV point cloud, as a path or `{ path, scale, units }`; without `curves` the start is
 //! the target's principal rectangle), `handles` (`[{ at = [x, y, z], to = [x, y, z] }]`: the
@@ -176,8 +179,8 @@
 //! 0.01), `tolerance` (chordal tolerance of the output sampling, mm, default 0.05),
 //! `bend_lines` (which rulings are scored, as strips; creases are folds whatever it says),
 //! `side` and `k_factor` (metal: developed on the neutral surface, as strips) and `name`.
-//! Unequal control-point counts, a wrong number of `creases`, a "fold" or "geodesic"
-//! crease on a straight curve, a control point that does not exist, an unreadable target and
+//! Unequal control-point counts, a wrong number of `creases` or `folds`, a "fold" or
+//! "geodesic" crease on a straight curve, a stated fold on a crease that does not fold, a control point that does not exist, an unreadable target and
 //! a curve off the outline are errors at the line of the key concerned; rulings that cross
 //! inside the surface (a curve of regression) and a solve that breaks down name `curves`.
 

@@ -73,6 +73,7 @@ pub(super) struct RawSurface {
     pub(super) degree: Option<Spanned<Val>>,
     pub(super) closed: Option<Spanned<Val>>,
     pub(super) creases: Option<Spanned<toml::Value>>,
+    pub(super) folds: Option<Spanned<toml::Value>>,
     pub(super) fixed: Option<Spanned<toml::Value>>,
     pub(super) iterations: Option<Spanned<Val>>,
     pub(super) epsilon1: Option<Spanned<Val>>,

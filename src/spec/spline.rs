@@ -1,9 +1,12 @@
 //! The reader of `kind = "spline"` surfaces (Tang et al. 2016, `surface::spline`): B-spline
 //! curves of one degree and control-point count, or one curve and an `apex`, made developable
-//! by guided projection, with `creases`, `fixed` control points and the solver's settings.
+//! by guided projection, with `creases`, `folds`, `fixed` control points and the solver's
+//! settings.
 //!
 //! Choices: `curves` is a list of inline control-point lists (each curve's line is its own,
-//! so a curve with the wrong count is reported where it stands); `fixed` takes a curve number
+//! so a curve with the wrong count is reported where it stands); `folds` takes one entry per
+//! interior curve, a name or `{ kind, angle_deg }` (degrees in the file, radians inside);
+//! `fixed` takes a curve number
 //! (the whole curve), `[curve, point]` (1-based) or `"apex"`; the shape checks of
 //! [`crate::surface::spline::model`] (counts, degree, creases on straight curves) run here, so
 //! their messages name the line of the key concerned. Mesh, strip and bent-sheet keys are
@@ -14,7 +17,7 @@ use super::context::{Ctx, MM_POSITIVE};
 use super::spanned::{span, List, RawSurface};
 use super::SpecError;
 use crate::surface::spline::target::Target;
-use crate::surface::spline::{Crease, SolveOptions, SplineError, SplineSpec};
+use crate::surface::spline::{Crease, FoldGoal, SolveOptions, SplineError, SplineSpec};
 use crate::surface::{SegmentSpec, SurfaceKind, SurfaceSpec, Units};
 use glam::DVec3;
 use std::path::Path;
@@ -65,6 +68,7 @@ impl Ctx<'_> {
             .map_or(3, |(v, _)| v as usize);
         let closed = self.boolean(&s.closed, &k("closed"))?.unwrap_or(false);
         let creases = self.spline_creases(s, key)?;
+        let folds = self.spline_folds(s, key)?;
         let fixed = self.spline_fixed(s, key, &curves, apex.is_some())?;
         let handles = self.spline_handles(s, key)?;
         let outline = self.spline_outline(s, key, &curves)?;
@@ -117,6 +121,7 @@ impl Ctx<'_> {
             closed,
             fixed,
             creases,
+            folds,
             target,
             handles,
             outline,
@@ -470,6 +475,68 @@ impl Ctx<'_> {
             .collect()
     }
 
+    /// `folds`: per interior curve `"mountain"`, `"valley"`, `"none"` or
+    /// `{ kind = "mountain" | "valley", angle_deg = A }` (the mean fold angle, degrees).
+    fn spline_folds(&self, s: &RawSurface, key: &str) -> Result<Vec<Option<FoldGoal>>, SpecError> {
+        let fk = format!("{key}.folds");
+        let Some(v) = &s.folds else {
+            return Ok(Vec::new());
+        };
+        let line = self.line(v.span());
+        const KINDS: [(&str, Option<bool>); 3] = [
+            ("mountain", Some(false)),
+            ("valley", Some(true)),
+            ("none", None),
+        ];
+        let expected = "\"mountain\", \"valley\", \"none\" or { kind = \"mountain\" or \"valley\", angle_deg = the mean fold angle in degrees, more than 0 and less than 180 }";
+        let Value::Array(items) = v.get_ref() else {
+            return Err(self.invalid(
+                line,
+                &fk,
+                format!(
+                    "must be a list with one of {expected} per interior curve, got {}",
+                    v.get_ref()
+                ),
+            ));
+        };
+        let kind = |t: &str| KINDS.iter().find(|(n, _)| *n == t).map(|(_, k)| *k);
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, it)| {
+                let ik = format!("{fk}[{}]", i + 1);
+                let bad = |what: String| self.invalid(line, &ik, what);
+                match it {
+                    Value::String(t) => match kind(t) {
+                        Some(k) => Ok(k.map(|valley| FoldGoal {
+                            valley,
+                            angle: None,
+                        })),
+                        None => Err(bad(format!("must be {expected}, got {it}"))),
+                    },
+                    Value::Table(t) => {
+                        if let Some(extra) = t.keys().find(|k| !["kind", "angle_deg"].contains(&k.as_str())) {
+                            return Err(bad(format!("`{extra}` is not a key of a fold; it takes `kind` and `angle_deg`")));
+                        }
+                        let valley = match t.get("kind").and_then(Value::as_str).map(kind) {
+                            Some(Some(Some(v))) => v,
+                            _ => return Err(bad(format!("`kind` must be \"mountain\" or \"valley\", got {}", t.get("kind").map_or("nothing".into(), |k| k.to_string())))),
+                        };
+                        let angle = match t.get("angle_deg") {
+                            None => None,
+                            Some(a) => match a.as_float().or(a.as_integer().map(|i| i as f64)) {
+                                Some(d) if d > 0.0 && d < 180.0 => Some(d.to_radians()),
+                                _ => return Err(bad(format!("`angle_deg` must be more than 0 and less than 180 (degrees), got {a}"))),
+                            },
+                        };
+                        Ok(Some(FoldGoal { valley, angle }))
+                    }
+                    _ => Err(bad(format!("must be {expected}, got {it}"))),
+                }
+            })
+            .collect()
+    }
+
     /// `fixed`: curve numbers, `[curve, point]` pairs (1-based) or `"apex"`, as 0-based
     /// (curve, point) pairs; curve `curves.len()` is the apex. A pair out of range is left to
     /// the shape check.
@@ -554,6 +621,7 @@ impl Ctx<'_> {
         match base {
             "curves" => index.and_then(|i| lines.get(i.checked_sub(1)?).copied()),
             "creases" => span(&s.creases).map(|sp| self.line(sp)),
+            "folds" => span(&s.folds).map(|sp| self.line(sp)),
             "fixed" => span(&s.fixed).map(|sp| self.line(sp)),
             "apex" => span(&s.apex).map(|sp| self.line(sp)),
             "degree" => span(&s.degree).map(|sp| self.line(sp)),
@@ -567,7 +635,7 @@ impl Ctx<'_> {
     /// and `max_iterations` of boundaries are the spline's own, `side` and `k_factor` as
     /// strips).
     fn no_other_keys_on_spline(&self, s: &RawSurface, key: &str) -> Result<(), SpecError> {
-        const WHY: &str = "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `side`, `k_factor`, `creases`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`";
+        const WHY: &str = "is not a spline key; a spline takes `curves` (and `apex`), `target`, `handles`, `outline`, `degree`, `closed`, `side`, `k_factor`, `creases`, `folds`, `fixed`, `iterations`, `max_iterations`, `epsilon1`, `epsilon2`, `tolerance` and `bend_lines`";
         self.no_mesh_keys(s, key, WHY)?;
         self.refuse(
             key,
@@ -594,6 +662,7 @@ impl Ctx<'_> {
                 ("degree", span(&s.degree)),
                 ("closed", span(&s.closed)),
                 ("creases", span(&s.creases)),
+                ("folds", span(&s.folds)),
                 ("fixed", span(&s.fixed)),
                 ("iterations", span(&s.iterations)),
                 ("epsilon1", span(&s.epsilon1)),

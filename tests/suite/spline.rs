@@ -433,6 +433,34 @@ fn spline_bad_input_exits_1_with_file_line_and_key() {
         (format!("{two}\ntarget = \"missing.obj\""), 7, "surface[1].target"),
         (format!("{two}\ntarget = {{ path = \"x.csv\", scale = -1 }}"), 7, "surface[1].target.scale"),
         ("curves = [3, 4]".into(), 3, "surface[1].curves[1]"),
+        // Stated folds: one per interior curve, on a crease that folds, a known kind and an
+        // angle in (0, 180) degrees.
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"fold\"]\nfolds = [\"valley\", \"valley\"]", up(100.0), up(200.0)),
+            9,
+            "surface[1].folds",
+        ),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"smooth\"]\nfolds = [\"valley\"]", up(100.0), up(200.0)),
+            9,
+            "surface[1].folds[1]",
+        ),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"fold\"]\nfolds = [\"up\"]", up(100.0), up(200.0)),
+            9,
+            "surface[1].folds[1]",
+        ),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"fold\"]\nfolds = [{{ kind = \"valley\", angle_deg = 180 }}]", up(100.0), up(200.0)),
+            9,
+            "surface[1].folds[1]",
+        ),
+        (
+            format!("curves = [\n  {line4},\n  {},\n  {},\n]\ncreases = [\"fold\"]\nfolds = [{{ kind = \"valley\", angle = 20 }}]", up(100.0), up(200.0)),
+            9,
+            "surface[1].folds[1]",
+        ),
+        (format!("{two}\nfolds = \"valley\""), 7, "surface[1].folds"),
         // Rulings that all cross the strip's middle: refused at the line of `curves`.
         (
             "curves = [\n  [[0, 0, 0], [25, 0, 0], [50, 0, 0], [75, 0, 0], [100, 0, 0]],\n  [[100, 50, 0], [75, 50, 0], [50, 50, 0], [25, 50, 0], [0, 50, 0]],\n]".into(),
@@ -526,6 +554,7 @@ fn spline_target_cylinder_is_fitted_from_its_principal_rectangle() {
         apex: None,
         fixed: Vec::new(),
         creases: Vec::new(),
+        folds: Vec::new(),
         target: Some(flatcut::surface::spline::target::Target::from_mesh(
             &target_mesh,
         )),
@@ -580,12 +609,11 @@ fn spline_handle_drags_a_corner_and_the_fixed_edge_stays() {
     assert!(figure(&report, "largest_sine") <= 1e-6);
 }
 
-/// Control points (8, cubic, clamped) of the least-squares fit to `f(t)`, t in [0, 1] with
+/// Control points (`n`, cubic, clamped) of the least-squares fit to `f(t)`, t in [0, 1] with
 /// t = u / spans.
 #[allow(clippy::needless_range_loop)] // rows and columns of one small matrix
-fn fit_curve(f: impl Fn(f64) -> DVec3) -> Vec<DVec3> {
-    let basis = BSpline::new(3, 8, false).unwrap();
-    let n = 8;
+fn fit_curve_n(n: usize, f: impl Fn(f64) -> DVec3) -> Vec<DVec3> {
+    let basis = BSpline::new(3, n, false).unwrap();
     let mut a = vec![vec![0.0; n]; n];
     let mut b = vec![DVec3::ZERO; n];
     for k in 0..=400 {
@@ -628,17 +656,15 @@ fn a4_arc(t: f64) -> DVec3 {
     DVec3::new(105.0 + r * a.cos(), cy + r * a.sin(), 0.0)
 }
 
-#[test]
-fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
-    let dir = scratch("spline-a4");
-    let mut crease = fit_curve(a4_arc);
-    crease[0] = DVec3::new(0.0, 120.0, 0.0);
-    crease[7] = DVec3::new(210.0, 120.0, 0.0);
-    let line = |y: f64| fit_curve(move |t| DVec3::new(210.0 * t, y, 0.0));
+/// An A4 run (`curves` and `extra` keys, outline 210 × 297, a `fold` crease on curve 2 along
+/// the arc) through the command line: its report, the blank's area and perimeter from the
+/// cut contour, and how far the flat crease lies from the arc (mm).
+fn a4_run(name: &str, curves: &[Vec<DVec3>], extra: &str) -> (serde_json::Value, f64, f64, f64) {
+    let dir = scratch(name);
     let spec = spline_spec(
         &dir,
-        &[line(0.0), crease, line(297.0)],
-        "outline = [210, 297]\ncreases = [\"fold\"]\nfixed = [1]\nbend_lines = \"none\"\nhandles = [{ at = [0, 297, 0], lift = 80 }, { at = [210, 297, 0], lift = 80 }]",
+        curves,
+        &format!("outline = [210, 297]\ncreases = [\"fold\"]\nbend_lines = \"none\"\n{extra}"),
     );
     let json = dir.join("design.json");
     let report = cut(
@@ -646,8 +672,6 @@ fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
         &spec,
         &["--tabs", "none", "--spline-json", json.to_str().unwrap()],
     );
-    let iso = figure(&report, "outline_isometry_error");
-    let lifted = figure(&report, "handle_distance_mm");
     let contours = cut_contours(&dir);
     assert_eq!(contours.len(), 1);
     let (area, per) = contours[0];
@@ -677,14 +701,132 @@ fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
         })
         .fold(0.0, f64::max);
     eprintln!(
-        "a4: blank {area:.1} mm² (62370), perimeter {per:.2} mm (1014), development error {iso:.2e}, handles {lifted:.2e} mm from their goal, flat crease within {off:.4} mm of the arc"
+        "{name}: blank {area:.1} mm² (62370), perimeter {per:.2} mm (1014), development error {:.2e}, handles {:.2e} mm from their goal, flat crease within {off:.4} mm of the arc, sine {:.2e}, crease sine {:.2e}, fold mean {:.3}° max {:.3}°, {} iterations",
+        figure(&report, "outline_isometry_error"),
+        figure(&report, "handle_distance_mm"),
+        figure(&report, "largest_sine"),
+        figure(&report, "crease_sine"),
+        figure(&report, "fold_angle_mean_deg"),
+        figure(&report, "fold_angle_max_deg"),
+        figure(&report, "iterations"),
     );
     assert!(rel(area, 62370.0) < 1e-3, "{area}");
     assert!(rel(per, 1014.0) < 1e-3, "{per}");
-    assert!(iso < 1e-6, "{iso}");
-    assert!(lifted < 0.01, "{lifted}");
     assert!(off < 0.1, "{off}");
+    assert!(figure(&report, "outline_isometry_error") < 1e-6);
+    assert!(figure(&report, "handle_distance_mm") < 0.01);
     assert!(figure(&report, "largest_sine") <= 1e-6);
+    assert!(figure(&report, "crease_sine") <= 1e-6);
+    (report, area, per, off)
+}
+
+/// The crease along the arc and the lines y = 0 and y = 297, each of `n` control points.
+fn a4_curves(n: usize) -> [Vec<DVec3>; 3] {
+    let mut crease = fit_curve_n(n, a4_arc);
+    crease[0] = DVec3::new(0.0, 120.0, 0.0);
+    crease[n - 1] = DVec3::new(210.0, 120.0, 0.0);
+    let line = |y: f64| fit_curve_n(n, move |t| DVec3::new(210.0 * t, y, 0.0));
+    [line(0.0), crease, line(297.0)]
+}
+
+const A4_LIFT: &str =
+    "handles = [{ at = [0, 297, 0], lift = 80 }, { at = [210, 297, 0], lift = 80 }";
+
+#[test]
+fn spline_a4_with_a_crease_lifted_by_handles_stays_the_a4_sheet() {
+    // The bottom edge fixed as a straight line: every ruling of the lower strip ends on it,
+    // so that strip stays planar, and a curved crease beside a plane cannot fold.
+    a4_run(
+        "spline-a4",
+        &a4_curves(8),
+        &format!("fixed = [1]\n{A4_LIFT}]"),
+    );
+}
+
+#[test]
+fn spline_a4_folds_along_its_arc_by_the_stated_angle() {
+    // The bottom edge's middle pinned, the top corners lifted, the crease folded by 20° on
+    // average as a valley, then as a mountain.
+    for (kind, other) in [("valley", "mountain"), ("mountain", "valley")] {
+        let (report, ..) = a4_run(
+            &format!("spline-a4-{kind}"),
+            &a4_curves(8),
+            &format!("folds = [{{ kind = \"{kind}\", angle_deg = 20 }}]\nmax_iterations = 200\n{A4_LIFT}, {{ at = [105, 0, 0], to = [105, 0, 0] }}]"),
+        );
+        let mean = figure(&report, "fold_angle_mean_deg");
+        assert!((mean - 20.0).abs() < 0.05, "{mean}");
+        assert!(figure(&report, "fold_angle_max_deg") >= 10.0);
+        let lines = report["pieces"][0]["fold_lines"].as_array().unwrap();
+        assert!(lines.len() > 10, "{}", lines.len());
+        assert!(lines
+            .iter()
+            .all(|l| l["kind"] == kind && l["kind"] != other));
+        assert!(lines
+            .iter()
+            .all(|l| l["angle_deg"].as_f64().unwrap() >= 10.0));
+    }
+}
+
+#[test]
+fn spline_a4_with_its_bottom_edge_fixed_fans_from_its_corners() {
+    // The bottom curve stands still at each corner for half the sheet (eight equal control
+    // points each): the lower strip is two cones with their apexes in the corners and a fan
+    // between, so the fixed straight edge no longer holds the strip flat.
+    let [_, crease, top] = a4_curves(16);
+    let corner = |x: f64| vec![DVec3::new(x, 0.0, 0.0); 8];
+    let bottom: Vec<DVec3> = corner(0.0).into_iter().chain(corner(210.0)).collect();
+    let dir = scratch("spline-a4-fans");
+    let obj = dir.join("surface.obj");
+    let spec = spline_spec(
+        &dir,
+        &[bottom, crease, top],
+        &format!("outline = [210, 297]\ncreases = [\"fold\"]\nbend_lines = \"none\"\nfixed = [1]\nmax_iterations = 200\n{A4_LIFT}]"),
+    );
+    let report = cut(
+        &dir,
+        &spec,
+        &["--tabs", "none", "--surface-obj", obj.to_str().unwrap()],
+    );
+    let contours = cut_contours(&dir);
+    assert_eq!(contours.len(), 1);
+    let (area, per) = contours[0];
+    eprintln!(
+        "a4 fans: blank {area:.1} mm², perimeter {per:.2} mm, sine {:.2e}, handles {:.2e} mm, {} iterations",
+        figure(&report, "largest_sine"),
+        figure(&report, "handle_distance_mm"),
+        figure(&report, "iterations")
+    );
+    assert!(rel(area, 62370.0) < 1e-3, "{area}");
+    assert!(rel(per, 1014.0) < 1e-3, "{per}");
+    assert!(figure(&report, "largest_sine") <= 1e-6);
+    assert!(figure(&report, "handle_distance_mm") < 0.01);
+    assert_eq!(
+        report["surfaces"][0]["warnings"]
+            .as_array()
+            .map_or(0, Vec::len),
+        0
+    );
+    // One vertex at each apex, no triangle without area.
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let verts: Vec<DVec3> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let c: Vec<f64> = l.split_whitespace().map(|v| v.parse().unwrap()).collect();
+            DVec3::new(c[0], c[1], c[2])
+        })
+        .collect();
+    for apex in [DVec3::ZERO, DVec3::new(210.0, 0.0, 0.0)] {
+        let at = verts.iter().filter(|v| v.distance(apex) < 1e-6).count();
+        assert_eq!(at, 1, "vertices at {apex}");
+    }
+    for l in text.lines().filter_map(|l| l.strip_prefix("f ")) {
+        let f: Vec<DVec3> = l
+            .split_whitespace()
+            .map(|v| verts[v.split('/').next().unwrap().parse::<usize>().unwrap() - 1])
+            .collect();
+        assert!((f[1] - f[0]).cross(f[2] - f[0]).length() > 1e-9, "face {l}");
+    }
 }
 
 #[test]

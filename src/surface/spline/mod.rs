@@ -18,6 +18,13 @@
 //!
 //! Choices where the paper is silent:
 //!
+//! - A run of equal control points stays one point (one unknown in the solve): the curve
+//!   stands still there. A strip whose one curve stands still is a cone with its apex on that
+//!   curve (a fan from a corner of the sheet); where both stand still the strip pauses on one
+//!   ruling. The sampled mesh has one vertex for such a run and leaves out the triangles it
+//!   would flatten, and the apex may be where the rulings meet (not a striction).
+//! - `folds` states which way a crease folds (mountain or valley seen from the printed side,
+//!   the side the mesh's faces face) and optionally its mean angle; see [`solve`].
 //! - Output sampling: each span is cut into N equal parameter steps with N the smallest that
 //!   keeps the chordal error `max|a″| h²/8` (of both curves) within `tolerance`, at least 2
 //!   and at most 512 per span. Each quad a_i a_i+1 b_i+1 b_i becomes the triangles
@@ -36,7 +43,8 @@
 //!   `control_points_moved_mm`, `crease_sine` (the largest intrinsic crease sine at 64
 //!   parameters per span, [`solve::crease_sine`]) and `crease_angle_defect` (Fig. 17's crease
 //!   flatness |K|: the largest |angle sum − 2π| at the sampled mesh's vertices on creases);
-//!   with a target `approximation_rms_mm`, `approximation_max_mm`, `coverage` (the share of
+//!   with creases `fold_angle_mean_deg` (weighted by length) and `fold_angle_max_deg` of the
+//!   sampled crease edges; with a target `approximation_rms_mm`, `approximation_max_mm`, `coverage` (the share of
 //!   target points within [`COVERAGE_MM`]) and `target_points`; with handles
 //!   `handle_distance_mm`; with an outline `outline_isometry_error` (eq. 12's largest relative
 //!   length error). Seconds per iteration are not written there (the report must be
@@ -53,7 +61,7 @@ use super::Bend;
 use crate::geom::bspline::BSpline;
 use crate::geom::mesh::{Face, Mesh};
 use glam::DVec3;
-pub use solve::{Crease, Model, Report, SolveError, SolveOptions};
+pub use solve::{Crease, FoldGoal, Model, Report, SolveError, SolveOptions};
 
 /// A spline surface as the spec describes it.
 #[derive(Debug, Clone, PartialEq)]
@@ -68,6 +76,8 @@ pub struct SplineSpec {
     pub fixed: Vec<(usize, usize)>,
     /// The condition on each interior curve (entry k for curve k + 1); empty: all `free`.
     pub creases: Vec<Crease>,
+    /// The stated fold of each interior curve (entry k for curve k + 1); empty: none.
+    pub folds: Vec<Option<FoldGoal>>,
     /// A shape to approximate (eq. 9–11); without `curves` the start is its principal
     /// rectangle.
     pub target: Option<target::Target>,
@@ -212,6 +222,31 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
             ),
         ));
     }
+    if !spec.folds.is_empty() && spec.folds.len() != interior {
+        return Err(shape(
+            "folds".into(),
+            format!(
+                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
+                spec.folds.len()
+            ),
+        ));
+    }
+    for (k, f) in spec.folds.iter().enumerate() {
+        let kind = spec.creases.get(k).copied().unwrap_or_default();
+        if f.is_some() && !matches!(kind, Crease::Fold | Crease::Geodesic) {
+            let name = Crease::NAMES
+                .iter()
+                .find(|(_, c)| *c == kind)
+                .map_or("free", |n| n.0);
+            return Err(shape(
+                format!("folds[{}]", k + 1),
+                format!(
+                    "curve {} is a `{name}` crease, which does not fold; make it `fold` (or `geodesic`) in `creases`, or say \"none\" here",
+                    k + 2
+                ),
+            ));
+        }
+    }
     let total = count.saturating_mul(spec.curves.len() + 1);
     if total > MAX_CONTROL_POINTS {
         return Err(shape(
@@ -239,6 +274,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         apex: spec.apex,
         fixed: spec.fixed.clone(),
         creases: spec.creases.clone(),
+        folds: spec.folds.clone(),
         target: spec.target.clone(),
         handles: spec.handles.clone(),
         outline: spec.outline.clone(),
@@ -277,6 +313,13 @@ pub const COVERAGE_MM: f64 = 0.5;
 /// Control points per curve of a start from a target's principal rectangle.
 pub const RECTANGLE_POINTS: usize = 8;
 
+/// Consecutive samples of a curve closer than this (relative to the model's diameter) are one
+/// vertex: the curve stands still there, a cone's apex.
+const STILL: f64 = 1e-12;
+
+/// A curve whose tangent is at most this share of the other curve's stands still there.
+const APEX: f64 = 1e-6;
+
 /// Most vertices of the sampled mesh.
 pub const MAX_SAMPLED_VERTICES: usize = 2_000_000;
 
@@ -309,7 +352,11 @@ pub fn dense_crease_sine(m: &Model, per: usize, flip: bool) -> f64 {
             let el = here - p(c - 1, &r.point);
             let er = p(c + 1, &r.point) - here;
             let er = if flip { -er } else { er };
-            let s = solve::crease_sine(m.crease(c), el, er, p(c, &r.d1), p(c, &r.d2), straight);
+            let t = p(c, &r.d1);
+            if t.length() <= solve::STILL * diameter(m) {
+                continue; // the crease stands still here
+            }
+            let s = solve::crease_sine(m.crease(c), el, er, t, p(c, &r.d2), straight);
             worst = worst.max(s);
         }
     }
@@ -357,6 +404,7 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
     let mesh = sampled_mesh;
     let mut bends = bends(&mesh, &sampled.rulings, spec.bend_lines);
     bends.extend(crease_bends(&mesh, &sampled.creases));
+    let (fold_mean, fold_max) = fold_angles(&mesh, &sampled.creases);
     let (delta, iso) = quad_figures(&m, &params);
     let defect = angle_defect(&mesh, &sampled.crease_verts);
     let crease_sine = dense_crease_sine(&m, 64, false);
@@ -392,6 +440,10 @@ pub fn build(spec: &SplineSpec) -> Result<Solved, SplineError> {
         ("crease_sine", crease_sine),
         ("crease_angle_defect", defect),
     ];
+    if !sampled.creases.is_empty() {
+        figures.push(("fold_angle_mean_deg", fold_mean));
+        figures.push(("fold_angle_max_deg", fold_max));
+    }
     if !m.handles.is_empty() {
         figures.push(("handle_distance_mm", report.handle_distance));
     }
@@ -510,7 +562,9 @@ fn sample_params(m: &Model, tol: f64) -> Vec<f64> {
 }
 
 /// Refuse rulings that cross inside a strip: at each sampled ruling, the parameter v where
-/// (1 − v) a′ + v b′ is along the ruling (the surface's singular point on it).
+/// (1 − v) a′ + v b′ is along the ruling (the surface's singular point on it). Where one
+/// curve stands still (its tangent under [`APEX`] times the other's) the rulings meet on it,
+/// a cone's apex on the sheet's edge: allowed within 1e-6 of that end.
 fn check_striction(m: &Model, params: &[f64]) -> Result<(), SplineError> {
     for (k, (a, b)) in strips(m).into_iter().enumerate() {
         for &u in params {
@@ -526,9 +580,18 @@ fn check_striction(m: &Model, params: &[f64]) -> Result<(), SplineError> {
             if (beta - delta).abs() <= 1e-12 * scale {
                 continue; // parallel rulings here (a cylinder point)
             }
+            if scale <= solve::STILL * e.length() {
+                continue; // both curves stand still: the strip pauses on one ruling
+            }
             let v = beta / (beta - delta);
-            let top = if b.is_none() { 1.0 - 1e-9 } else { 1.0 + 1e-9 };
-            if v >= -1e-9 && v <= top {
+            // A curve standing still is a cone's apex: the rulings meet there, on the edge.
+            let (bottom, top) = match b {
+                None => (-1e-9, 1.0 - 1e-9),
+                Some(_) if tb.length() <= APEX * ta.length() => (-1e-9, 1.0 - 1e-6),
+                Some(_) if ta.length() <= APEX * tb.length() => (1e-6, 1.0 + 1e-9),
+                Some(_) => (-1e-9, 1.0 + 1e-9),
+            };
+            if v >= bottom && v <= top {
                 return Err(SplineError::Striction { u, v, strip: k + 1 });
             }
         }
@@ -550,94 +613,112 @@ struct Sampled {
     curve_verts: Vec<Vec<usize>>,
 }
 
-/// Sample the model into triangles whose rulings are edges.
+/// Sample the model into triangles whose rulings are edges. Where a curve stands still (a
+/// run of equal control points: the strip is a cone with its apex on that curve there), its
+/// consecutive samples are one vertex and the quad is one triangle.
 fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
-    let mut vertices = Vec::new();
+    let mut vertices: Vec<DVec3> = Vec::new();
     let mut faces = Vec::new();
-    let mut rulings = Vec::new();
-    let mut creases = Vec::new();
     let mut crease_verts = Vec::new();
-    // The previous strip's triangles along its curve b: (face, corner of b_i+1 → b_i).
-    let mut pending: Vec<(usize, usize)> = Vec::new();
     let k = params.len();
-    let mut row_a: Vec<usize> = Vec::new();
-    let first = strips(m).first().map_or(0, |s| s.0);
     // A closed surface is welded around: the last ruling is the first one.
     let weld = m.basis.closed();
-    for (i, &u) in params.iter().enumerate() {
-        if weld && i + 1 == k {
-            row_a.push(row_a[0]);
-            continue;
+    let still = STILL * diameter(m);
+    let row = |c: usize, vertices: &mut Vec<DVec3>| -> Vec<usize> {
+        let mut out: Vec<usize> = Vec::with_capacity(k);
+        for (i, &u) in params.iter().enumerate() {
+            if weld && i + 1 == k {
+                out.push(out[0]);
+                continue;
+            }
+            let p = m.basis.eval(&m.curves[c], u);
+            match out.last() {
+                Some(&v) if vertices[v].distance(p) <= still => out.push(v),
+                _ => {
+                    out.push(vertices.len());
+                    vertices.push(p);
+                }
+            }
         }
-        row_a.push(vertices.len());
-        vertices.push(at(m, Some(first), u).0);
-    }
-    let mut curve_verts = vec![row_a.clone()];
+        out
+    };
+    let first = strips(m).first().map_or(0, |s| s.0);
+    let mut rows = vec![row(first, &mut vertices)];
     for (a, b) in strips(m) {
-        debug_assert!(a + 1 == b.unwrap_or(a + 1) || b.is_none());
-        let face0 = faces.len();
-        match b {
+        let row_a = rows[a].clone();
+        let row_b = match b {
             None => {
-                let apex = vertices.len();
                 vertices.push(m.apex.unwrap_or_default());
-                curve_verts.push(vec![apex]);
-                for i in 0..k - 1 {
-                    let f = [row_a[i], row_a[i + 1], apex];
+                vec![vertices.len() - 1; k]
+            }
+            Some(b) => {
+                if a > 0 {
+                    crease_verts.extend(row_a[1..k - 1].iter().copied());
+                }
+                row(b, &mut vertices)
+            }
+        };
+        for i in 0..k - 1 {
+            let (a0, a1, b0, b1) = (row_a[i], row_a[i + 1], row_b[i], row_b[i + 1]);
+            for f in [[a0, a1, b1], [a0, b1, b0]] {
+                if f[0] != f[1] && f[1] != f[2] && f[2] != f[0] {
                     faces.push(Face {
                         verts: f.to_vec(),
                         line: None,
                     });
-                    if i > 0 {
-                        // Ruling a_i–apex: corner 1 of the face before, shared with this one.
-                        rulings.push((face0 + i - 1, face0 + i, 1));
-                    }
                 }
             }
-            Some(b) => {
-                if !pending.is_empty() {
-                    crease_verts.extend_from_slice(&row_a[1..k - 1]);
-                }
-                let mut row_b: Vec<usize> = Vec::with_capacity(k);
-                for (i, &u) in params.iter().enumerate() {
-                    if weld && i + 1 == k {
-                        row_b.push(row_b[0]);
-                        continue;
+        }
+        rows.push(row_b);
+    }
+    crease_verts.dedup();
+    let mesh = Mesh { vertices, faces };
+    // Each edge's faces with its corner in them, to name rulings and creases.
+    let mut uses: std::collections::HashMap<[usize; 2], Vec<(usize, usize)>> =
+        std::collections::HashMap::new();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for c in 0..3 {
+            let (p, q) = (face.verts[c], face.verts[(c + 1) % 3]);
+            uses.entry([p.min(q), p.max(q)]).or_default().push((f, c));
+        }
+    }
+    let shared = |p: usize, q: usize| -> Option<(usize, usize, usize)> {
+        match uses.get(&[p.min(q), p.max(q)])?.as_slice() {
+            &[(f, c), (g, _)] => Some((f, c, g)),
+            _ => None,
+        }
+    };
+    let mut rulings = Vec::new();
+    let mut creases = Vec::new();
+    for (s, _) in strips(m).into_iter().enumerate() {
+        let (ra, rb) = (&rows[s], &rows[s + 1]);
+        for i in 1..k - 1 {
+            if (ra[i], rb[i]) == (ra[i - 1], rb[i - 1]) {
+                continue;
+            }
+            if let Some((f, c, g)) = shared(ra[i], rb[i]) {
+                rulings.push((f, g, c));
+            }
+        }
+        if s > 0 {
+            for i in 0..k - 1 {
+                if ra[i] != ra[i + 1] {
+                    if let Some(e) = shared(ra[i], ra[i + 1]) {
+                        creases.push(e);
                     }
-                    vertices.push(m.basis.eval(&m.curves[b], u));
-                    row_b.push(vertices.len() - 1);
                 }
-                curve_verts.push(row_b.clone());
-                let before = std::mem::take(&mut pending);
-                for i in 0..k - 1 {
-                    if let Some(&(f, corner)) = before.get(i) {
-                        creases.push((f, corner, faces.len()));
-                    }
-                    pending.push((faces.len() + 1, 1));
-                    let (a0, a1, b0, b1) = (row_a[i], row_a[i + 1], row_b[i], row_b[i + 1]);
-                    faces.push(Face {
-                        verts: vec![a0, a1, b1],
-                        line: None,
-                    });
-                    faces.push(Face {
-                        verts: vec![a0, b1, b0],
-                        line: None,
-                    });
-                    if i > 0 {
-                        // Ruling a_i–b_i: corner 2 (b_i → a_i) of this quad's second
-                        // triangle, shared with the previous quad's first.
-                        rulings.push((face0 + 2 * i + 1, face0 + 2 * (i - 1), 2));
-                    }
-                }
-                row_a = row_b;
             }
         }
     }
+    if m.apex.is_some() {
+        rows[1].truncate(1); // the apex: one vertex
+    }
     Sampled {
-        mesh: Mesh { vertices, faces },
+        mesh,
         rulings,
         creases,
         crease_verts,
-        curve_verts,
+        curve_verts: rows,
     }
 }
 
@@ -704,6 +785,24 @@ fn crease_bends(mesh: &Mesh, creases: &[(usize, usize, usize)]) -> Vec<Bend> {
             })
         })
         .collect()
+}
+
+/// The fold angle (degrees, unsigned) along the crease edges: its mean weighted by edge
+/// length and its largest.
+fn fold_angles(mesh: &Mesh, creases: &[(usize, usize, usize)]) -> (f64, f64) {
+    let (mut sum, mut len, mut max) = (0.0, 0.0, 0.0f64);
+    for &(f, corner, g) in creases {
+        let (va, vb) = crate::geom::mesh::Topology::corner_verts(mesh, f, corner);
+        let Some(a) = mesh.signed_dihedral(f, corner, g) else {
+            continue;
+        };
+        let l = mesh.vertices[va].distance(mesh.vertices[vb]);
+        let deg = a.to_degrees().abs();
+        sum += deg * l;
+        len += l;
+        max = max.max(deg);
+    }
+    (if len > 0.0 { sum / len } else { 0.0 }, max)
 }
 
 /// The largest |angle sum − 2π| (radians) at `verts` over the faces of `mesh`.

@@ -10,6 +10,7 @@ fn spec(curves: Vec<Vec<DVec3>>, apex: Option<DVec3>, closed: bool) -> SplineSpe
         closed,
         fixed: Vec::new(),
         creases: Vec::new(),
+        folds: Vec::new(),
         target: None,
         handles: Vec::new(),
         outline: None,
@@ -300,4 +301,110 @@ fn crease_counts_and_straight_creases_are_refused() {
     assert!(e.contains("`creases[1]`: curve 2 is straight"), "{e}");
     s.creases = vec![Crease::Smooth];
     assert!(model(&s).is_ok());
+}
+
+/// A flat sheet of three curves, the middle one bowed: a crease that starts unfolded.
+fn flat_sheet() -> Vec<Vec<DVec3>> {
+    (0..3)
+        .map(|k| {
+            (0..8)
+                .map(|j| {
+                    let x = j as f64 * 30.0;
+                    let bow = if k == 1 {
+                        25.0 * (x / 210.0 * std::f64::consts::PI).sin()
+                    } else {
+                        0.0
+                    };
+                    DVec3::new(x, k as f64 * 100.0 + bow, 0.0)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn a_stated_direction_folds_a_flat_start_that_way_by_at_least_one_degree() {
+    for (valley, sense) in [(true, -1.0), (false, 1.0)] {
+        let mut s = spec(flat_sheet(), None, false);
+        s.creases = vec![Crease::Fold];
+        // Unfolded, the flat start is already a solution: nothing moves.
+        let out = build(&s).unwrap();
+        assert!(out.report.moved <= 1e-12, "{}", out.report.moved);
+        assert_eq!(figure(&out, "fold_angle_max_deg"), 0.0);
+        s.folds = vec![Some(FoldGoal {
+            valley,
+            angle: None,
+        })];
+        let out = build(&s).unwrap();
+        let mean = figure(&out, "fold_angle_mean_deg");
+        assert!((1.0 - 1e-6..1.1).contains(&mean), "mean {mean}");
+        assert!(figure(&out, "crease_sine") <= 1e-9, "{:?}", out.figures);
+        assert!(figure(&out, "largest_sine") <= 1e-9, "{:?}", out.figures);
+        // Seen from the printed side (the mesh's faces), a valley folds towards it: the
+        // pattern calls a negative dihedral a valley.
+        let on = |v: usize| out.curve_verts[1].contains(&v);
+        let creases: Vec<&Bend> = out
+            .bends
+            .iter()
+            .filter(|b| on(b.verts[0]) && on(b.verts[1]))
+            .collect();
+        assert!(creases.len() > 10);
+        assert!(creases.iter().all(|b| b.angle_deg.signum() == sense));
+    }
+}
+
+#[test]
+fn a_stated_angle_is_the_mean_fold_along_the_crease() {
+    let mut s = spec(flat_sheet(), None, false);
+    s.creases = vec![Crease::Fold];
+    s.options.max_iterations = 100;
+    s.folds = vec![Some(FoldGoal {
+        valley: false,
+        angle: Some(30f64.to_radians()),
+    })];
+    let out = build(&s).unwrap();
+    let mean = figure(&out, "fold_angle_mean_deg");
+    assert!((mean - 30.0).abs() < 0.05, "mean {mean} {:?}", out.figures);
+    assert!(figure(&out, "crease_sine") <= 1e-9, "{:?}", out.figures);
+    assert!(figure(&out, "largest_sine") <= 1e-9, "{:?}", out.figures);
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+}
+
+#[test]
+fn a_curve_that_stands_still_is_a_cone_apex_with_one_vertex() {
+    // The first curve is one point for its first half (a cone over the bow), then moves.
+    let mut curves = flat_sheet();
+    for p in curves[0].iter_mut().take(4) {
+        *p = DVec3::ZERO;
+    }
+    let mut s = spec(curves, None, false);
+    s.fixed = vec![(0, 0), (0, 1), (0, 2), (0, 3)];
+    s.creases = vec![Crease::Fold];
+    // The far corner lifted: the cone bends about its apex.
+    s.handles = vec![(curves_end(&s), DVec3::new(f64::NAN, f64::NAN, 40.0))];
+    s.options.max_iterations = 100;
+    let out = build(&s).unwrap();
+    let at_apex = out
+        .mesh
+        .vertices
+        .iter()
+        .filter(|v| v.length() < 1e-9)
+        .count();
+    assert_eq!(at_apex, 1);
+    for f in &out.mesh.faces {
+        let p: Vec<DVec3> = f.verts.iter().map(|&v| out.mesh.vertices[v]).collect();
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).length() > 1e-9);
+    }
+    assert!(figure(&out, "largest_sine") <= 1e-9, "{:?}", out.figures);
+    assert!(
+        figure(&out, "handle_distance_mm") <= 1e-6,
+        "{:?}",
+        out.figures
+    );
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+}
+
+/// The last control point of the last curve.
+fn curves_end(s: &SplineSpec) -> DVec3 {
+    *s.curves.last().and_then(|c| c.last()).unwrap()
 }

@@ -6,7 +6,7 @@
 //! the surface normal held fixed within an iteration (as Fig. 16 does), eq. 9 weighted up at
 //! the strip's edge so that it grows, handles ramped to their goal.
 
-use super::{Layout, Row};
+use super::{normal_of, CreaseSample, Layout, Row, STILL};
 use crate::geom::bspline::BSpline;
 use crate::surface::spline::system::{eval, Expr};
 use crate::surface::spline::target::StripRef;
@@ -220,4 +220,114 @@ pub(super) fn target_merit(l: &Layout, basis: &BSpline, feet: &[Foot]) -> (f64, 
         }
     }
     (sum, dist / feet.len().max(1) as f64)
+}
+
+/// The least mean angle (radians, 1°) of a fold stated by its direction alone: enough to
+/// leave the flat start on that side.
+pub const FOLD_MIN: f64 = std::f64::consts::PI / 180.0;
+
+/// The weight of a stated fold's row (a user-defined goal, like a handle).
+const W_FOLD: f64 = 1.0;
+
+/// The fold angle at one crease sample — the signed angle from the left strip's normal to
+/// the right one's about the crease tangent, positive for a valley seen from the front — and
+/// its gradient in the two normals (atan2 of ⟨n_L × n_R, t⟩ and ⟨n_L, n_R⟩, t held fixed).
+fn fold_at(l: &Layout, x: &[f64], c: &CreaseSample) -> (f64, DVec3, DVec3) {
+    let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
+    let (nl, nr) = (normal_of(x, sl), normal_of(x, sr));
+    let t = eval(&sr.ta, &l.points).normalize_or_zero();
+    let (s, co) = (nl.cross(nr).dot(t), nl.dot(nr));
+    let q = (s * s + co * co).max(1e-300);
+    let phi = s.atan2(co);
+    let gl = (co * nr.cross(t) - s * nr) / q;
+    let gr = (co * t.cross(nl) - s * nl) / q;
+    (FOLD_SIGN * phi, FOLD_SIGN * gl, FOLD_SIGN * gr)
+}
+
+/// Which way the angle of [`fold_at`] turns for a valley: the solver's normals are e × a′,
+/// against the sampled mesh's faces (a′ × e), which the pattern's mountain and valley see.
+const FOLD_SIGN: f64 = 1.0;
+
+/// A stated fold's mean angle in its direction (radians; negative when it folds the other
+/// way), weighted by length along the crease, and the gradient of that mean in the normals
+/// (the weights held at the iterate), as row entries.
+pub(super) fn fold_mean(l: &Layout, x: &[f64], f: &FoldGoalRows) -> (f64, Vec<(usize, f64)>) {
+    // Each sample weighs its share of the crease's length, |c′| (the samples are equally
+    // spaced in u); where the crease stands still it has no angle and no weight.
+    let speed = |k: usize| {
+        let t = eval(&l.samples[l.creases[k].right].ta, &l.points).length();
+        if t > STILL {
+            t
+        } else {
+            0.0
+        }
+    };
+    let total: f64 = f.creases.iter().map(|&k| speed(k)).sum();
+    let mut mean = 0.0;
+    let mut entries = Vec::with_capacity(6 * f.creases.len());
+    if total <= 0.0 {
+        return (mean, entries);
+    }
+    for &k in &f.creases {
+        let w = speed(k) / total;
+        if w == 0.0 {
+            continue;
+        }
+        let c = &l.creases[k];
+        let (phi, gl, gr) = fold_at(l, x, c);
+        mean += w * f.sigma * phi;
+        for (s, g) in [(&l.samples[c.left], gl), (&l.samples[c.right], gr)] {
+            for i in 0..3 {
+                entries.push((s.normal + i, w * f.sigma * g[i]));
+            }
+        }
+    }
+    (mean, entries)
+}
+
+/// The stated folds' rows: the mean angle at this iteration's goal (an angle), or raised to
+/// [`FOLD_MIN`] where it is less (a direction alone).
+pub(super) fn fold_rows(l: &Layout, x: &[f64], rows: &mut Vec<Row>) {
+    for f in &l.folds {
+        let (mean, entries) = fold_mean(l, x, f);
+        let goal = match f.angle {
+            Some(_) => f.now,
+            None if mean < FOLD_MIN => FOLD_MIN,
+            None => continue,
+        };
+        // Σ gᵢ xᵢ = goal − mean + Σ gᵢ xᵢ at the iterate.
+        let at: f64 = entries.iter().map(|&(i, g)| g * x[i]).sum();
+        rows.push(Row {
+            entries,
+            rhs: goal - mean + at,
+            w: W_FOLD,
+        });
+    }
+}
+
+/// The stated folds' weighted squared residual and their largest distance (radians) from
+/// the goal (this iteration's with `now`, else the final one).
+pub(super) fn fold_merit(l: &Layout, x: &[f64], now: bool) -> (f64, f64) {
+    let (mut sum, mut worst) = (0.0, 0.0f64);
+    for f in &l.folds {
+        let mean = fold_mean(l, x, f).0;
+        let d = match f.angle {
+            Some(a) => (mean - if now { f.now } else { a }).abs(),
+            None => (FOLD_MIN - mean).max(0.0),
+        };
+        sum += W_FOLD * W_FOLD * d * d;
+        worst = worst.max(d);
+    }
+    (sum, worst)
+}
+
+/// A stated fold in the solver: its crease samples (indices into the layout's creases), the
+/// direction (1 valley, −1 mountain), the mean angle asked for, and where its goal starts and
+/// stands this iteration (moved from the start to the angle over [`HANDLE_RAMP`] iterations).
+pub(super) struct FoldGoalRows {
+    pub(super) creases: Vec<usize>,
+    pub(super) sigma: f64,
+    pub(super) angle: Option<f64>,
+    pub(super) start: f64,
+    pub(super) now: f64,
 }

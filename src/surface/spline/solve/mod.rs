@@ -38,7 +38,18 @@
 //!   sides), as the one equation ⟨n_L ± n_R, c″⟩ / |c″ ⟂ c′| = 0 per sample parameter of the
 //!   strips, at the strips' own samples (3m − 2 per span: enforced numerically, as the paper
 //!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
-//!   nothing and is left out. Smooth: n_L − n_R = 0.
+//!   nothing and is left out. Smooth: n_L − n_R = 0. A row is divided by |c″ ⟂ c′| but by
+//!   no less than [`CREASE_FLOOR`]·|c″|, which keeps it bounded where the crease slows down.
+//! - A curve that stands still (a tangent shorter than [`STILL`] in the diameter-1 frame: a
+//!   run of equal control points, which share one unknown) has no tangent: its conditions are
+//!   left out there, a normal is oriented by the other curve's tangent, and where both stand
+//!   still it takes the nearest sample's plane of its strip to start from.
+//! - A stated fold (`folds`, §3.3 leaves the direction of a fold to the start) is one more
+//!   goal row: the mean over the crease's samples of the fold angle, the signed angle from the
+//!   left strip's normal to the right one's about c′ (atan2, linearised in the normals), at
+//!   the stated angle (its goal moved there from the start over [`HANDLE_RAMP`] rounds, like a
+//!   handle) or, for a direction alone, at least [`FOLD_MIN`]. The fold angle of a curved
+//!   crease varies along it (it follows the sides' bending); the mean is what a user sets.
 
 mod goals;
 
@@ -47,11 +58,11 @@ use super::system::{eval, normal_equations, sparse_solve, Expr, Pattern, Row};
 use super::target::Target;
 use crate::geom::bspline::BSpline;
 use glam::DVec3;
-pub use goals::HANDLE_RAMP;
 use goals::{
-    feet, foot_exprs, grids, handle_merit, handle_rows, nearest_foot, target_merit, target_rows,
-    Foot,
+    feet, fold_mean, fold_merit, fold_rows, foot_exprs, grids, handle_merit, handle_rows,
+    nearest_foot, target_merit, target_rows, FoldGoalRows, Foot,
 };
+pub use goals::{FOLD_MIN, HANDLE_RAMP};
 
 /// The solver's settings (spec keys of the same names).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -103,6 +114,17 @@ impl Crease {
     ];
 }
 
+/// A crease's stated fold (spec `folds`): which way it folds and, optionally, by how much.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FoldGoal {
+    /// A valley seen from the front (the side the sampled mesh's faces face, where the
+    /// pattern is printed), else a mountain.
+    pub valley: bool,
+    /// The mean fold angle along the crease (radians, in (0, π)); `None`: at least
+    /// [`FOLD_MIN`], the direction alone.
+    pub angle: Option<f64>,
+}
+
 /// A spline developable's unknowns before and after the solve, in millimetres.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -115,6 +137,8 @@ pub struct Model {
     pub fixed: Vec<(usize, usize)>,
     /// The condition on each interior curve (curve k + 1 for entry k); shorter means `Free`.
     pub creases: Vec<Crease>,
+    /// The stated fold of each interior curve (entry k for curve k + 1); shorter means none.
+    pub folds: Vec<Option<FoldGoal>>,
     /// A shape to approximate (eq. 9–11); `None` for none.
     pub target: Option<Target>,
     /// Handles: a point on the surface as given (`at`) dragged towards a 3D position (`to`),
@@ -193,6 +217,8 @@ struct Layout {
     handle_now: Vec<DVec3>,
     /// The development kept isometric to the outline (eq. 12).
     dev: Option<Dev>,
+    /// The stated folds.
+    folds: Vec<FoldGoalRows>,
     /// Number of unknowns.
     n: usize,
 }
@@ -230,8 +256,10 @@ pub fn plane_sine(e: DVec3, ta: DVec3, tb: Option<DVec3>) -> f64 {
     let Some(tb) = tb else { return 0.0 };
     let na = e.cross(ta).length();
     let nb = e.cross(tb).length();
-    if nb <= 1e-300 || na <= 1e-300 {
-        // b′ = 0 (a cone point) or along the ruling: no condition there.
+    let still = STILL * e.length();
+    if ta.length() <= still || tb.length() <= still || nb <= 1e-300 || na <= 1e-300 {
+        // a′ or b′ = 0 (a cone point: the curve stands still) or along the ruling: no
+        // condition there.
         return 0.0;
     }
     (e.dot(ta.cross(tb)).abs() * e.length() / (na * nb)).min(1.0)
@@ -240,6 +268,14 @@ pub fn plane_sine(e: DVec3, ta: DVec3, tb: Option<DVec3>) -> f64 {
 /// Curvature (in the diameter-1 frame) at or under which a crease point counts as straight:
 /// the fold and geodesic conditions say nothing there.
 pub const STRAIGHT: f64 = 1e-6;
+
+/// A tangent (or ruling) at most this long in the diameter-1 frame is zero: the curve stands
+/// still there (a run of equal control points, a cone's apex on that curve), and the
+/// conditions on it are left out; relative to the other tangent in [`plane_sine`].
+pub const STILL: f64 = 1e-9;
+
+/// The least share of |c″| a crease row is divided by (see [`crease_rows`]).
+const CREASE_FLOOR: f64 = 0.1;
 
 /// The smallest ε₂ the schedule decays to once the fairness is off.
 const EPS2_FLOOR: f64 = 1e-4;
@@ -282,15 +318,23 @@ pub fn crease_sine(kind: Crease, el: DVec3, er: DVec3, t: DVec3, d2: DVec3, stra
 fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout {
     let count = m.basis.count();
     let nc = m.curves.len();
-    let mut var = vec![None; points.len()];
+    let mut var: Vec<Option<usize>> = vec![None; points.len()];
     let mut n = 0;
-    for (p, v) in var.iter_mut().enumerate() {
+    for p in 0..points.len() {
         let key = (p / count.max(1), p % count.max(1));
         let key = if p >= nc * count { (nc, 0) } else { key };
-        if !m.fixed.contains(&key) {
-            *v = Some(n);
-            n += 3;
+        if m.fixed.contains(&key) {
+            continue;
         }
+        // A run of equal control points is one point: where a curve stands still (a cone's
+        // apex on the edge, a pause) it stays still.
+        let (c, i) = key;
+        if c < nc && i > 0 && m.curves[c][i] == m.curves[c][i - 1] && var[p - 1].is_some() {
+            var[p] = var[p - 1];
+            continue;
+        }
+        var[p] = Some(n);
+        n += 3;
     }
     let deg = m.basis.degree();
     let per = 3 * deg - 2;
@@ -372,22 +416,82 @@ fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout 
         handle_start: Vec::new(),
         handle_now: Vec::new(),
         dev: None,
+        folds: Vec::new(),
         n,
     }
 }
 
+/// The stated folds over the layout's crease samples, their goals starting at the mean
+/// angle of the start `x`.
+fn fold_goals(m: &Model, l: &Layout, x: &[f64]) -> Vec<FoldGoalRows> {
+    let per_strip = l.samples.len() / l.strips.len().max(1);
+    let mut out = Vec::new();
+    for (k, f) in m.folds.iter().enumerate() {
+        let Some(f) = f else { continue };
+        // Curve k + 1's samples: those whose left strip is strip k.
+        let creases: Vec<usize> = (0..l.creases.len())
+            .filter(|&i| l.creases[i].left / per_strip.max(1) == k)
+            .collect();
+        if creases.is_empty() {
+            continue;
+        }
+        let mut g = FoldGoalRows {
+            creases,
+            sigma: if f.valley { 1.0 } else { -1.0 },
+            angle: f.angle,
+            start: 0.0,
+            now: 0.0,
+        };
+        g.start = fold_mean(l, x, &g).0;
+        g.now = g.start;
+        out.push(g);
+    }
+    out
+}
+
 /// Initial normals: the tangent planes at both ends of each ruling averaged.
 fn initial_normals(l: &Layout, x: &mut [f64]) -> Result<(), SolveError> {
-    for s in &l.samples {
+    // Where both curves stand still (a pause of the whole strip: the quads are points or
+    // rulings) there is no plane; such a sample takes its strip's nearest plane.
+    let mut paused = Vec::new();
+    for (i, s) in l.samples.iter().enumerate() {
         let e = eval(&s.e, &l.points);
-        let na = e.cross(eval(&s.ta, &l.points));
-        let mut n = na.normalize_or_zero();
-        if let Some(tb) = &s.tb {
-            let nb = e.cross(eval(tb, &l.points)).normalize_or_zero();
+        // A tangent that stands still (a cone's apex) has no plane; e × b′ then orients n.
+        let moving = |t: DVec3| if t.length() <= STILL { DVec3::ZERO } else { t };
+        let ta = moving(eval(&s.ta, &l.points));
+        let tb = s.tb.as_ref().map(|t| moving(eval(t, &l.points)));
+        let mut n = e.cross(ta).normalize_or_zero();
+        if let Some(tb) = tb {
+            let nb = e.cross(tb).normalize_or_zero();
             n += if nb.dot(n) < 0.0 { -nb } else { nb };
         }
         let n = n.normalize_or_zero();
+        if n == DVec3::ZERO && ta == DVec3::ZERO && tb.unwrap_or_default() == DVec3::ZERO {
+            paused.push(i);
+            continue;
+        }
         if n == DVec3::ZERO || !n.is_finite() {
+            return Err(SolveError::NoPlane {
+                u: s.u,
+                curve: s.curve + 1,
+            });
+        }
+        x[s.normal..s.normal + 3].copy_from_slice(&n.to_array());
+    }
+    for &i in &paused {
+        let s = &l.samples[i];
+        let same = |j: &usize| l.samples[*j].curve == s.curve && !paused.contains(j);
+        let near = (0..l.samples.len())
+            .filter(same)
+            .min_by_key(|&j| j.abs_diff(i))
+            .ok_or(SolveError::NoPlane {
+                u: s.u,
+                curve: s.curve + 1,
+            })?;
+        let e = eval(&s.e, &l.points).normalize_or_zero();
+        let m = normal_of(x, &l.samples[near]);
+        let n = (m - e * m.dot(e)).normalize_or_zero();
+        if n == DVec3::ZERO {
             return Err(SolveError::NoPlane {
                 u: s.u,
                 curve: s.curve + 1,
@@ -423,7 +527,7 @@ fn residual(l: &Layout, x: &[f64]) -> (f64, f64) {
         let tb = s.tb.as_ref().map(|t| eval(t, &l.points));
         for d in [Some(e), Some(ta), tb].into_iter().flatten() {
             let len = d.length();
-            if len > 1e-300 {
+            if len > STILL {
                 sum += (n.dot(d) / len).powi(2);
             }
         }
@@ -441,13 +545,15 @@ fn residual(l: &Layout, x: &[f64]) -> (f64, f64) {
             Crease::Smooth => sum += (nl - nr).length_squared(),
             Crease::Fold | Crease::Geodesic => {
                 let sigma = if c.kind == Crease::Fold { 1.0 } else { -1.0 };
-                if let Some(k) = principal_normal(t, d2, STRAIGHT) {
+                if let Some(k) = principal_normal(t, d2, STRAIGHT).filter(|_| t.length() > STILL) {
                     sum += (nl + sigma * nr).dot(k).powi(2);
                 }
             }
             Crease::Free => {}
         }
-        worst = worst.max(crease_sine(c.kind, el, er, t, d2, STRAIGHT));
+        if t.length() > STILL {
+            worst = worst.max(crease_sine(c.kind, el, er, t, d2, STRAIGHT));
+        }
     }
     (sum, worst)
 }
@@ -474,22 +580,25 @@ fn crease_rows(l: &Layout, x: &[f64], c: &CreaseSample, rows: &mut Vec<Row>) {
     let t = eval(&sr.ta, &l.points);
     let d = eval(&c.d2, &l.points);
     let tl = t.length();
-    let perp = if tl > 1e-300 {
+    let perp = if tl > STILL {
         (d - t * (d.dot(t) / (tl * tl))).length()
     } else {
         0.0
     };
-    if tl <= 1e-300 || perp / (tl * tl) <= STRAIGHT {
-        return;
+    if tl <= STILL || perp / (tl * tl) <= STRAIGHT {
+        return; // the crease stands still or is straight here: no condition
     }
+    // Divided by |c″ ⟂ c′| the row is a cosine; where the crease slows down (c″ mostly along
+    // c′) at most 1/CREASE_FLOOR times |c″| keeps its entries bounded.
+    let scale = perp.max(CREASE_FLOOR * d.length());
     let n0 = normal_of(x, sl) + sigma * normal_of(x, sr);
     let mut entries = Vec::with_capacity(6 + 3 * c.d2.len());
     let mut rhs = 0.0;
     for k in 0..3 {
-        entries.push((sl.normal + k, d[k] / perp));
-        entries.push((sr.normal + k, sigma * d[k] / perp));
+        entries.push((sl.normal + k, d[k] / scale));
+        entries.push((sr.normal + k, sigma * d[k] / scale));
     }
-    point_part(l, &c.d2, n0, perp, &mut entries, &mut rhs);
+    point_part(l, &c.d2, n0, scale, &mut entries, &mut rhs);
     rows.push(Row {
         entries,
         rhs,
@@ -522,7 +631,10 @@ fn point_part(
 fn bilinear(l: &Layout, x: &[f64], s: &Sample, expr: &Expr, rows: &mut Vec<Row>) {
     let n = normal_of(x, s);
     let d = eval(expr, &l.points);
-    let len = d.length().max(1e-12);
+    if d.length() <= STILL {
+        return; // a curve standing still (a cone's apex): no tangent, no condition
+    }
+    let len = d.length();
     let mut entries = Vec::with_capacity(3 + 3 * expr.len());
     let mut rhs = 0.0;
     for c in 0..3 {
@@ -544,6 +656,7 @@ fn rows(l: &Layout, x: &[f64], eps1: f64, basis: &BSpline, feet: &[Foot]) -> Vec
         d.rows(&l.points, &l.var, x, eps1, &mut rows);
     }
     handle_rows(l, basis, &mut rows);
+    fold_rows(l, x, &mut rows);
     for s in &l.samples {
         bilinear(l, x, s, &s.e, &mut rows);
         bilinear(l, x, s, &s.ta, &mut rows);
@@ -671,6 +784,7 @@ impl Problem {
             }
         }
         initial_normals(&l, &mut x)?;
+        l.folds = fold_goals(m, &l, &x);
         let (merit, sine) = residual(&l, &x);
         let feet = feet(&l, &basis);
         Ok(Problem {
@@ -705,7 +819,10 @@ impl Problem {
     /// Whether there are goals besides the constraints (a target, handles): the solve then
     /// goes on until they stop improving.
     pub fn has_goals(&self) -> bool {
-        self.has_target() || !self.l.handles.is_empty() || self.l.dev.is_some()
+        self.has_target()
+            || !self.l.handles.is_empty()
+            || self.l.dev.is_some()
+            || !self.l.folds.is_empty()
     }
 
     /// The development's squared residual and largest relative length error (eq. 12); zero
@@ -723,6 +840,7 @@ impl Problem {
         target_merit(&self.l, &self.basis, &self.feet).0
             + handle_merit(&self.l, &self.basis, true).0
             + self.dev_merit().0
+            + fold_merit(&self.l, &self.x, true).0
     }
 
     /// The largest relative length error of the development (eq. 12).
@@ -736,6 +854,7 @@ impl Problem {
         target_merit(&self.l, &self.basis, &self.feet).1.sqrt()
             + handle_merit(&self.l, &self.basis, false).1
             + self.dev_merit().1
+            + fold_merit(&self.l, &self.x, false).1
     }
 
     /// The largest distance (mm) of a handle from its goal.
@@ -754,6 +873,11 @@ impl Problem {
         for (k, (_, goal)) in self.l.handles.iter().enumerate() {
             let start = self.l.handle_start[k];
             self.l.handle_now[k] = start + (*goal - start) * f;
+        }
+        for g in &mut self.l.folds {
+            if let Some(a) = g.angle {
+                g.now = g.start + (a - g.start) * f;
+            }
         }
         if self.has_goals() {
             // Footpoints found again every iteration (§4.2); the merit counts the goals too.
@@ -818,7 +942,7 @@ pub fn solve(m: &mut Model, o: &SolveOptions) -> Result<Report, SolveError> {
     let budget = (WORK_BUDGET / per.max(1)).max(1);
     let max_iterations = o.max_iterations.min(budget);
     while it < max_iterations && (pr.sine() > o.stop_sine || !converged) {
-        let fair_rounds = if m.handles.is_empty() {
+        let fair_rounds = if m.handles.is_empty() && m.folds.iter().all(Option::is_none) {
             o.iterations
         } else {
             o.iterations.max(HANDLE_RAMP)
