@@ -659,7 +659,11 @@ fn a4_arc(t: f64) -> DVec3 {
 /// An A4 run (`curves` and `extra` keys, outline 210 × 297, a `fold` crease on curve 2 along
 /// the arc) through the command line: its report, the blank's area and perimeter from the
 /// cut contour, and how far the flat crease lies from the arc (mm).
-fn a4_run(name: &str, curves: &[Vec<DVec3>], extra: &str) -> (serde_json::Value, f64, f64, f64) {
+fn a4_run(
+    name: &str,
+    curves: &[Vec<DVec3>],
+    extra: &str,
+) -> (serde_json::Value, serde_json::Value, f64, f64, f64) {
     let dir = scratch(name);
     let spec = spline_spec(
         &dir,
@@ -717,7 +721,7 @@ fn a4_run(name: &str, curves: &[Vec<DVec3>], extra: &str) -> (serde_json::Value,
     assert!(figure(&report, "handle_distance_mm") < 0.01);
     assert!(figure(&report, "largest_sine") <= 1e-6);
     assert!(figure(&report, "crease_sine") <= 1e-6);
-    (report, area, per, off)
+    (report, d, area, per, off)
 }
 
 /// The crease along the arc and the lines y = 0 and y = 297, each of `n` control points.
@@ -748,7 +752,7 @@ fn spline_a4_folds_along_its_arc_by_the_stated_angle() {
     // The bottom edge's middle pinned, the top corners lifted, the crease folded by 20° on
     // average as a valley, then as a mountain.
     for (kind, other) in [("valley", "mountain"), ("mountain", "valley")] {
-        let (report, ..) = a4_run(
+        let (report, design, ..) = a4_run(
             &format!("spline-a4-{kind}"),
             &a4_curves(8),
             &format!("folds = [{{ kind = \"{kind}\", angle_deg = 20 }}]\nmax_iterations = 200\n{A4_LIFT}, {{ at = [105, 0, 0], to = [105, 0, 0] }}]"),
@@ -764,6 +768,42 @@ fn spline_a4_folds_along_its_arc_by_the_stated_angle() {
         assert!(lines
             .iter()
             .all(|l| l["angle_deg"].as_f64().unwrap() >= 10.0));
+        // The pin holds the point of the flat sheet it was put on: the bottom edge's point at
+        // (105, 0, 0) in 3D is 105 mm along that edge on the blank.
+        let basis = BSpline::new(3, 8, false).unwrap();
+        let bottom = &design_curves(&design)[0];
+        let pin = DVec3::new(105.0, 0.0, 0.0);
+        let u0 = (0..=20_000)
+            .map(|k| k as f64 * basis.spans() as f64 / 20_000.0)
+            .min_by(|&a, &b| {
+                let d = |u: f64| basis.eval(bottom, u).distance(pin);
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        assert!(basis.eval(bottom, u0).distance(pin) < 0.01);
+        let dev = &design["surfaces"][0]["development"];
+        let num = |v: &serde_json::Value| v.as_f64().unwrap();
+        let params: Vec<f64> = dev["params"].as_array().unwrap().iter().map(num).collect();
+        let flat: Vec<(f64, f64)> = dev["curves"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["curve"] == 1)
+            .unwrap()["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| (num(&p[0]), num(&p[1])))
+            .collect();
+        let i = params.iter().position(|&u| u >= u0).unwrap().max(1);
+        let t = (u0 - params[i - 1]) / (params[i] - params[i - 1]);
+        let at = (
+            flat[i - 1].0 + t * (flat[i].0 - flat[i - 1].0),
+            flat[i - 1].1 + t * (flat[i].1 - flat[i - 1].1),
+        );
+        let along = ((at.0 - flat[0].0).powi(2) + (at.1 - flat[0].1).powi(2)).sqrt();
+        eprintln!("{kind}: the pin is {along:.4} mm along the bottom edge of the blank");
+        assert!((along - 105.0).abs() < 0.05, "{along}");
     }
 }
 

@@ -45,6 +45,8 @@ pub(super) struct Dev {
     fair_s: Vec<DVec2>,
     /// V̄ at the start.
     start: Vec<DVec2>,
+    /// Vertices per curve (V samples every curve at the same parameters).
+    per_curve: usize,
 }
 
 impl Dev {
@@ -128,7 +130,44 @@ impl Dev {
             fair,
             fair_s,
             start,
+            per_curve: k,
         }
+    }
+
+    /// Where the point `q` of the flat sheet is on the surface at the current iterate: the
+    /// strip and parameters (u, v) of the development's triangle that holds it (the nearest
+    /// one when it holds none), u and v interpolated linearly within that triangle.
+    pub(super) fn locate(&self, x: &[f64], q: DVec2) -> Option<(usize, f64, f64)> {
+        let k = self.per_curve;
+        let curves = self.verts.len() / k.max(1);
+        let mut best: Option<(f64, (usize, f64, f64))> = None;
+        for c in 0..curves.saturating_sub(1) {
+            for i in 0..k.saturating_sub(1) {
+                let (u0, u1) = (i as f64 / PER_SPAN as f64, (i + 1) as f64 / PER_SPAN as f64);
+                let corner = |cc: usize, ii: usize| self.flat(x, cc * k + ii);
+                let (a0, a1, b0, b1) = (
+                    corner(c, i),
+                    corner(c, i + 1),
+                    corner(c + 1, i),
+                    corner(c + 1, i + 1),
+                );
+                // The triangles of the sampled mesh: (a0, a1, b1) and (a0, b1, b0).
+                for (t, uv) in [
+                    ([a0, a1, b1], [(u0, 0.0), (u1, 0.0), (u1, 1.0)]),
+                    ([a0, b1, b0], [(u0, 0.0), (u1, 1.0), (u0, 1.0)]),
+                ] {
+                    let Some(w) = barycentric(t, q) else { continue };
+                    // Outside by the most negative weight (0 inside).
+                    let out = -w.iter().copied().fold(0.0, f64::min);
+                    if best.is_none_or(|b| out < b.0) {
+                        let u = w[0] * uv[0].0 + w[1] * uv[1].0 + w[2] * uv[2].0;
+                        let v = w[0] * uv[0].1 + w[1] * uv[1].1 + w[2] * uv[2].1;
+                        best = Some((out, (c, u, v.clamp(0.0, 1.0))));
+                    }
+                }
+            }
+        }
+        best.map(|b| b.1)
     }
 
     /// Number of unknowns the development adds.
@@ -256,6 +295,17 @@ impl Dev {
         }
         (sum, worst)
     }
+}
+
+/// The barycentric weights of `q` in the triangle `t`; `None` when it has no area.
+fn barycentric(t: [DVec2; 3], q: DVec2) -> Option<[f64; 3]> {
+    let d = (t[1] - t[0]).perp_dot(t[2] - t[0]);
+    if d.abs() <= 1e-300 {
+        return None;
+    }
+    let w1 = (q - t[0]).perp_dot(t[2] - t[0]) / d;
+    let w2 = (t[1] - t[0]).perp_dot(q - t[0]) / d;
+    Some([1.0 - w1 - w2, w1, w2])
 }
 
 /// The nearest point of a polyline (closed: a polygon) to `q` and the unit normal of the

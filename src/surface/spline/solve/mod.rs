@@ -22,8 +22,10 @@
 //!   at ε₂ it damps the last rounds into linear convergence; much below 1e-4 the normal
 //!   equations lose the digits the last rounds need).
 //! - Goals besides the constraints — a target (eq. 9–11, rows in this file, footpoints from
-//!   `target`), handles (weight 1, their goal moved there over [`HANDLE_RAMP`] rounds) and an
-//!   outline (eq. 12, `develop`) — keep the solve going past the sine test until their
+//!   `target`), handles (weight 1, their goal moved there over [`HANDLE_RAMP`] rounds; with an
+//!   outline a handle holds a point of the flat sheet, found on the surface again every
+//!   iteration through the development's triangle that holds it, u and v interpolated there)
+//!   and an outline (eq. 12, `develop`) — keep the solve going past the sine test until their
 //!   measure stops changing; a deterministic work budget bounds the rounds of any design.
 //! - The model is moved to its bounding box centre and scaled to diameter 1 inside.
 //! - A step whose squared constraint residual is larger than the current one is halved, up to
@@ -141,8 +143,9 @@ pub struct Model {
     pub folds: Vec<Option<FoldGoal>>,
     /// A shape to approximate (eq. 9–11); `None` for none.
     pub target: Option<Target>,
-    /// Handles: a point on the surface as given (`at`) dragged towards a 3D position (`to`),
-    /// as (at, to), in millimetres; a coordinate of `to` that is NaN is left free.
+    /// Handles: a point on the surface as given (`at`; with an outline, the point of the flat
+    /// sheet there) dragged towards a 3D position (`to`), as (at, to), in millimetres; a
+    /// coordinate of `to` that is NaN is left free.
     pub handles: Vec<(DVec3, DVec3)>,
     /// A flat domain (mm, in the plane z = 0 of the curves as given, which lie in it) that the
     /// surface stays isometric to (eq. 12); `None` for none.
@@ -215,6 +218,8 @@ struct Layout {
     /// the start to the goal over [`HANDLE_RAMP`] iterations).
     handle_start: Vec<DVec3>,
     handle_now: Vec<DVec3>,
+    /// Each handle's point of the flat sheet (scaled; used with an outline).
+    handle_flat: Vec<glam::DVec2>,
     /// The development kept isometric to the outline (eq. 12).
     dev: Option<Dev>,
     /// The stated folds.
@@ -415,6 +420,7 @@ fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout 
         handles: Vec::new(),
         handle_start: Vec::new(),
         handle_now: Vec::new(),
+        handle_flat: Vec::new(),
         dev: None,
         folds: Vec::new(),
         n,
@@ -762,6 +768,11 @@ impl Problem {
             .map(|(f, _)| eval(&foot_exprs(&l, &basis, f).0, &l.points))
             .collect();
         l.handle_now = l.handle_start.clone();
+        l.handle_flat = m
+            .handles
+            .iter()
+            .map(|(at, _)| ((*at - centre) / diameter).truncate())
+            .collect();
         if let Some(outline) = &m.outline {
             let flat = outline
                 .iter()
@@ -873,6 +884,20 @@ impl Problem {
         for (k, (_, goal)) in self.l.handles.iter().enumerate() {
             let start = self.l.handle_start[k];
             self.l.handle_now[k] = start + (*goal - start) * f;
+        }
+        // With an outline a handle holds a point of the flat sheet: where that point is on
+        // the surface is found again through the development every iteration.
+        if let Some(d) = &self.l.dev {
+            for (k, (foot, _)) in self.l.handles.iter_mut().enumerate() {
+                if let Some((strip, u, v)) = d.locate(&self.x, self.l.handle_flat[k]) {
+                    *foot = Foot {
+                        strip,
+                        u,
+                        v,
+                        ..*foot
+                    };
+                }
+            }
         }
         for g in &mut self.l.folds {
             if let Some(a) = g.angle {
