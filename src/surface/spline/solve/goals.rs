@@ -99,6 +99,9 @@ pub(super) fn grids(l: &Layout, basis: &BSpline) -> Vec<Vec<(f64, f64, DVec3)>> 
 
 /// The footpoint of every target point on its nearest strip, with the surface normal there.
 pub(super) fn feet(l: &Layout, basis: &BSpline) -> Vec<Foot> {
+    if l.target.is_empty() {
+        return Vec::new(); // no grids to build
+    }
     let grids = grids(l, basis);
     l.target
         .iter()
