@@ -38,6 +38,7 @@ impl MetalArgs {
                 return bad("thickness", t, "a thickness in mm, more than 0");
             }
             spec.material.thickness = t;
+            spec.material.thickness_given = true;
         }
         if let Some(k) = self.k_factor {
             if !(0.0..=1.0).contains(&k) {

@@ -257,6 +257,7 @@ pub fn spec(a: &FittingArgs) -> Result<Spec, Error> {
             },
             k_factor: a.k_factor,
             bend_radius: None,
+            thickness_given: a.thickness > 0.0,
         },
         sheet: SheetSpec {
             width: a.sheet_width,

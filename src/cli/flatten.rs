@@ -53,7 +53,7 @@ pub struct FlattenArgs {
 pub fn run(a: &FlattenArgs) -> Result<(), Error> {
     let mut spec = crate::spec::load(&a.input)?;
     if let Some(m) = a.material {
-        spec.material.kind = m;
+        spec.material.set_kind(m);
     }
     a.metal.apply(&mut spec)?;
     a.pattern.apply(&mut spec)?;

@@ -537,9 +537,8 @@ impl Ctx<'_> {
         let kind = self
             .choice(&m.kind, "material.kind", &MaterialKind::NAMES)?
             .unwrap_or_default();
-        let thickness = self
-            .number(&m.thickness, "material.thickness", MM_POSITIVE, |v| v > 0.0)?
-            .map_or(kind.default_thickness(), |(v, _)| v);
+        let stated = self.number(&m.thickness, "material.thickness", MM_POSITIVE, |v| v > 0.0)?;
+        let thickness = stated.map_or(kind.default_thickness(), |(v, _)| v);
         let k_factor = self
             .number(
                 &m.k_factor,
@@ -561,6 +560,7 @@ impl Ctx<'_> {
             thickness,
             k_factor,
             bend_radius,
+            thickness_given: stated.is_some(),
         })
     }
 

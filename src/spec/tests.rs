@@ -104,6 +104,7 @@ fn full_example_parses_exactly() {
             material: Material {
                 kind: MaterialKind::Paper,
                 thickness: 0.25,
+                thickness_given: true,
                 ..Material::default()
             },
             sheet: SheetSpec {

@@ -5,7 +5,8 @@
 //! from the kind, and the pattern stage develops the folds of metal meshes with its bend
 //! settings ([`Material::sheet_bend`], `pattern::develop`).
 //!
-//! Choices: a thickness left out defaults by kind (paper 0.25 mm, fabric 0.5, metal 1.0); K
+//! Choices: a thickness left out defaults by kind (paper 0.25 mm, fabric 0.5, metal 1.0),
+//! also when the command line changes the kind; K
 //! defaults to 0.4 (as the fittings' and FreeCAD SheetMetal's tables for steel in air
 //! bending) and the inside bend radius to the thickness (a common punch for mild steel).
 
@@ -22,11 +23,23 @@ pub struct Material {
     pub k_factor: f64,
     /// Inside bend radius (mm) of the folds of metal meshes; `None`: the thickness.
     pub bend_radius: Option<f64>,
+    /// Whether the thickness was stated (in the spec or by a flag), not the kind's default.
+    pub thickness_given: bool,
 }
 
 impl Material {
     /// The K factor used when none is given.
     pub const DEFAULT_K_FACTOR: f64 = 0.4;
+
+    /// Make the material `kind` (`--material`): a thickness that was only the old kind's
+    /// default becomes the new kind's (a spec without `[material]` cut as metal is 1 mm
+    /// sheet, not paper's 0.25 mm); a stated one stays.
+    pub fn set_kind(&mut self, kind: MaterialKind) {
+        self.kind = kind;
+        if !self.thickness_given {
+            self.thickness = kind.default_thickness();
+        }
+    }
 
     /// How this material's sheet bends: thickness, K factor and inside radius (the thickness
     /// unless given).
@@ -87,6 +100,7 @@ impl Default for Material {
             thickness: MaterialKind::Paper.default_thickness(),
             k_factor: Material::DEFAULT_K_FACTOR,
             bend_radius: None,
+            thickness_given: false,
         }
     }
 }

@@ -394,3 +394,51 @@ fn only_metal_meshes_are_developed() {
     let (_, pieces) = flatcut::pipeline::pieces(&duct, true).unwrap();
     assert!(pieces.iter().all(|p| p.development.is_none()));
 }
+
+#[test]
+fn a_mesh_cut_as_metal_without_a_thickness_is_1_mm_sheet_not_paper() {
+    // `--material metal` on a bare OBJ (no `[material]`): the metal default, 1 mm, with R = t;
+    // a thickness stated in the spec or by a flag stays whatever the kind.
+    let dir = scratch("bends-metal-default");
+    let run = |args: &[&str], name: &str| -> f64 {
+        let out = dir.join(name);
+        let mut all = vec!["cut"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["--sheet", "600x600", "--dry-run", "-q", "-o"]);
+        all.push(out.to_str().unwrap());
+        let o = flatcut(&all);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let rep: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        let d = &rep["pieces"][0]["bend_development"];
+        assert_eq!(d["inside_radius_mm"], d["thickness_mm"]);
+        d["thickness_mm"].as_f64().unwrap()
+    };
+    assert_eq!(
+        run(&["patterns/cube.obj", "--material", "metal"], "bare"),
+        1.0
+    );
+    assert_eq!(
+        run(
+            &[
+                "patterns/cube.obj",
+                "--material",
+                "metal",
+                "--thickness",
+                "1.5"
+            ],
+            "flag"
+        ),
+        1.5
+    );
+    let path = spec(&dir, &manifest("patterns/cube.obj"), "thickness = 0.8");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("kind = \"metal\"", "kind = \"paper\"");
+    std::fs::write(&path, text).unwrap();
+    assert_eq!(
+        run(&[path.to_str().unwrap(), "--material", "metal"], "stated"),
+        0.8
+    );
+}
