@@ -34,7 +34,7 @@
 //!   the pattern stage sees a seam (glue tab, matched marks) instead of two loose ends.
 //! - A striction point (where rulings cross, the curve of regression) at a parameter v in
 //!   [0, 1] of a sampled ruling is refused, naming u (0-based span parameter) and v; a cone's
-//!   apex (v = 1) is allowed.
+//!   apex (v = 1) and the end of a ruling on a curve that stands still are allowed.
 //! - Figures (report.json): `iterations`, `largest_sine` (the intrinsic developability sine at
 //!   64 parameters per span after the solve), `solver_sine` (at the solver's samples),
 //!   `flatness_delta` (Fig. 17's δ: distance of the diagonals of each sampled quad over the
@@ -44,7 +44,8 @@
 //!   parameters per span, [`solve::crease_sine`]) and `crease_angle_defect` (Fig. 17's crease
 //!   flatness |K|: the largest |angle sum − 2π| at the sampled mesh's vertices on creases);
 //!   with creases `fold_angle_mean_deg` (weighted by length) and `fold_angle_max_deg` of the
-//!   sampled crease edges; with a target `approximation_rms_mm`, `approximation_max_mm`, `coverage` (the share of
+//!   sampled crease edges; with a target `approximation_rms_mm`, `approximation_max_mm`,
+//!   `coverage` (the share of
 //!   target points within [`COVERAGE_MM`]) and `target_points`; with handles
 //!   `handle_distance_mm`; with an outline `outline_isometry_error` (eq. 12's largest relative
 //!   length error). Seconds per iteration are not written there (the report must be
@@ -315,7 +316,7 @@ pub const RECTANGLE_POINTS: usize = 8;
 
 /// Consecutive samples of a curve closer than this (relative to the model's diameter) are one
 /// vertex: the curve stands still there, a cone's apex.
-const STILL: f64 = 1e-12;
+const WELD: f64 = 1e-12;
 
 /// A curve whose tangent is at most this share of the other curve's stands still there.
 const APEX: f64 = 1e-6;
@@ -623,7 +624,7 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
     let k = params.len();
     // A closed surface is welded around: the last ruling is the first one.
     let weld = m.basis.closed();
-    let still = STILL * diameter(m);
+    let still = WELD * diameter(m);
     let row = |c: usize, vertices: &mut Vec<DVec3>| -> Vec<usize> {
         let mut out: Vec<usize> = Vec::with_capacity(k);
         for (i, &u) in params.iter().enumerate() {

@@ -827,8 +827,8 @@ impl Problem {
         !self.l.target.is_empty()
     }
 
-    /// Whether there are goals besides the constraints (a target, handles): the solve then
-    /// goes on until they stop improving.
+    /// Whether there are goals besides the constraints (a target, handles, an outline, stated
+    /// folds): the solve then goes on until they stop improving.
     pub fn has_goals(&self) -> bool {
         self.has_target()
             || !self.l.handles.is_empty()
