@@ -223,31 +223,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
             ),
         ));
     }
-    if !spec.folds.is_empty() && spec.folds.len() != interior {
-        return Err(shape(
-            "folds".into(),
-            format!(
-                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
-                spec.folds.len()
-            ),
-        ));
-    }
-    for (k, f) in spec.folds.iter().enumerate() {
-        let kind = spec.creases.get(k).copied().unwrap_or_default();
-        if f.is_some() && !matches!(kind, Crease::Fold | Crease::Geodesic) {
-            let name = Crease::NAMES
-                .iter()
-                .find(|(_, c)| *c == kind)
-                .map_or("free", |n| n.0);
-            return Err(shape(
-                format!("folds[{}]", k + 1),
-                format!(
-                    "curve {} is a `{name}` crease, which does not fold; make it `fold` (or `geodesic`) in `creases`, or say \"none\" here",
-                    k + 2
-                ),
-            ));
-        }
-    }
+    check_folds(spec, interior)?;
     let total = count.saturating_mul(spec.curves.len() + 1);
     if total > MAX_CONTROL_POINTS {
         return Err(shape(
@@ -306,6 +282,37 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         }
     }
     Ok(m)
+}
+
+/// `folds`: one entry per interior curve, a stated fold only on a crease that folds.
+fn check_folds(spec: &SplineSpec, interior: usize) -> Result<(), SplineError> {
+    let shape = |key: String, message: String| SplineError::Shape { key, message };
+    if !spec.folds.is_empty() && spec.folds.len() != interior {
+        return Err(shape(
+            "folds".into(),
+            format!(
+                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
+                spec.folds.len()
+            ),
+        ));
+    }
+    for (k, f) in spec.folds.iter().enumerate() {
+        let kind = spec.creases.get(k).copied().unwrap_or_default();
+        if f.is_some() && !matches!(kind, Crease::Fold | Crease::Geodesic) {
+            let name = Crease::NAMES
+                .iter()
+                .find(|(_, c)| *c == kind)
+                .map_or("free", |n| n.0);
+            return Err(shape(
+                format!("folds[{}]", k + 1),
+                format!(
+                    "curve {} is a `{name}` crease, which does not fold; make it `fold` (or `geodesic`) in `creases`, or say \"none\" here",
+                    k + 2
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A target point within this distance (mm) of the surface counts as covered (`coverage`).
