@@ -483,11 +483,6 @@ impl Ctx<'_> {
             return Ok(Vec::new());
         };
         let line = self.line(v.span());
-        const KINDS: [(&str, Option<bool>); 3] = [
-            ("mountain", Some(false)),
-            ("valley", Some(true)),
-            ("none", None),
-        ];
         let expected = "\"mountain\", \"valley\", \"none\" or { kind = \"mountain\" or \"valley\", angle_deg = the mean fold angle in degrees, more than 0 and less than 180 }";
         let Value::Array(items) = v.get_ref() else {
             return Err(self.invalid(
@@ -499,38 +494,21 @@ impl Ctx<'_> {
                 ),
             ));
         };
-        let kind = |t: &str| KINDS.iter().find(|(n, _)| *n == t).map(|(_, k)| *k);
         items
             .iter()
             .enumerate()
             .map(|(i, it)| {
-                let ik = format!("{fk}[{}]", i + 1);
-                let bad = |what: String| self.invalid(line, &ik, what);
+                let bad = |what: String| self.invalid(line, &format!("{fk}[{}]", i + 1), what);
                 match it {
-                    Value::String(t) => match kind(t) {
-                        Some(k) => Ok(k.map(|valley| FoldGoal {
-                            valley,
-                            angle: None,
-                        })),
-                        None => Err(bad(format!("must be {expected}, got {it}"))),
-                    },
-                    Value::Table(t) => {
-                        if let Some(extra) = t.keys().find(|k| !["kind", "angle_deg"].contains(&k.as_str())) {
-                            return Err(bad(format!("`{extra}` is not a key of a fold; it takes `kind` and `angle_deg`")));
-                        }
-                        let valley = match t.get("kind").and_then(Value::as_str).map(kind) {
-                            Some(Some(Some(v))) => v,
-                            _ => return Err(bad(format!("`kind` must be \"mountain\" or \"valley\", got {}", t.get("kind").map_or("nothing".into(), |k| k.to_string())))),
-                        };
-                        let angle = match t.get("angle_deg") {
-                            None => None,
-                            Some(a) => match a.as_float().or(a.as_integer().map(|i| i as f64)) {
-                                Some(d) if d > 0.0 && d < 180.0 => Some(d.to_radians()),
-                                _ => return Err(bad(format!("`angle_deg` must be more than 0 and less than 180 (degrees), got {a}"))),
-                            },
-                        };
-                        Ok(Some(FoldGoal { valley, angle }))
-                    }
+                    Value::String(t) => super::names::pick(t, &FOLD_KINDS)
+                        .map(|k| {
+                            k.map(|valley| FoldGoal {
+                                valley,
+                                angle: None,
+                            })
+                        })
+                        .map_err(|_| bad(format!("must be {expected}, got {it}"))),
+                    Value::Table(t) => fold_table(t).map(Some).map_err(bad),
                     _ => Err(bad(format!("must be {expected}, got {it}"))),
                 }
             })
@@ -672,6 +650,49 @@ impl Ctx<'_> {
             "is for spline surfaces (kind = \"spline\")",
         )
     }
+}
+
+/// The names of `folds` entries: a direction, or none.
+const FOLD_KINDS: [(&str, Option<bool>); 3] = [
+    ("mountain", Some(false)),
+    ("valley", Some(true)),
+    ("none", None),
+];
+
+/// A `folds` entry written as `{ kind = "mountain" | "valley", angle_deg = A }`; the error
+/// says what is wrong with it.
+fn fold_table(t: &toml::map::Map<String, Value>) -> Result<FoldGoal, String> {
+    if let Some(extra) = t
+        .keys()
+        .find(|k| !["kind", "angle_deg"].contains(&k.as_str()))
+    {
+        return Err(format!(
+            "`{extra}` is not a key of a fold; it takes `kind` and `angle_deg`"
+        ));
+    }
+    let kind = t.get("kind");
+    let valley = kind
+        .and_then(Value::as_str)
+        .and_then(|k| super::names::pick(k, &FOLD_KINDS).ok())
+        .flatten()
+        .ok_or_else(|| {
+            format!(
+                "`kind` must be \"mountain\" or \"valley\", got {}",
+                kind.map_or("nothing".into(), Value::to_string)
+            )
+        })?;
+    let angle = match t.get("angle_deg") {
+        None => None,
+        Some(a) => match a.as_float().or(a.as_integer().map(|i| i as f64)) {
+            Some(d) if d > 0.0 && d < 180.0 => Some(d.to_radians()),
+            _ => {
+                return Err(format!(
+                    "`angle_deg` must be more than 0 and less than 180 (degrees), got {a}"
+                ))
+            }
+        },
+    };
+    Ok(FoldGoal { valley, angle })
 }
 
 /// Whether `p` lies inside or on the polygon (edges within 1e-6 count).

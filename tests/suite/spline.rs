@@ -846,26 +846,21 @@ fn spline_a4_with_its_bottom_edge_fixed_fans_from_its_corners() {
             .map_or(0, Vec::len),
         0
     );
-    // One vertex at each apex, no triangle without area.
-    let text = std::fs::read_to_string(&obj).unwrap();
-    let verts: Vec<DVec3> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let c: Vec<f64> = l.split_whitespace().map(|v| v.parse().unwrap()).collect();
-            DVec3::new(c[0], c[1], c[2])
-        })
-        .collect();
+    // One vertex at each apex (read without welding anything), no triangle without area.
+    let raw = flatcut::surface::obj::read(&obj).unwrap();
+    assert_eq!(raw.welded, 0);
+    let m = raw.mesh;
     for apex in [DVec3::ZERO, DVec3::new(210.0, 0.0, 0.0)] {
-        let at = verts.iter().filter(|v| v.distance(apex) < 1e-6).count();
+        let at = m
+            .vertices
+            .iter()
+            .filter(|v| v.distance(apex) < 1e-6)
+            .count();
         assert_eq!(at, 1, "vertices at {apex}");
     }
-    for l in text.lines().filter_map(|l| l.strip_prefix("f ")) {
-        let f: Vec<DVec3> = l
-            .split_whitespace()
-            .map(|v| verts[v.split('/').next().unwrap().parse::<usize>().unwrap() - 1])
-            .collect();
-        assert!((f[1] - f[0]).cross(f[2] - f[0]).length() > 1e-9, "face {l}");
+    for (i, f) in m.faces.iter().enumerate() {
+        let p: Vec<DVec3> = f.verts.iter().map(|&v| m.vertices[v]).collect();
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).length() > 1e-9, "face {i}");
     }
 }
 

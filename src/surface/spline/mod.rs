@@ -214,15 +214,7 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
         }
     }
     let interior = spec.curves.len().saturating_sub(2);
-    if !spec.creases.is_empty() && spec.creases.len() != interior {
-        return Err(shape(
-            "creases".into(),
-            format!(
-                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
-                spec.creases.len()
-            ),
-        ));
-    }
+    per_interior("creases", spec.creases.len(), interior)?;
     check_folds(spec, interior)?;
     let total = count.saturating_mul(spec.curves.len() + 1);
     if total > MAX_CONTROL_POINTS {
@@ -284,18 +276,24 @@ pub fn model(spec: &SplineSpec) -> Result<Model, SplineError> {
     Ok(m)
 }
 
+/// A list with one entry per interior curve (`creases`, `folds`) has `len` entries: none (all
+/// defaults) or one per interior curve of the chain.
+fn per_interior(key: &str, len: usize, interior: usize) -> Result<(), SplineError> {
+    if len == 0 || len == interior {
+        return Ok(());
+    }
+    Err(SplineError::Shape {
+        key: key.into(),
+        message: format!(
+            "has {len} entries, the chain has {interior} interior curves (one per curve between the first and the last)"
+        ),
+    })
+}
+
 /// `folds`: one entry per interior curve, a stated fold only on a crease that folds.
 fn check_folds(spec: &SplineSpec, interior: usize) -> Result<(), SplineError> {
     let shape = |key: String, message: String| SplineError::Shape { key, message };
-    if !spec.folds.is_empty() && spec.folds.len() != interior {
-        return Err(shape(
-            "folds".into(),
-            format!(
-                "has {} entries, the chain has {interior} interior curves (one per curve between the first and the last)",
-                spec.folds.len()
-            ),
-        ));
-    }
+    per_interior("folds", spec.folds.len(), interior)?;
     for (k, f) in spec.folds.iter().enumerate() {
         let kind = spec.creases.get(k).copied().unwrap_or_default();
         if f.is_some() && !matches!(kind, Crease::Fold | Crease::Geodesic) {
@@ -682,16 +680,18 @@ fn sample_mesh(m: &Model, params: &[f64]) -> Sampled {
     crease_verts.dedup();
     let mesh = Mesh { vertices, faces };
     // Each edge's faces with its corner in them, to name rulings and creases.
-    let mut uses: std::collections::HashMap<[usize; 2], Vec<(usize, usize)>> =
-        std::collections::HashMap::new();
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for c in 0..3 {
-            let (p, q) = (face.verts[c], face.verts[(c + 1) % 3]);
-            uses.entry([p.min(q), p.max(q)]).or_default().push((f, c));
-        }
-    }
+    let topo = mesh.topology();
+    let edge: std::collections::HashMap<[usize; 2], usize> = topo
+        .edges
+        .iter()
+        .enumerate()
+        .map(|(i, e)| (e.verts, i))
+        .collect();
     let shared = |p: usize, q: usize| -> Option<(usize, usize, usize)> {
-        match uses.get(&[p.min(q), p.max(q)])?.as_slice() {
+        match topo.edges[*edge.get(&[p.min(q), p.max(q)])?]
+            .uses
+            .as_slice()
+        {
             &[(f, c), (g, _)] => Some((f, c, g)),
             _ => None,
         }

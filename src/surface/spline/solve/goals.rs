@@ -233,8 +233,10 @@ pub const FOLD_MIN: f64 = std::f64::consts::PI / 180.0;
 const W_FOLD: f64 = 1.0;
 
 /// The fold angle at one crease sample — the signed angle from the left strip's normal to
-/// the right one's about the crease tangent, positive for a valley seen from the front — and
-/// its gradient in the two normals (atan2 of ⟨n_L × n_R, t⟩ and ⟨n_L, n_R⟩, t held fixed).
+/// the right one's about the crease tangent, positive for a valley seen from the front (the
+/// solver's normals are e × a′, against the sampled mesh's faces a′ × e, which the pattern's
+/// mountain and valley see) — and its gradient in the two normals (atan2 of ⟨n_L × n_R, t⟩
+/// and ⟨n_L, n_R⟩, t held fixed).
 fn fold_at(l: &Layout, x: &[f64], c: &CreaseSample) -> (f64, DVec3, DVec3) {
     let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
     let (nl, nr) = (normal_of(x, sl), normal_of(x, sr));
@@ -244,12 +246,8 @@ fn fold_at(l: &Layout, x: &[f64], c: &CreaseSample) -> (f64, DVec3, DVec3) {
     let phi = s.atan2(co);
     let gl = (co * nr.cross(t) - s * nr) / q;
     let gr = (co * t.cross(nl) - s * nl) / q;
-    (FOLD_SIGN * phi, FOLD_SIGN * gl, FOLD_SIGN * gr)
+    (phi, gl, gr)
 }
-
-/// Which way the angle of [`fold_at`] turns for a valley: the solver's normals are e × a′,
-/// against the sampled mesh's faces (a′ × e), which the pattern's mountain and valley see.
-const FOLD_SIGN: f64 = 1.0;
 
 /// A stated fold's mean angle in its direction (radians; negative when it folds the other
 /// way), weighted by length along the crease, and the gradient of that mean in the normals

@@ -34,31 +34,28 @@
 //!   the angle between the tangent planes at `a(u)` and `b(u)`,
 //!   |det(e, a′, b′)|·|e| / (|e × a′|·|e × b′|) with e = b − a, which does not depend on the
 //!   auxiliary normals. It is tested before the first iteration too, so an exact developable is
-//!   returned untouched; so is the largest intrinsic crease sine ([`crease_sine`]).
-//! - Creases (§3.3): eq. 7–8 are written with c″ (the paper's c₀⁽²⁾ − c₁⁽²⁾ and c₁⁽²⁾ − c₂⁽²⁾
-//!   span the same osculating plane together with c′, and ⟨n, c′⟩ = 0 holds already on both
-//!   sides), as the one equation ⟨n_L ± n_R, c″⟩ / |c″ ⟂ c′| = 0 per sample parameter of the
-//!   strips, at the strips' own samples (3m − 2 per span: enforced numerically, as the paper
-//!   says). Where the crease is straight (curvature ≤ 1e-6 at diameter 1) the condition says
-//!   nothing and is left out. Smooth: n_L − n_R = 0. A row is divided by |c″ ⟂ c′| but by
-//!   no less than [`CREASE_FLOOR`]·|c″|, which keeps it bounded where the crease slows down.
+//!   returned untouched; so is the largest intrinsic crease sine ([`crease::crease_sine`]).
+//! - Creases (§3.3): eq. 7–8 and the smooth condition, in [`crease`].
 //! - A curve that stands still (a tangent shorter than [`STILL`] in the diameter-1 frame: a
 //!   run of equal control points, which share one unknown) has no tangent: its conditions are
 //!   left out there, a normal is oriented by the other curve's tangent, and where both stand
 //!   still it takes the nearest sample's plane of its strip to start from.
 //! - A stated fold (`folds`, §3.3 leaves the direction of a fold to the start) is one more
-//!   goal row: the mean over the crease's samples of the fold angle, the signed angle from the
+//!   goal row: the length-weighted mean over the crease's samples of the fold angle, the signed angle from the
 //!   left strip's normal to the right one's about c′ (atan2, linearised in the normals), at
 //!   the stated angle (its goal moved there from the start over [`HANDLE_RAMP`] rounds, like a
 //!   handle) or, for a direction alone, at least [`FOLD_MIN`]. The fold angle of a curved
 //!   crease varies along it (it follows the sides' bending); the mean is what a user sets.
 
+mod crease;
 mod goals;
 
 use super::develop::Dev;
 use super::system::{eval, normal_equations, sparse_solve, Expr, Pattern, Row};
 use super::target::Target;
 use crate::geom::bspline::BSpline;
+use crease::{crease_residual, crease_rows, CreaseSample};
+pub use crease::{crease_sine, Crease, STRAIGHT};
 use glam::DVec3;
 use goals::{
     feet, fold_mean, fold_merit, fold_rows, foot_exprs, grids, handle_merit, handle_rows,
@@ -91,29 +88,6 @@ impl Default for SolveOptions {
             stop_sine: 1e-10,
         }
     }
-}
-
-/// The condition on an interior curve of a chain, shared by the strips to either side (spec
-/// `creases`): eq. 7 (`Fold`: the sheet folds along it and unfolds in one piece), eq. 8
-/// (`Geodesic`: the two sides unfold to mirror images), `Smooth` (equal normals, no crease)
-/// or `Free` (no condition: the strips are cut apart there).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Crease {
-    #[default]
-    Free,
-    Fold,
-    Geodesic,
-    Smooth,
-}
-
-impl Crease {
-    /// The names a spec file uses, in the order messages list them.
-    pub const NAMES: [(&'static str, Crease); 4] = [
-        ("fold", Crease::Fold),
-        ("geodesic", Crease::Geodesic),
-        ("smooth", Crease::Smooth),
-        ("free", Crease::Free),
-    ];
 }
 
 /// A crease's stated fold (spec `folds`): which way it folds and, optionally, by how much.
@@ -247,15 +221,6 @@ struct Sample {
     normal: usize,
 }
 
-/// One crease condition at one parameter: the samples (normals) of the strips to the left
-/// (ending at the crease) and right (starting there), and the crease's second derivative.
-struct CreaseSample {
-    kind: Crease,
-    left: usize,
-    right: usize,
-    d2: Expr,
-}
-
 /// Intrinsic sine of the angle between the tangent planes at the two ends of a ruling.
 pub fn plane_sine(e: DVec3, ta: DVec3, tb: Option<DVec3>) -> f64 {
     let Some(tb) = tb else { return 0.0 };
@@ -270,55 +235,13 @@ pub fn plane_sine(e: DVec3, ta: DVec3, tb: Option<DVec3>) -> f64 {
     (e.dot(ta.cross(tb)).abs() * e.length() / (na * nb)).min(1.0)
 }
 
-/// Curvature (in the diameter-1 frame) at or under which a crease point counts as straight:
-/// the fold and geodesic conditions say nothing there.
-pub const STRAIGHT: f64 = 1e-6;
-
 /// A tangent (or ruling) at most this long in the diameter-1 frame is zero: the curve stands
 /// still there (a run of equal control points, a cone's apex on that curve), and the
 /// conditions on it are left out; relative to the other tangent in [`plane_sine`].
 pub const STILL: f64 = 1e-9;
 
-/// The least share of |c″| a crease row is divided by (see [`crease_rows`]).
-const CREASE_FLOOR: f64 = 0.1;
-
 /// The smallest ε₂ the schedule decays to once the fairness is off.
 const EPS2_FLOOR: f64 = 1e-4;
-
-/// The crease's principal normal at a point (c″ without its tangential part), unit; `None`
-/// where the crease is straight (curvature |c′ × c″| / |c′|³ at most `straight`).
-fn principal_normal(t: DVec3, d2: DVec3, straight: f64) -> Option<DVec3> {
-    let tl = t.length();
-    if tl <= 1e-300 {
-        return None;
-    }
-    let th = t / tl;
-    let perp = d2 - th * d2.dot(th);
-    (perp.length() / (tl * tl) > straight).then(|| perp.normalize())
-}
-
-/// The intrinsic crease sine at one crease point, from the tangent planes to either side: `el`
-/// the left strip's ruling towards the crease, `er` the right strip's away from it (so that
-/// both normals e × c′ lie on one side of the sheet), `t` = c′, `d2` = c″, `straight` the
-/// curvature (1/mm, or in the scaled frame) under which eq. 7–8 say nothing. Fold (eq. 7):
-/// the cosine between n_L + n_R and the principal normal; geodesic (eq. 8) the same with
-/// n_L − n_R; smooth: |n_L − n_R| / 2, the sine of half the angle between the sides.
-pub fn crease_sine(kind: Crease, el: DVec3, er: DVec3, t: DVec3, d2: DVec3, straight: f64) -> f64 {
-    let nl = el.cross(t).normalize_or_zero();
-    let nr = er.cross(t).normalize_or_zero();
-    let sigma = match kind {
-        Crease::Free => return 0.0,
-        Crease::Smooth => return 0.5 * (nl - nr).length(),
-        Crease::Fold => 1.0,
-        Crease::Geodesic => -1.0,
-    };
-    let n = nl + sigma * nr;
-    let len = n.length();
-    match principal_normal(t, d2, straight) {
-        Some(k) if len > 1e-9 => (n.dot(k) / len).abs().min(1.0),
-        _ => 0.0,
-    }
-}
 
 fn layout(m: &Model, points: Vec<DVec3>, target: Vec<(DVec3, DVec3)>) -> Layout {
     let count = m.basis.count();
@@ -541,75 +464,11 @@ fn residual(l: &Layout, x: &[f64]) -> (f64, f64) {
         worst = worst.max(plane_sine(e, ta, tb));
     }
     for c in &l.creases {
-        let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
-        let (nl, nr) = (normal_of(x, sl), normal_of(x, sr));
-        let t = eval(&sr.ta, &l.points);
-        let d2 = eval(&c.d2, &l.points);
-        let el = eval(&sl.e, &l.points);
-        let er = eval(&sr.e, &l.points);
-        match c.kind {
-            Crease::Smooth => sum += (nl - nr).length_squared(),
-            Crease::Fold | Crease::Geodesic => {
-                let sigma = if c.kind == Crease::Fold { 1.0 } else { -1.0 };
-                if let Some(k) = principal_normal(t, d2, STRAIGHT).filter(|_| t.length() > STILL) {
-                    sum += (nl + sigma * nr).dot(k).powi(2);
-                }
-            }
-            Crease::Free => {}
-        }
-        if t.length() > STILL {
-            worst = worst.max(crease_sine(c.kind, el, er, t, d2, STRAIGHT));
-        }
+        let (r, sine) = crease_residual(l, x, c);
+        sum += r;
+        worst = worst.max(sine);
     }
     (sum, worst)
-}
-
-/// The rows of one crease condition at the current iterate: ⟨n_L ± n_R, c″⟩ / |c″ ⟂ c′| for
-/// a fold or geodesic crease, n_L − n_R = 0 (three rows) for a smooth one.
-fn crease_rows(l: &Layout, x: &[f64], c: &CreaseSample, rows: &mut Vec<Row>) {
-    let (sl, sr) = (&l.samples[c.left], &l.samples[c.right]);
-    let sigma = match c.kind {
-        Crease::Free => return,
-        Crease::Smooth => {
-            for k in 0..3 {
-                rows.push(Row {
-                    entries: vec![(sl.normal + k, 1.0), (sr.normal + k, -1.0)],
-                    rhs: 0.0,
-                    w: 1.0,
-                });
-            }
-            return;
-        }
-        Crease::Fold => 1.0,
-        Crease::Geodesic => -1.0,
-    };
-    let t = eval(&sr.ta, &l.points);
-    let d = eval(&c.d2, &l.points);
-    let tl = t.length();
-    let perp = if tl > STILL {
-        (d - t * (d.dot(t) / (tl * tl))).length()
-    } else {
-        0.0
-    };
-    if tl <= STILL || perp / (tl * tl) <= STRAIGHT {
-        return; // the crease stands still or is straight here: no condition
-    }
-    // Divided by |c″ ⟂ c′| the row is a cosine; where the crease slows down (c″ mostly along
-    // c′) at most 1/CREASE_FLOOR times |c″| keeps its entries bounded.
-    let scale = perp.max(CREASE_FLOOR * d.length());
-    let n0 = normal_of(x, sl) + sigma * normal_of(x, sr);
-    let mut entries = Vec::with_capacity(6 + 3 * c.d2.len());
-    let mut rhs = 0.0;
-    for k in 0..3 {
-        entries.push((sl.normal + k, d[k] / scale));
-        entries.push((sr.normal + k, sigma * d[k] / scale));
-    }
-    point_part(l, &c.d2, n0, scale, &mut entries, &mut rhs);
-    rows.push(Row {
-        entries,
-        rhs,
-        w: 1.0,
-    });
 }
 
 /// The point part of a bilinear ⟨n, Σ w·P⟩ / `scale` linearised at the iterate (n held at
