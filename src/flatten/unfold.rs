@@ -21,7 +21,7 @@
 //! closed spline surface is opened).
 
 use super::{Flat, FlattenError};
-use crate::geom::mesh::Topology;
+use crate::geom::mesh::{Mesh, Topology};
 use crate::geom::polygon;
 use crate::surface::Surface;
 use glam::{DVec2, DVec3};
@@ -40,6 +40,20 @@ pub struct UnfoldOptions {
     /// distance within which the two copies of a cut edge count as coincident. Capped at 1 % of
     /// the mean edge length so that tiny meshes are not swallowed by it.
     pub tolerance: f64,
+}
+
+impl UnfoldOptions {
+    /// The join priority of an edge (lower joins first) with bend `dihedral` (radians, positive
+    /// convex) and `length` relative to the mean.
+    fn key(&self, dihedral: f64, length: f64) -> f64 {
+        let t = dihedral / std::f64::consts::PI;
+        let w = if t > 0.0 {
+            self.convex_weight
+        } else {
+            -self.concave_weight
+        };
+        w * t - self.length_weight * length
+    }
 }
 
 impl Default for UnfoldOptions {
@@ -103,22 +117,27 @@ impl Motion {
 /// Corner positions of a face in its own plane: first vertex at the origin, first edge along +x,
 /// counter-clockwise seen from the side the face normal points to.
 fn face_in_plane(surface: &Surface, f: usize) -> Result<Vec<DVec2>, FlattenError> {
-    let mesh = &surface.mesh;
+    plane_of(&surface.mesh, f).ok_or_else(|| FlattenError::Degenerate {
+        surface: surface.name.clone(),
+        face: f + 1,
+        line: surface.mesh.faces[f].line,
+    })
+}
+
+/// [`face_in_plane`] of a mesh's face; `None` for a face without area.
+fn plane_of(mesh: &Mesh, f: usize) -> Option<Vec<DVec2>> {
     let pts = mesh.face_points(f);
     let n = mesh.face_normal(f);
     let x = (pts[1] - pts[0]).normalize_or_zero();
     let y = n.cross(x);
     if x == DVec3::ZERO || n == DVec3::ZERO || !y.is_finite() {
-        return Err(FlattenError::Degenerate {
-            surface: surface.name.clone(),
-            face: f + 1,
-            line: mesh.faces[f].line,
-        });
+        return None;
     }
-    Ok(pts
-        .iter()
-        .map(|p| DVec2::new((*p - pts[0]).dot(x), (*p - pts[0]).dot(y)))
-        .collect())
+    Some(
+        pts.iter()
+            .map(|p| DVec2::new((*p - pts[0]).dot(x), (*p - pts[0]).dot(y)))
+            .collect(),
+    )
 }
 
 /// Islands being built: face positions, island membership and a grid per island.
@@ -133,16 +152,75 @@ struct Unfolder {
     round: u32,
     moved: Vec<Vec<DVec2>>,
     eps: f64,
+    /// For each island: it holds a layout that stays as it is ([`unfold_onto`]); two such
+    /// are never joined.
+    anchored: Vec<bool>,
 }
 
 impl Unfolder {
+    /// Every face of `pos` an island of its own, on a grid of cells a little over the typical
+    /// face's size (`longest`: the longest edge).
+    fn new(pos: Vec<Vec<DVec2>>, longest: f64, eps: f64) -> Unfolder {
+        let nf = pos.len();
+        let tris: Vec<Vec<[usize; 3]>> = pos.iter().map(|p| polygon::triangulate(p)).collect();
+        let mut sizes: Vec<f64> = pos
+            .iter()
+            .map(|p| {
+                polygon::bounds(p.iter().copied())
+                    .map(|(lo, hi)| (hi - lo).max_element())
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        sizes.sort_by(f64::total_cmp);
+        let typical = sizes.get(sizes.len() * 9 / 10).copied().unwrap_or(1.0);
+        let grid = Grid {
+            cell: typical.max(longest * 1e-6).max(1e-9),
+        };
+        let mut u = Unfolder {
+            face_island: (0..nf).collect(),
+            members: (0..nf).map(|f| vec![f]).collect(),
+            cells: Vec::with_capacity(nf),
+            grid,
+            stamp: vec![0; nf],
+            round: 0,
+            moved: Vec::new(),
+            eps,
+            anchored: vec![false; nf],
+            pos,
+            tris,
+        };
+        for f in 0..nf {
+            let mut m: HashMap<Cell, Vec<usize>> = HashMap::new();
+            if let Some((lo, hi)) = polygon::bounds(u.pos[f].iter().copied()) {
+                for c in u.grid.cells(lo, hi) {
+                    m.entry(c).or_default().push(f);
+                }
+            }
+            u.cells.push(m);
+        }
+        u
+    }
+
+    /// Faces `from..to` as one anchored island (island `from`), where they lie.
+    fn fix(&mut self, from: usize, to: usize) {
+        self.anchored[from] = true;
+        for f in from + 1..to.min(self.pos.len()) {
+            self.members[f].clear();
+            self.members[from].push(f);
+            self.face_island[f] = from;
+            for (c, list) in std::mem::take(&mut self.cells[f]) {
+                self.cells[from].entry(c).or_default().extend(list);
+            }
+        }
+    }
+
     /// Join the two islands on either side of interior edge `e` by moving the smaller one onto
     /// the larger along the edge, unless that would make them overlap. Returns whether joined.
     fn try_join(&mut self, topology: &Topology, e: usize) -> bool {
         let [(mut f, mut i), (mut g, mut j)] =
             [topology.edges[e].uses[0], topology.edges[e].uses[1]];
         let (mut a, mut b) = (self.face_island[f], self.face_island[g]);
-        if a == b {
+        if a == b || (self.anchored[a] && self.anchored[b]) {
             return false;
         }
         if self.members[a].len() < self.members[b].len() {
@@ -195,6 +273,7 @@ impl Unfolder {
             self.face_island[*h] = a;
         }
         self.members[a].extend(faces_b);
+        self.anchored[a] |= self.anchored[b];
         true
     }
 }
@@ -207,7 +286,6 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
     for f in 0..nf {
         pos.push(face_in_plane(&surface, f)?);
     }
-    let tris: Vec<Vec<[usize; 3]>> = pos.iter().map(|p| polygon::triangulate(p)).collect();
 
     let ne = topology.edges.len();
     let mut dihedral = vec![0.0; ne];
@@ -226,53 +304,9 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         .max(f64::MIN_POSITIVE);
     let mean = lengths.iter().sum::<f64>() / ne.max(1) as f64;
     let eps = opts.tolerance.min(0.01 * mean);
-
-    // Grid cell: a little over the typical face size.
-    let mut sizes: Vec<f64> = pos
-        .iter()
-        .map(|p| {
-            polygon::bounds(p.iter().copied())
-                .map(|(lo, hi)| (hi - lo).max_element())
-                .unwrap_or(0.0)
-        })
-        .collect();
-    sizes.sort_by(f64::total_cmp);
-    let typical = sizes.get(sizes.len() * 9 / 10).copied().unwrap_or(1.0);
-    let grid = Grid {
-        cell: typical.max(longest * 1e-6).max(1e-9),
-    };
-
-    let mut u = Unfolder {
-        face_island: (0..nf).collect(),
-        members: (0..nf).map(|f| vec![f]).collect(),
-        cells: Vec::with_capacity(nf),
-        grid,
-        stamp: vec![0; nf],
-        round: 0,
-        moved: Vec::new(),
-        eps,
-        pos,
-        tris,
-    };
-    for f in 0..nf {
-        let mut m: HashMap<Cell, Vec<usize>> = HashMap::new();
-        if let Some((lo, hi)) = polygon::bounds(u.pos[f].iter().copied()) {
-            for c in u.grid.cells(lo, hi) {
-                m.entry(c).or_default().push(f);
-            }
-        }
-        u.cells.push(m);
-    }
+    let mut u = Unfolder::new(pos, longest, eps);
     let mut joined = vec![false; ne];
-    let key = |e: usize| {
-        let t = dihedral[e] / std::f64::consts::PI;
-        let w = if t > 0.0 {
-            opts.convex_weight
-        } else {
-            -opts.concave_weight
-        };
-        w * t - opts.length_weight * lengths[e] / mean
-    };
+    let key = |e: usize| opts.key(dihedral[e], lengths[e] / mean);
 
     // Join islands across edges in priority order (Kruskal), the smaller moved onto the larger;
     // the source's cuts (the seam of a closed spline surface) stay cut.
@@ -336,6 +370,84 @@ pub fn unfold(surface: Surface, opts: &UnfoldOptions) -> Result<Flat, FlattenErr
         dihedral,
         tolerance: eps,
     })
+}
+
+/// What [`unfold_onto`] gives: each face's corners, the fixed layout each face ended in, and
+/// for each edge whether it was joined.
+type Onto = (Vec<Vec<DVec2>>, Vec<usize>, Vec<bool>);
+
+/// Faces unfolded onto layouts that stay as they are (`charts::exact::graft`): the first
+/// faces of `mesh` are the layouts of `fixed`, one after the other, each an island where it
+/// lies; the other faces start apart, each in its own plane, and are joined in the
+/// unfolder's order (see the module doc), a join that would overlap deeper than `eps` or
+/// that would join two of the fixed layouts left cut. A fixed layout moves only rigidly, when
+/// a larger island is joined onto it. The positions of all faces, the fixed layout each face
+/// ended in, and the edges joined (ids of `topology`, the mesh's); `None` when a face has no
+/// area or stays apart from every fixed layout.
+pub(super) fn unfold_onto(
+    mesh: &Mesh,
+    topology: &Topology,
+    fixed: &[&[Vec<DVec2>]],
+    opts: &UnfoldOptions,
+    eps: f64,
+) -> Option<Onto> {
+    let nf = mesh.faces.len();
+    let n: usize = fixed.iter().map(|l| l.len()).sum();
+    if fixed.iter().any(|l| l.is_empty()) || n > nf {
+        return None;
+    }
+    let mut pos: Vec<Vec<DVec2>> = fixed.iter().flat_map(|l| l.iter().cloned()).collect();
+    for f in n..nf {
+        pos.push(plane_of(mesh, f)?);
+    }
+    let ne = topology.edges.len();
+    let length = |e: usize| {
+        let [a, b] = topology.edges[e].verts;
+        mesh.vertices[a].distance(mesh.vertices[b])
+    };
+    let free: Vec<usize> = (0..ne)
+        .filter(|&e| {
+            let uses = &topology.edges[e].uses;
+            uses.len() == 2 && uses.iter().any(|u| u.0 >= n)
+        })
+        .collect();
+    let longest = free
+        .iter()
+        .map(|&e| length(e))
+        .fold(f64::MIN_POSITIVE, f64::max);
+    let mean = free.iter().map(|&e| length(e)).sum::<f64>() / free.len().max(1) as f64;
+    let mut keys: Vec<(f64, usize)> = free
+        .iter()
+        .map(|&e| {
+            let [(f, i), (g, _)] = [topology.edges[e].uses[0], topology.edges[e].uses[1]];
+            let d = mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
+            (opts.key(d, length(e) / mean.max(f64::MIN_POSITIVE)), e)
+        })
+        .collect();
+    keys.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut u = Unfolder::new(pos, longest, eps);
+    let mut starts = Vec::with_capacity(fixed.len());
+    let mut at = 0;
+    for l in fixed {
+        u.fix(at, at + l.len());
+        starts.push(at);
+        at += l.len();
+    }
+    let mut joined = vec![false; ne];
+    for (_, e) in keys {
+        let [(f, _), (g, _)] = [topology.edges[e].uses[0], topology.edges[e].uses[1]];
+        if u.face_island[f] != u.face_island[g] && u.try_join(topology, e) {
+            joined[e] = true;
+        }
+    }
+    let which: Vec<usize> = (0..nf)
+        .map(|f| {
+            starts
+                .iter()
+                .position(|&s| u.face_island[s] == u.face_island[f])
+        })
+        .collect::<Option<_>>()?;
+    Some((u.pos, which, joined))
 }
 
 fn faces_overlap(
@@ -476,6 +588,55 @@ pub(crate) mod tests {
         assert!(flat.islands.len() >= 2, "{}", flat.islands.len());
         check_isometry(&flat);
         assert!(find_overlap(&flat).is_none());
+    }
+
+    /// `unfold_onto` (issue 20, grafting): a cube's first two faces are two fixed layouts
+    /// far apart; the four other faces join one or the other, each by a rigid motion (its
+    /// edges as long as in 3D, its joined edges where the face it joins has them), and the two
+    /// fixed layouts are never joined to each other or moved out of shape.
+    #[test]
+    fn faces_unfold_onto_fixed_layouts_without_joining_them() {
+        let mesh = cube(10.0).mesh;
+        let topo = mesh.topology();
+        let a = vec![plane_of(&mesh, 0).unwrap()];
+        let far = DVec2::new(1000.0, 0.0);
+        let b = vec![plane_of(&mesh, 1)
+            .unwrap()
+            .into_iter()
+            .map(|p| p + far)
+            .collect::<Vec<_>>()];
+        let (pos, which, joined) =
+            unfold_onto(&mesh, &topo, &[&a, &b], &UnfoldOptions::default(), 0.01).unwrap();
+        assert_eq!((which[0], which[1]), (0, 1));
+        assert!(which[2..].iter().all(|&w| w < 2));
+        // The fixed layouts keep their shape (moved rigidly at most).
+        let side = |f: usize, i: usize| pos[f][i].distance(pos[f][(i + 1) % 4]);
+        for f in 0..6 {
+            for i in 0..4 {
+                assert!((side(f, i) - 10.0).abs() < 1e-9, "face {f}: {}", side(f, i));
+            }
+        }
+        let mut joins = 0;
+        for (e, edge) in topo.edges.iter().enumerate() {
+            let [(f, i), (g, j)] = [edge.uses[0], edge.uses[1]];
+            if joined[e] {
+                joins += 1;
+                assert_eq!(which[f], which[g], "edge {e} joins the two layouts");
+                assert!(pos[f][i].distance(pos[g][(j + 1) % 4]) < 1e-9);
+                assert!(pos[f][(i + 1) % 4].distance(pos[g][j]) < 1e-9);
+            }
+        }
+        // Every free face joined once: four joins.
+        assert_eq!(joins, 4);
+        // Too few faces for the fixed layouts: refused.
+        assert!(unfold_onto(
+            &mesh,
+            &topo,
+            &[&a, &a, &a, &a, &a, &a, &a],
+            &UnfoldOptions::default(),
+            0.01
+        )
+        .is_none());
     }
 
     #[test]

@@ -845,6 +845,7 @@ fn darts_lower_stretch_without_splitting() {
         let o = FlattenOptions {
             darts,
             max_splits,
+            exact: false,
             ..FlattenOptions::default()
         };
         let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
@@ -1186,6 +1187,69 @@ fn torus_with_a_hole_and_genus_two_are_cut_into_disks() {
     assert_eq!(seg.split, 0);
 }
 
+/// Issue 20: a chart still over the material's tolerance once it may be split no further is
+/// laid out exactly (`charts::exact`). The saddle as one chart, with no split, dart or gusset
+/// allowed, was one piece over paper's L2 1.003 with a warning; laid out exactly every piece
+/// is isometric (each face's edges as long as in 3D) and nothing overlaps (deeper than the
+/// unfolder's tolerance, as in every exact unfolding); a saddle does not lie flat in one
+/// piece, so there are several.
+#[test]
+fn a_chart_that_cannot_be_split_further_is_laid_out_exactly() {
+    let mesh = saddle(50.0, 30.0, 24);
+    let n = mesh.faces.len();
+    let lay = |exact: bool| {
+        let o = FlattenOptions {
+            max_splits: 0,
+            darts: 0,
+            gussets: 0,
+            exact,
+            ..FlattenOptions::default()
+        };
+        fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap()
+    };
+    let tol = FlattenOptions::default().tolerance;
+    let plain = lay(false);
+    let (_, s0) = fcharts::stretch(&plain);
+    assert_eq!(plain.islands.len(), 1);
+    assert!(s0.l2 > tol, "{s0:?}");
+    assert_eq!(
+        plain.surface.warnings.len(),
+        1,
+        "{:?}",
+        plain.surface.warnings
+    );
+    let flat = lay(true);
+    check_flat(&flat);
+    let (per, whole) = fcharts::stretch(&flat);
+    println!(
+        "saddle 100 mm, c 30, one chart: L2 {:.5} as laid; exactly {} pieces, L2 {:.9}, {} edges cut inside them",
+        s0.l2,
+        flat.islands.len(),
+        whole.l2,
+        flat.surface.cuts.len()
+    );
+    assert!(flat.islands.len() > 1);
+    for (k, s) in per.iter().enumerate() {
+        assert!(s.l2 <= 1.0 + 1e-9 && s.flipped == 0, "piece {k}: {s:?}");
+    }
+    assert!(
+        flat.surface.warnings.is_empty(),
+        "{:?}",
+        flat.surface.warnings
+    );
+    assert_eq!(flatcut::flatten::unfold::find_overlap(&flat), None);
+    let m = &flat.surface.mesh;
+    for (f, face) in m.faces.iter().enumerate() {
+        let k = face.verts.len();
+        for i in 0..k {
+            let d3 = m.vertices[face.verts[i]].distance(m.vertices[face.verts[(i + 1) % k]]);
+            let d2 = flat.face_2d[f][i].distance(flat.face_2d[f][(i + 1) % k]);
+            assert!((d2 - d3).abs() <= 1e-9 * d3, "face {f}: {d2} vs {d3}");
+        }
+    }
+    assert_eq!(lay(true).face_2d, flat.face_2d, "same input, same output");
+}
+
 /// A hyperbolic paraboloid z = (x² − y²) / (2c) over a square of side `2 half`, `n` × `n`
 /// quads each split in two triangles: negative angle defect everywhere inside.
 fn saddle(half: f64, c: f64, n: usize) -> Mesh {
@@ -1237,6 +1301,7 @@ fn gussets_fill_the_slits_of_a_saddle() {
         let o = FlattenOptions {
             gussets,
             max_splits: 0,
+            exact: false,
             ..FlattenOptions::default()
         };
         let flat = fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();

@@ -23,6 +23,7 @@
 //! pieces. Pieces are tried smallest first, with the same neighbours as above, in rounds until
 //! none joins; a pair that failed is not tried again unless one of the two has grown since.
 
+use super::exact::graft;
 use super::overlap::{both_cuts, merge_into, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid};
 use crate::flatten::distortion;
@@ -68,15 +69,25 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
         if owners.gone[si] || area(&done[si].faces) >= small {
             continue;
         }
-        for k in owners
+        let near: Vec<usize> = owners
             .neighbours(ctx, done, si)
             .into_iter()
             .take(MERGE_TRIES)
+            .collect();
+        // Laid out again as one, else grafted onto the neighbours as they lie.
+        if let Some(k) = near
+            .iter()
+            .copied()
+            .find(|&k| merge_into(ctx, done, k, si, opts, eps))
         {
-            if merge_into(ctx, done, k, si, opts, eps) {
-                owners.absorb(done, k, si);
-                break;
+            owners.absorb(done, k, si);
+        } else if let Some(took) = graft(ctx, done, &near, si, opts.tolerance, eps) {
+            for (k, faces) in took {
+                for f in faces {
+                    owners.owner[f] = k;
+                }
             }
+            owners.gone[si] = true;
         }
     }
     owners.drop_gone(done);
@@ -219,7 +230,7 @@ fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps
 
 /// The rotation (as a unit complex number) and shift that best move the first points of
 /// `pairs` onto the second (least squares); `None` for fewer than two distinct points.
-fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
+pub(super) fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
     let n = pairs.len() as f64;
     let cp = pairs.iter().map(|p| p.0).sum::<DVec2>() / n;
     let cq = pairs.iter().map(|p| p.1).sum::<DVec2>() / n;

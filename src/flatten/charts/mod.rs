@@ -84,6 +84,7 @@ use glam::DVec2;
 use std::collections::HashMap;
 
 mod darts;
+mod exact;
 mod merge;
 mod overlap;
 
@@ -108,6 +109,10 @@ pub struct FlattenOptions {
     /// Most gussets cut into a chart still over the tolerance after its darts (see
     /// `gussets`); 0 for none (default 2).
     pub gussets: usize,
+    /// A chart still over the tolerance once it may be split no further is laid out exactly,
+    /// as the polyhedral unfolder does (`exact`); false leaves it as the parameteriser laid
+    /// it, with a warning (default true).
+    pub exact: bool,
     /// Merging threshold `η` for re-attaching a cut-off gusset to an adjacent piece: the mean
     /// cylinder fitting error of the gusset and two face rings of the piece around their common
     /// boundary ([`crate::geom::proxy::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
@@ -124,6 +129,7 @@ impl Default for FlattenOptions {
             max_splits: 3,
             darts: 4,
             gussets: 2,
+            exact: true,
             reattach_eta: 1e-3,
         }
     }
@@ -587,6 +593,13 @@ impl Charts<'_> {
                 return Ok(());
             }
             laid.faces = t.faces;
+        }
+        // Too curved for its size: laid out exactly, its islands the pieces.
+        if laid.stretch.l2 > opts.tolerance && opts.exact {
+            if let Some(islands) = exact::exact(self, &laid.faces, eps) {
+                done.extend(islands);
+                return Ok(());
+            }
         }
         done.push(laid);
         Ok(())
