@@ -190,13 +190,36 @@ fn find_spot(obstacles: &Obstacles, w: f64, h: f64, bw: f64, bh: f64) -> Option<
         .find(|&at| obstacles.free(at, bw, bh))
 }
 
-/// The strokes of a sheet as segments with their bounds, and the closed cut outlines (the
-/// pieces), for [`test_squares`].
+/// The strokes of a sheet as segments on a grid of [`OBSTACLE_CELL_MM`] cells (each in the
+/// cells its box covers; one that would cover more than [`OBSTACLE_SPAN`] cells, or a far
+/// away one, in a list looked at every time), and the closed cut outlines (the pieces) with
+/// their boxes, for [`test_squares`].
 struct Obstacles {
     segments: Vec<(DVec2, DVec2)>,
-    outlines: Vec<Vec<DVec2>>,
+    cells: std::collections::HashMap<(i64, i64), Vec<usize>>,
+    long: Vec<usize>,
+    outlines: Vec<(Vec<DVec2>, DVec2, DVec2)>,
     /// Squares placed already (lower-left, upper-right corners).
     boxes: Vec<(DVec2, DVec2)>,
+}
+
+/// Side of the cells [`Obstacles`] sorts segments into.
+const OBSTACLE_CELL_MM: f64 = 20.0;
+
+/// Most cells a segment is sorted into (see [`Obstacles`]).
+const OBSTACLE_SPAN: i64 = 256;
+
+/// The cells of [`OBSTACLE_CELL_MM`] that the box `lo`..`hi` covers; `None` when they are
+/// more than [`OBSTACLE_SPAN`] (or the box is not finite).
+fn obstacle_cells(lo: DVec2, hi: DVec2) -> Option<impl Iterator<Item = (i64, i64)>> {
+    let at = |v: f64| (v / OBSTACLE_CELL_MM).floor();
+    let (x0, x1, y0, y1) = (at(lo.x), at(hi.x), at(lo.y), at(hi.y));
+    let span = (x1 - x0 + 1.0) * (y1 - y0 + 1.0);
+    if !(span.is_finite() && span <= OBSTACLE_SPAN as f64 && x0.abs() < 1e9 && y0.abs() < 1e9) {
+        return None;
+    }
+    let (x0, x1, y0, y1) = (x0 as i64, x1 as i64, y0 as i64, y1 as i64);
+    Some((x0..=x1).flat_map(move |x| (y0..=y1).map(move |y| (x, y))))
 }
 
 impl Obstacles {
@@ -211,34 +234,66 @@ impl Obstacles {
                     segments.push((a, b));
                 }
                 if s.role == StrokeRole::Cut {
-                    outlines.push(pts);
+                    let lo = pts.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+                    let hi = pts.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
+                    outlines.push((pts, lo, hi));
                 }
             } else if pts.len() == 1 {
                 segments.push((pts[0], pts[0]));
             }
         }
+        let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+        let mut long = Vec::new();
+        for (k, &(p, q)) in segments.iter().enumerate() {
+            match obstacle_cells(p.min(q), p.max(q)) {
+                Some(covered) => {
+                    for c in covered {
+                        cells.entry(c).or_default().push(k);
+                    }
+                }
+                None => long.push(k),
+            }
+        }
         Obstacles {
             segments,
+            cells,
+            long,
             outlines,
             boxes: Vec::new(),
         }
     }
 
     /// Whether the block at `at` (lower-left), `bw` × `bh`, grown by the clearance, touches no
-    /// stroke and does not lie inside a piece.
+    /// stroke and no square placed, and does not lie inside a piece.
     fn free(&self, at: DVec2, bw: f64, bh: f64) -> bool {
         let c = SQUARE_CLEARANCE_MM;
         let lo = at - DVec2::splat(c);
         let hi = at + DVec2::new(bw + c, bh + c);
+        let hits = |k: &usize| {
+            let (p, q) = self.segments[*k];
+            segment_meets_box(p, q, lo, hi)
+        };
+        let near = match obstacle_cells(lo, hi) {
+            Some(covered) => covered
+                .filter_map(|cell| self.cells.get(&cell))
+                .any(|list| list.iter().any(hits)),
+            // A block that covers more cells than that is looked at against every segment.
+            None => (0..self.segments.len()).any(|k| hits(&k)),
+        };
+        if near || self.long.iter().any(hits) {
+            return false;
+        }
         if self
-            .segments
+            .boxes
             .iter()
-            .any(|&(p, q)| segment_meets_box(p, q, lo, hi))
+            .any(|&(a, b)| a.x < hi.x && b.x > lo.x && a.y < hi.y && b.y > lo.y)
         {
             return false;
         }
         let centre = (lo + hi) / 2.0;
-        !self.outlines.iter().any(|o| inside(centre, o))
+        !self.outlines.iter().any(|(o, olo, ohi)| {
+            centre.cmpge(*olo).all() && centre.cmple(*ohi).all() && inside(centre, o)
+        })
     }
 }
 
@@ -824,6 +879,29 @@ mod tests {
         let (sq, free) = test_squares(&s);
         assert!(free);
         assert_eq!(sq[0].corner.x, sq[1].corner.x);
+    }
+
+    #[test]
+    fn squares_placed_apart_do_not_overlap_each_other() {
+        // Lines every 70 mm: no room for the two squares together, room for each alone in a
+        // cell; the second goes to another cell than the first (it used to take the same).
+        let mut strokes = Vec::new();
+        for k in 0..=4 {
+            let v = 70.0 * k as f64;
+            strokes.push(stroke(StrokeRole::Mark, &[(v, 0.0), (v, 300.0)]));
+            strokes.push(stroke(StrokeRole::Mark, &[(0.0, v), (300.0, v)]));
+        }
+        let mut s = sheet(strokes);
+        s.width = 300.0;
+        s.height = 300.0;
+        let (sq, free) = test_squares(&s);
+        assert!(free);
+        let (a, b) = (sq[0], sq[1]);
+        let apart = a.corner.x + a.side <= b.corner.x
+            || b.corner.x + b.side <= a.corner.x
+            || a.corner.y + a.side <= b.corner.y
+            || b.corner.y + b.side <= a.corner.y;
+        assert!(apart, "{a:?} and {b:?} overlap");
     }
 
     #[test]
