@@ -44,7 +44,10 @@
 //! - the parameteriser refuses it (no cut makes it a disk),
 //! - or its L2 stretch is still over the tolerance — at most [`FlattenOptions::max_splits`]
 //!   times per chart (its darts dropped, each half gets its own); what is still over it then
-//!   is reported (a warning on the surface, and the stretch of every piece in `report.json`).
+//!   is laid out exactly, as the polyhedral unfolder does (`exact`: stretch 1, its bends fold
+//!   lines, slits where it needs them, several pieces where it would overlap itself), unless
+//!   [`FlattenOptions::exact`] is off; then it is reported (a warning on the surface, and the
+//!   stretch of every piece in `report.json`).
 //!
 //! Material tolerances on the L2 stretch of a piece (`material_tolerance`), chosen here:
 //! paper 1.003 (paper does not stretch; 0.3 % is taken up by folding and gluing without a
@@ -61,7 +64,8 @@
 //!
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
-//! and without overlap (`merge`).
+//! and without overlap (`merge`), else grafted onto its neighbours as they lie: its faces
+//! unfolded exactly onto their layouts (`exact::graft`).
 //!
 //! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
 //! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
