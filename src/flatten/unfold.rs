@@ -379,8 +379,9 @@ type Onto = (Vec<Vec<DVec2>>, Vec<usize>, Vec<bool>);
 /// Faces unfolded onto layouts that stay as they are (`charts::exact::graft`): the first
 /// faces of `mesh` are the layouts of `fixed`, one after the other, each an island where it
 /// lies; the other faces start apart, each in its own plane, and are joined in the
-/// unfolder's order (see the module doc), a join that would overlap deeper than `eps` or
-/// that would join two of the fixed layouts left cut. A fixed layout moves only rigidly, when
+/// unfolder's order (see the module doc; with `anchor_first`, the edges between a fixed
+/// layout and another face before all others), a join that would overlap deeper than `eps`
+/// or that would join two of the fixed layouts left cut. A fixed layout moves only rigidly, when
 /// a larger island is joined onto it. The positions of all faces, the fixed layout each face
 /// ended in, and the edges joined (ids of `topology`, the mesh's); `None` when a face has no
 /// area or stays apart from every fixed layout.
@@ -390,6 +391,7 @@ pub(super) fn unfold_onto(
     fixed: &[&[Vec<DVec2>]],
     opts: &UnfoldOptions,
     eps: f64,
+    anchor_first: bool,
 ) -> Option<Onto> {
     let nf = mesh.faces.len();
     let n: usize = fixed.iter().map(|l| l.len()).sum();
@@ -421,7 +423,16 @@ pub(super) fn unfold_onto(
         .map(|&e| {
             let [(f, i), (g, _)] = [topology.edges[e].uses[0], topology.edges[e].uses[1]];
             let d = mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
-            (opts.key(d, length(e) / mean.max(f64::MIN_POSITIVE)), e)
+            // Edges to a fixed layout before all others, when asked.
+            let first = if anchor_first && (f < n || g < n) {
+                -10.0
+            } else {
+                0.0
+            };
+            (
+                first + opts.key(d, length(e) / mean.max(f64::MIN_POSITIVE)),
+                e,
+            )
         })
         .collect();
     keys.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -605,8 +616,15 @@ pub(crate) mod tests {
             .into_iter()
             .map(|p| p + far)
             .collect::<Vec<_>>()];
-        let (pos, which, joined) =
-            unfold_onto(&mesh, &topo, &[&a, &b], &UnfoldOptions::default(), 0.01).unwrap();
+        let (pos, which, joined) = unfold_onto(
+            &mesh,
+            &topo,
+            &[&a, &b],
+            &UnfoldOptions::default(),
+            0.01,
+            false,
+        )
+        .unwrap();
         assert_eq!((which[0], which[1]), (0, 1));
         assert!(which[2..].iter().all(|&w| w < 2));
         // The fixed layouts keep their shape (moved rigidly at most).
@@ -634,7 +652,8 @@ pub(crate) mod tests {
             &topo,
             &[&a, &a, &a, &a, &a, &a, &a],
             &UnfoldOptions::default(),
-            0.01
+            0.01,
+            false
         )
         .is_none());
     }

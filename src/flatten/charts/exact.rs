@@ -100,8 +100,10 @@ pub(super) fn graft(
     let (mesh, _) = submesh(ctx, &faces);
     let topo = mesh.topology();
     let layouts: Vec<&[Vec<DVec2>]> = near.iter().map(|&k| done[k].uv.as_slice()).collect();
-    let (mut uv, which, joined) =
-        unfold::unfold_onto(&mesh, &topo, &layouts, &UnfoldOptions::default(), eps)?;
+    // The unfolder's order, else the edges to the neighbours first.
+    let opts = UnfoldOptions::default();
+    let (mut uv, which, joined) = unfold::unfold_onto(&mesh, &topo, &layouts, &opts, eps, false)
+        .or_else(|| unfold::unfold_onto(&mesh, &topo, &layouts, &opts, eps, true))?;
     snap_ends(&mesh, &topo, &mut uv, &joined, n);
     let mut out = Vec::new();
     let mut laid = Vec::new();
