@@ -177,19 +177,27 @@ fn flatten_surfaces(
         flats.push(flat);
     }
     let opts = spec.pattern_options();
-    let pieces = match spec.pattern.split.unwrap_or_default() {
-        crate::pattern::split::Split::None => crate::pattern::build(&flats, &opts)?,
-        crate::pattern::split::Split::Auto => {
-            let s = &spec.sheet;
-            let room = crate::pattern::split::Room::inside(s.width, s.height, s.margin);
-            crate::pattern::split::build_to_fit(&mut flats, &opts, &room).map_err(|e| {
-                Error::In {
-                    file: spec.path.clone(),
-                    source: Box::new(e.into()),
+    let pieces =
+        match spec.pattern.split.unwrap_or_default() {
+            crate::pattern::split::Split::None => crate::pattern::build(&flats, &opts)?,
+            crate::pattern::split::Split::Auto => {
+                let s = &spec.sheet;
+                let room = crate::pattern::split::Room::inside(s.width, s.height, s.margin);
+                let before: Vec<usize> = flats.iter().map(|f| f.surface.warnings.len()).collect();
+                let pieces = crate::pattern::split::build_to_fit(&mut flats, &opts, &room)
+                    .map_err(|e| Error::In {
+                        file: spec.path.clone(),
+                        source: Box::new(e.into()),
+                    })?;
+                // Parts of a split piece that stretch more than their material allows.
+                for (f, n) in flats.iter().zip(before).filter(|_| !quiet) {
+                    for w in f.surface.warnings.iter().skip(n) {
+                        eprintln!("flatcut: warning: {w}");
+                    }
                 }
-            })?
-        }
-    };
+                pieces
+            }
+        };
     Ok((flats, pieces))
 }
 

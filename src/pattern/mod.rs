@@ -100,6 +100,11 @@ pub struct PatternOptions {
     /// the sheet's thickness, K factor and inside bend radius: the mesh surfaces of a metal
     /// job. Empty in the bare net.
     pub develop: Vec<(String, crate::geom::bend::SheetBend)>,
+    /// Largest L2 stretch of a part when a piece laid out from charts is split to fit the
+    /// sheet ([`split`]): partitions with fewer parts over it are preferred. `None` in the
+    /// bare net; the flatten stage's tolerance of the material otherwise
+    /// ([`PatternOptions::for_material`]).
+    pub stretch_limit: Option<f64>,
 }
 
 impl Default for PatternOptions {
@@ -121,6 +126,7 @@ impl Default for PatternOptions {
             simplify: 0.0,
             simplify_surfaces: Vec::new(),
             develop: Vec::new(),
+            stretch_limit: None,
         }
     }
 }
@@ -137,6 +143,9 @@ impl PatternOptions {
                 MaterialKind::Metal => 0.1,
                 _ => 0.5,
             },
+            stretch_limit: Some(
+                crate::flatten::charts::FlattenOptions::for_material(kind).tolerance,
+            ),
             ..PatternOptions::default()
         };
         match kind {

@@ -287,7 +287,33 @@ pub fn build_to_fit(
             break;
         }
     }
+    explain_stretch(flats, &last, opts);
     Ok(last)
+}
+
+/// A part of a split piece laid out from charts that stretches more than the material's
+/// tolerance (its layout is the piece's, within it as a whole) gets a warning on its surface
+/// saying so, which report.json lists.
+fn explain_stretch(flats: &mut [Flat], pieces: &[Piece], opts: &PatternOptions) {
+    let Some(limit) = opts.stretch_limit else {
+        return;
+    };
+    for p in pieces.iter().filter(|p| p.seams.iter().any(|s| s.split)) {
+        let Some(flat) = flats
+            .iter_mut()
+            .find(|f| f.surface.name == p.surface && f.surface.charts.is_some())
+        else {
+            continue;
+        };
+        let uv: Vec<Vec<DVec2>> = p.faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
+        let l2 = crate::flatten::distortion::stretch(&flat.surface.mesh, &p.faces, &uv).l2;
+        if l2 > limit {
+            flat.surface.warnings.push(format!(
+                "surface `{}`: part {} stretches by L2 {l2:.5}, over the material's {limit:.4}: it is cut from a piece split to fit the sheet, laid out as that piece (within the tolerance as a whole), where the stretch gathers; a larger sheet keeps the piece whole",
+                p.surface, p.name
+            ));
+        }
+    }
 }
 
 /// What the material adds around a part at most (mm): tabs or seam allowance, half the kerf.
@@ -407,6 +433,8 @@ struct Island<'a> {
     grain: bool,
     room: Room,
     grow: f64,
+    /// [`PatternOptions::stretch_limit`], for an island laid out from charts.
+    limit: Option<f64>,
 }
 
 impl<'a> Island<'a> {
@@ -461,7 +489,21 @@ impl<'a> Island<'a> {
             grain: opts.grain,
             room: *room,
             grow: 0.0,
+            limit: opts.stretch_limit.filter(|_| flat.surface.charts.is_some()),
         }
+    }
+
+    /// Whether a part (local faces) stretches by more than [`Island::limit`] as laid.
+    fn over_limit(&self, part: &[usize]) -> bool {
+        let Some(limit) = self.limit else {
+            return false;
+        };
+        let faces: Vec<usize> = part.iter().map(|&u| self.faces[u]).collect();
+        let uv: Vec<Vec<DVec2>> = faces
+            .iter()
+            .map(|&f| self.flat.face_2d[f].clone())
+            .collect();
+        crate::flatten::distortion::stretch(&self.flat.surface.mesh, &faces, &uv).l2 > limit
     }
 
     /// Overflow (mm) of a set of local faces, grown by `self.grow` unless it is one face.
@@ -712,11 +754,13 @@ fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     }
 }
 
-/// The best partition so far: (number of parts, cost) and the parts.
-type Best = Option<((usize, f64), Vec<Vec<usize>>)>;
+/// The best partition so far: (parts over the stretch limit, number of parts, cost) and the
+/// parts.
+type Best = Option<((usize, usize, f64), Vec<Vec<usize>>)>;
 
-/// Keep `parts` if it beats the best so far: fewer parts, then a lower cost (seam length over
-/// a part's typical size, twice the largest part's excess area over the mean).
+/// Keep `parts` if it beats the best so far: fewer parts over the stretch limit (a part of a
+/// layout can stretch more than the whole), then fewer parts, then a lower cost (seam length
+/// over a part's typical size, twice the largest part's excess area over the mean).
 fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
     let mut part_of = vec![0; isl.faces.len()];
     for (k, p) in parts.iter().enumerate() {
@@ -736,10 +780,14 @@ fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
         .map(|p| p.iter().map(|&u| isl.area[u]).sum::<f64>())
         .fold(0.0, f64::max);
     let cost = seam / mean.sqrt().max(1e-9) + 2.0 * (largest / mean.max(1e-300) - 1.0);
-    let score = (parts.len(), cost);
+    let over = parts.iter().filter(|p| isl.over_limit(p)).count();
+    let score = (parts.len(), over, cost);
     let better = match best {
         None => true,
-        Some((s, _)) => score.0 < s.0 || (score.0 == s.0 && score.1 < s.1 - 1e-12),
+        Some((s, _)) => {
+            (score.0, score.1) < (s.0, s.1)
+                || ((score.0, score.1) == (s.0, s.1) && score.2 < s.2 - 1e-12)
+        }
     };
     if better {
         *best = Some((score, parts));
