@@ -36,7 +36,7 @@ use std::collections::HashMap;
 /// its cuts the edges left cut inside the island; `None` when the unfolder refuses a face.
 /// The unfolder's overlap tolerance is `eps`, the charts' own.
 pub(super) fn exact(ctx: &Charts, faces: &[usize], eps: f64) -> Option<Vec<Laid>> {
-    let (mesh, _) = submesh(ctx, faces);
+    let mesh = submesh(ctx, faces);
     let opts = UnfoldOptions {
         tolerance: eps,
         ..UnfoldOptions::default()
@@ -97,7 +97,7 @@ pub(super) fn graft(
         .collect();
     let n = faces.len();
     faces.extend(&done[part].faces);
-    let (mesh, _) = submesh(ctx, &faces);
+    let mesh = submesh(ctx, &faces);
     let topo = mesh.topology();
     let layouts: Vec<&[Vec<DVec2>]> = near.iter().map(|&k| done[k].uv.as_slice()).collect();
     // The unfolder's order, else the edges to the neighbours first.
@@ -205,11 +205,10 @@ fn snap_ends(mesh: &Mesh, topo: &Topology, uv: &mut [Vec<DVec2>], joined: &[bool
 }
 
 /// The mesh of `faces` alone (face `i` is `faces[i]`, vertices renumbered in order of first
-/// use), and the mesh vertex of each of its vertices.
-fn submesh(ctx: &Charts, faces: &[usize]) -> (Mesh, Vec<usize>) {
+/// use).
+fn submesh(ctx: &Charts, faces: &[usize]) -> Mesh {
     let mut local: HashMap<usize, usize> = HashMap::new();
     let mut mesh = Mesh::default();
-    let mut of = Vec::new();
     for &f in faces {
         let face = &ctx.mesh.faces[f];
         let mut verts = Vec::with_capacity(face.verts.len());
@@ -218,7 +217,6 @@ fn submesh(ctx: &Charts, faces: &[usize]) -> (Mesh, Vec<usize>) {
             let l = *local.entry(v).or_insert(next);
             if l == next {
                 mesh.vertices.push(ctx.mesh.vertices[v]);
-                of.push(v);
             }
             verts.push(l);
         }
@@ -227,7 +225,7 @@ fn submesh(ctx: &Charts, faces: &[usize]) -> (Mesh, Vec<usize>) {
             line: face.line,
         });
     }
-    (mesh, of)
+    mesh
 }
 
 /// The mean length of a mesh's edges.
