@@ -20,7 +20,7 @@
 //! material. Edges the source lists in [`Surface::cuts`] are never joined (the seam where a
 //! closed spline surface is opened).
 //!
-//! [`unfold_onto`] runs the same joins with some faces held where another layout put them
+//! `unfold_onto` runs the same joins with some faces held where another layout put them
 //! (each such layout an island that moves only rigidly and is never joined to another): the
 //! chart flattener grafts small pieces onto their neighbours with it (issue 20).
 
