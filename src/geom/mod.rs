@@ -19,6 +19,8 @@
 //! - [`rng`]: the crate's one seeded random number generator.
 //! - [`par`]: fork–join over the machine's cores (a join, a map over independent jobs) whose
 //!   results do not depend on the number of threads.
+//! - [`grid`]: a uniform grid of boxes and segments over a box, for box and ray queries
+//!   (text placement, the PDF's free spots).
 //! - [`font`]: the single-stroke font for labels a pen or knife can draw.
 //! - [`input`]: reading a user's input file: a regular file under a size limit, UTF-8 with a
 //!   position.
@@ -29,6 +31,7 @@ pub mod bspline;
 pub mod curve;
 pub mod cut;
 pub mod font;
+pub mod grid;
 pub mod heap;
 pub mod hull;
 pub mod input;

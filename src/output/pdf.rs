@@ -31,6 +31,7 @@
 //!   tests read the coordinates back. Output is a pure function of the job: no dates, no file
 //!   id, fixed object numbers.
 
+use crate::geom::grid::Grid;
 use glam::DVec2;
 use pdf_writer::types::{LineCapStyle, LineJoinStyle, PageMode};
 use pdf_writer::{Content, Finish, Name, Pdf, Rect, Ref, TextStr};
@@ -190,36 +191,14 @@ fn find_spot(obstacles: &Obstacles, w: f64, h: f64, bw: f64, bh: f64) -> Option<
         .find(|&at| obstacles.free(at, bw, bh))
 }
 
-/// The strokes of a sheet as segments on a grid of [`OBSTACLE_CELL_MM`] cells (each in the
-/// cells its box covers; one that would cover more than [`OBSTACLE_SPAN`] cells, or a far
-/// away one, in a list looked at every time), and the closed cut outlines (the pieces) with
-/// their boxes, for [`test_squares`].
+/// The strokes of a sheet as segments on a grid over the page, and the closed cut outlines
+/// (the pieces) with their boxes, for [`test_squares`].
 struct Obstacles {
     segments: Vec<(DVec2, DVec2)>,
-    cells: std::collections::HashMap<(i64, i64), Vec<usize>>,
-    long: Vec<usize>,
+    grid: Grid,
     outlines: Vec<(Vec<DVec2>, DVec2, DVec2)>,
     /// Squares placed already (lower-left, upper-right corners).
     boxes: Vec<(DVec2, DVec2)>,
-}
-
-/// Side of the cells [`Obstacles`] sorts segments into.
-const OBSTACLE_CELL_MM: f64 = 20.0;
-
-/// Most cells a segment is sorted into (see [`Obstacles`]).
-const OBSTACLE_SPAN: i64 = 256;
-
-/// The cells of [`OBSTACLE_CELL_MM`] that the box `lo`..`hi` covers; `None` when they are
-/// more than [`OBSTACLE_SPAN`] (or the box is not finite).
-fn obstacle_cells(lo: DVec2, hi: DVec2) -> Option<impl Iterator<Item = (i64, i64)>> {
-    let at = |v: f64| (v / OBSTACLE_CELL_MM).floor();
-    let (x0, x1, y0, y1) = (at(lo.x), at(hi.x), at(lo.y), at(hi.y));
-    let span = (x1 - x0 + 1.0) * (y1 - y0 + 1.0);
-    if !(span.is_finite() && span <= OBSTACLE_SPAN as f64 && x0.abs() < 1e9 && y0.abs() < 1e9) {
-        return None;
-    }
-    let (x0, x1, y0, y1) = (x0 as i64, x1 as i64, y0 as i64, y1 as i64);
-    Some((x0..=x1).flat_map(move |x| (y0..=y1).map(move |y| (x, y))))
 }
 
 impl Obstacles {
@@ -242,22 +221,14 @@ impl Obstacles {
                 segments.push((pts[0], pts[0]));
             }
         }
-        let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
-        let mut long = Vec::new();
+        let (w, h) = page_size_mm(sheet);
+        let mut grid = Grid::new(DVec2::ZERO, DVec2::new(w, h));
         for (k, &(p, q)) in segments.iter().enumerate() {
-            match obstacle_cells(p.min(q), p.max(q)) {
-                Some(covered) => {
-                    for c in covered {
-                        cells.entry(c).or_default().push(k);
-                    }
-                }
-                None => long.push(k),
-            }
+            grid.insert_segment(p, q, k as u32);
         }
         Obstacles {
             segments,
-            cells,
-            long,
+            grid,
             outlines,
             boxes: Vec::new(),
         }
@@ -269,18 +240,12 @@ impl Obstacles {
         let c = SQUARE_CLEARANCE_MM;
         let lo = at - DVec2::splat(c);
         let hi = at + DVec2::new(bw + c, bh + c);
-        let hits = |k: &usize| {
-            let (p, q) = self.segments[*k];
+        let mut near = Vec::new();
+        self.grid.query(lo, hi, &mut near);
+        if near.iter().any(|&k| {
+            let (p, q) = self.segments[k as usize];
             segment_meets_box(p, q, lo, hi)
-        };
-        let near = match obstacle_cells(lo, hi) {
-            Some(covered) => covered
-                .filter_map(|cell| self.cells.get(&cell))
-                .any(|list| list.iter().any(hits)),
-            // A block that covers more cells than that is looked at against every segment.
-            None => (0..self.segments.len()).any(|k| hits(&k)),
-        };
-        if near || self.long.iter().any(hits) {
+        }) {
             return false;
         }
         if self

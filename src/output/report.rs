@@ -310,10 +310,5 @@ fn piece_stretch(flats: &[Flat], p: &crate::pattern::Piece) -> Value {
     else {
         return Value::Null;
     };
-    let uv: Vec<_> = p.faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
-    stretch_json(&crate::flatten::distortion::stretch(
-        &flat.surface.mesh,
-        &p.faces,
-        &uv,
-    ))
+    stretch_json(&crate::flatten::charts::stretch_of(flat, &p.faces))
 }

@@ -49,6 +49,7 @@
 //! (it is never set along a line to squeeze between folds).
 
 use super::{FoldKind, PatternOptions, Piece, Text};
+use crate::geom::grid::Grid;
 use crate::geom::{font, polygon};
 use glam::DVec2;
 
@@ -230,93 +231,6 @@ impl Footprint {
     }
 }
 
-/// A uniform grid of items by their bounds; an item is listed in every cell it may touch.
-struct Grid {
-    lo: DVec2,
-    cell: f64,
-    nx: usize,
-    ny: usize,
-    cells: Vec<Vec<u32>>,
-}
-
-impl Grid {
-    /// At most 128 cells along the longer side of `lo`–`hi`, none under 0.5 mm.
-    fn new(lo: DVec2, hi: DVec2) -> Grid {
-        let size = (hi - lo).max(DVec2::splat(1e-9));
-        let cell = (size.max_element() / 128.0).max(0.5);
-        let nx = ((size.x / cell).ceil() as usize).clamp(1, 129);
-        let ny = ((size.y / cell).ceil() as usize).clamp(1, 129);
-        Grid {
-            lo,
-            cell,
-            nx,
-            ny,
-            cells: vec![Vec::new(); nx * ny],
-        }
-    }
-
-    fn col(&self, x: f64) -> usize {
-        (((x - self.lo.x) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
-    }
-
-    fn row(&self, y: f64) -> usize {
-        (((y - self.lo.y) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
-    }
-
-    /// Lists item `id` in every cell of the box `lo`–`hi`.
-    fn insert_box(&mut self, lo: DVec2, hi: DVec2, id: u32) {
-        if !(lo.is_finite() && hi.is_finite()) {
-            return;
-        }
-        for i in self.col(lo.x)..=self.col(hi.x) {
-            for j in self.row(lo.y)..=self.row(hi.y) {
-                self.cells[j * self.nx + i].push(id);
-            }
-        }
-    }
-
-    /// Lists segment `id` in the cells it passes through: column by column, the rows its part
-    /// in that column spans.
-    fn insert_segment(&mut self, a: DVec2, b: DVec2, id: u32) {
-        if !(a.is_finite() && b.is_finite()) {
-            return;
-        }
-        let (a, b) = if a.x <= b.x { (a, b) } else { (b, a) };
-        let (c0, c1) = (self.col(a.x), self.col(b.x));
-        for i in c0..=c1 {
-            let x0 = (self.lo.x + i as f64 * self.cell).max(a.x);
-            let x1 = (self.lo.x + (i + 1) as f64 * self.cell).min(b.x);
-            let y_at = |x: f64| {
-                if b.x - a.x > 0.0 {
-                    a.y + (b.y - a.y) * ((x - a.x) / (b.x - a.x)).clamp(0.0, 1.0)
-                } else {
-                    a.y
-                }
-            };
-            let (ya, yb) = if c0 == c1 {
-                (a.y, b.y)
-            } else {
-                (y_at(x0), y_at(x1))
-            };
-            for j in self.row(ya.min(yb))..=self.row(ya.max(yb)) {
-                self.cells[j * self.nx + i].push(id);
-            }
-        }
-    }
-
-    /// The items listed in the cells of the box `lo`–`hi`, each once, in order.
-    fn query(&self, lo: DVec2, hi: DVec2, out: &mut Vec<u32>) {
-        out.clear();
-        for i in self.col(lo.x)..=self.col(hi.x) {
-            for j in self.row(lo.y)..=self.row(hi.y) {
-                out.extend_from_slice(&self.cells[j * self.nx + i]);
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-    }
-}
-
 /// Rings (an outer contour and its holes) with their segments in a grid, for a fast inside
 /// test.
 struct Rings {
@@ -341,18 +255,9 @@ impl Rings {
     /// crossings of a ray towards +x, counted on the segments listed in the grid cells it
     /// passes.
     fn contains(&self, q: DVec2, ids: &mut Vec<u32>) -> bool {
-        let g = &self.grid;
-        let top = g.lo + DVec2::new(g.nx as f64, g.ny as f64) * g.cell;
-        if !(q.cmpge(g.lo).all() && q.cmple(top).all()) {
+        if !self.grid.ray(q, ids) {
             return false;
         }
-        ids.clear();
-        let j = g.row(q.y);
-        for i in g.col(q.x)..g.nx {
-            ids.extend_from_slice(&g.cells[j * g.nx + i]);
-        }
-        ids.sort_unstable();
-        ids.dedup();
         let mut inside = false;
         for &k in ids.iter() {
             let (a, b) = self.segments[k as usize];
@@ -895,18 +800,6 @@ mod tests {
             hv: 0.5,
         };
         assert!(!b3.overlaps(&b));
-    }
-
-    #[test]
-    fn the_grid_finds_every_segment_a_box_meets() {
-        let mut g = Grid::new(DVec2::ZERO, DVec2::splat(1000.0));
-        g.insert_segment(DVec2::new(0.0, 0.0), DVec2::new(1000.0, 700.0), 0);
-        g.insert_segment(DVec2::new(500.0, 0.0), DVec2::new(500.0, 1000.0), 1);
-        let mut out = Vec::new();
-        g.query(DVec2::new(499.0, 349.0), DVec2::new(501.0, 351.0), &mut out);
-        assert_eq!(out, vec![0, 1]);
-        g.query(DVec2::new(900.0, 100.0), DVec2::new(950.0, 150.0), &mut out);
-        assert!(out.is_empty(), "{out:?}");
     }
 
     /// A 40 × 16 mm strip with a fold every 1.5 mm: no room for its label anywhere (without the

@@ -305,8 +305,7 @@ fn explain_stretch(flats: &mut [Flat], pieces: &[Piece], opts: &PatternOptions) 
         else {
             continue;
         };
-        let uv: Vec<Vec<DVec2>> = p.faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
-        let l2 = crate::flatten::distortion::stretch(&flat.surface.mesh, &p.faces, &uv).l2;
+        let l2 = crate::flatten::charts::stretch_of(flat, &p.faces).l2;
         if l2 > limit {
             flat.surface.warnings.push(format!(
                 "surface `{}`: part {} stretches by L2 {l2:.5}, over the material's {limit:.4}: it is cut from a piece split to fit the sheet, laid out as that piece (within the tolerance as a whole), where the stretch gathers; a larger sheet keeps the piece whole",

@@ -136,10 +136,7 @@ pub(super) fn graft(
                 if topo.edges[e].uses.len() != 2 || !inside[g] {
                     continue;
                 }
-                let (p, q) = (uv[f][i], uv[f][(i + 1) % uv[f].len()]);
-                let (q0, p0) = (uv[g][j], uv[g][(j + 1) % uv[g].len()]);
-                let same = |a: DVec2, b: DVec2| a.distance(b) <= 1e-9 * (1.0 + a.length());
-                if !(same(p, p0) && same(q, q0)) {
+                if !super::coincide(&uv[f], i, &uv[g], j) {
                     cuts.push(ctx.topo.face_edges[faces[f]][i]);
                 }
             }
@@ -191,7 +188,7 @@ fn snap_ends(mesh: &Mesh, topo: &Topology, uv: &mut [Vec<DVec2>], joined: &[bool
             .or_default()
             .push((uv[g][j], uv[f][(i + 1) % mf]));
     }
-    let near = 1e-3 * mean_edge(mesh, topo);
+    let near = 1e-3 * super::mean_edge(mesh, topo);
     for (f, corners) in uv.iter_mut().enumerate().skip(n) {
         for (c, &v) in mesh.faces[f].verts.iter().enumerate() {
             let to = ends
@@ -226,14 +223,4 @@ fn submesh(ctx: &Charts, faces: &[usize]) -> Mesh {
         });
     }
     mesh
-}
-
-/// The mean length of a mesh's edges.
-fn mean_edge(mesh: &Mesh, topo: &Topology) -> f64 {
-    let sum: f64 = topo
-        .edges
-        .iter()
-        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
-        .sum();
-    sum / topo.edges.len().max(1) as f64
 }

@@ -632,13 +632,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     let surface_cuts = edge_ids(&topology, &surface.cuts);
     let todo = ctx.initial(&chart_of, &surface_cuts);
     // Overlaps shallower than the unfolder's tolerance count as touching, as in `unfold`.
-    let mean_edge = topology
-        .edges
-        .iter()
-        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
-        .sum::<f64>()
-        / topology.edges.len().max(1) as f64;
-    let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge);
+    let overlap_eps = opts.unfold.tolerance.min(0.01 * mean_edge(mesh, &topology));
     let degenerate = |f: usize| FlattenError::Degenerate {
         surface: surface.name.clone(),
         face: f + 1,
@@ -742,21 +736,16 @@ fn assemble(
     }
     let mut joined = vec![false; ne];
     let mut dihedral = vec![0.0; ne];
-    let mut lengths = 0.0;
     for (e, edge) in topology.edges.iter().enumerate() {
-        lengths += mesh.vertices[edge.verts[0]].distance(mesh.vertices[edge.verts[1]]);
         let [(f, i), (g, j)] = edge.uses[..] else {
             continue;
         };
         dihedral[e] = mesh.signed_dihedral(f, i, g).unwrap_or(0.0);
-        if face_island[f] == face_island[g] && !is_cut[e] {
-            let (p, q) = (face_2d[f][i], face_2d[f][(i + 1) % face_2d[f].len()]);
-            let (q0, p0) = (face_2d[g][j], face_2d[g][(j + 1) % face_2d[g].len()]);
-            let tol = 1e-9 * (1.0 + p.length().max(q.length()));
-            joined[e] = p.distance(p0) <= tol && q.distance(q0) <= tol;
-        }
+        joined[e] = face_island[f] == face_island[g]
+            && !is_cut[e]
+            && coincide(&face_2d[f], i, &face_2d[g], j);
     }
-    let mean = lengths / ne.max(1) as f64;
+    let mean = mean_edge(mesh, &topology);
     for (k, l2) in over {
         surface.warnings.push(format!(
             "surface `{}`: piece {} stretches by L2 {:.5}, over the material's {:.4}: expect wrinkles or gaps",
@@ -788,18 +777,41 @@ fn assemble(
     }
 }
 
+/// Whether the edge at corner `i` of a face laid at `a` and the edge at corner `j` of the face
+/// across it, laid at `b` (which runs it the other way round), lie at one place: the two
+/// copies of a joined edge (to 1e-9, relative to the distance from the origin).
+fn coincide(a: &[DVec2], i: usize, b: &[DVec2], j: usize) -> bool {
+    let (p, q) = (a[i], a[(i + 1) % a.len()]);
+    let (q0, p0) = (b[j], b[(j + 1) % b.len()]);
+    let tol = 1e-9 * (1.0 + p.length().max(q.length()));
+    p.distance(p0) <= tol && q.distance(q0) <= tol
+}
+
+/// The mean 3D length of a mesh's edges.
+fn mean_edge(mesh: &Mesh, topology: &Topology) -> f64 {
+    topology
+        .edges
+        .iter()
+        .map(|e| mesh.vertices[e.verts[0]].distance(mesh.vertices[e.verts[1]]))
+        .sum::<f64>()
+        / topology.edges.len().max(1) as f64
+}
+
 /// Stretch of each island of a flat, and of the whole (area-weighted), from its layout.
 pub fn stretch(flat: &Flat) -> (Vec<Stretch>, Stretch) {
     let per: Vec<Stretch> = flat
         .islands
         .iter()
-        .map(|faces| {
-            let uv: Vec<Vec<DVec2>> = faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
-            distortion::stretch(&flat.surface.mesh, faces, &uv)
-        })
+        .map(|faces| stretch_of(flat, faces))
         .collect();
     let whole = distortion::combine(&per);
     (per, whole)
+}
+
+/// Stretch of some faces of a flat (a piece, or a part of one) as laid out.
+pub fn stretch_of(flat: &Flat, faces: &[usize]) -> Stretch {
+    let uv: Vec<Vec<DVec2>> = faces.iter().map(|&f| flat.face_2d[f].clone()).collect();
+    distortion::stretch(&flat.surface.mesh, faces, &uv)
 }
 
 /// A global overlap is cut off ([`overlap::cut_off`]) when the part cut off has at most this fraction
