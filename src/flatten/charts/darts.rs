@@ -306,9 +306,17 @@ pub(super) fn gussets(ctx: &Charts, laid: &mut Laid, opts: &FlattenOptions, eps:
             }
             v = u;
         }
-        let Some((rest, pieces)) =
-            cut_off(ctx, &laid.faces, &cuts, &left, &right, &pairs, &uv, eps)
-        else {
+        let Some((rest, pieces)) = cut_off(
+            ctx,
+            &laid.faces,
+            &cuts,
+            &left,
+            &right,
+            &pairs,
+            &uv,
+            eps,
+            false,
+        ) else {
             break;
         };
         let mut all: Vec<Stretch> = pieces.iter().map(|p| p.stretch).collect();

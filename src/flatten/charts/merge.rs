@@ -24,11 +24,10 @@
 //! none joins; a pair that failed is not tried again unless one of the two has grown since.
 
 use super::exact::graft;
+use super::join::moved_onto;
 use super::overlap::{both_cuts, merge_into, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid};
 use crate::flatten::distortion;
-use glam::DVec2;
-use std::collections::HashMap;
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
@@ -138,113 +137,23 @@ pub(super) fn merge_near(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptio
 /// Join `done[part]` to `done[k]` by moving its layout onto `done[k]`'s along their common
 /// boundary (see the module doc); false, leaving both as they were, when it does not fit.
 fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps: f64) -> bool {
-    let in_k: HashMap<usize, usize> = done[k]
-        .faces
-        .iter()
-        .enumerate()
-        .map(|(i, &f)| (f, i))
-        .collect();
-    // The common edges: each end as `part` has it and where `done[k]` has it.
-    let mut pairs: Vec<(DVec2, DVec2)> = Vec::new();
-    let mut at: HashMap<usize, DVec2> = HashMap::new();
-    let (mut edges, mut length) = (0usize, 0.0);
-    for (pi, &f) in done[part].faces.iter().enumerate() {
-        let n = ctx.mesh.faces[f].verts.len();
-        for i in 0..n {
-            let e = &ctx.topo.edges[ctx.topo.face_edges[f][i]];
-            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
-                continue;
-            };
-            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
-                continue;
-            };
-            let m = ctx.mesh.faces[g].verts.len();
-            let (a, b) = (
-                ctx.mesh.faces[f].verts[i],
-                ctx.mesh.faces[f].verts[(i + 1) % n],
-            );
-            let here = [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]];
-            // The edge runs the other way round in `g`.
-            let there = [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]];
-            for (v, (p, q)) in [a, b].into_iter().zip(here.into_iter().zip(there)) {
-                match at.get(&v) {
-                    Some(old) if old.distance(q) > 1e-9 * (1.0 + q.length()) => return false,
-                    Some(_) => {}
-                    None => {
-                        at.insert(v, q);
-                        pairs.push((p, q));
-                    }
-                }
-            }
-            edges += 1;
-            length += ctx.mesh.vertices[a].distance(ctx.mesh.vertices[b]);
-        }
-    }
-    // One path or one loop of common edges.
-    if edges == 0 || !(at.len() == edges || at.len() == edges + 1) {
-        return false;
-    }
-    let Some((turn, shift)) = fit(&pairs) else {
+    let Some(j) = moved_onto(ctx, done, k, part) else {
         return false;
     };
-    let moved = |p: DVec2| turn.rotate(p) + shift;
-    let worst = pairs
-        .iter()
-        .map(|&(p, q)| moved(p).distance(q))
-        .fold(0.0, f64::max);
-    if worst > (near - 1.0) * length {
+    // One path or one loop of common edges.
+    if !(j.verts == j.edges || j.verts == j.edges + 1) || j.worst > (near - 1.0) * j.length {
         return false;
     }
-    let mut faces = done[k].faces.clone();
-    let mut uv = done[k].uv.clone();
-    for (&f, corners) in done[part].faces.iter().zip(&done[part].uv) {
-        let verts = &ctx.mesh.faces[f].verts;
-        faces.push(f);
-        uv.push(
-            verts
-                .iter()
-                .zip(corners)
-                .map(|(v, &p)| {
-                    let p = moved(p);
-                    match at.get(v) {
-                        Some(&q) if q.distance(p) <= 2.0 * worst + 1e-9 * (1.0 + q.length()) => q,
-                        _ => p,
-                    }
-                })
-                .collect(),
-        );
-    }
-    let s = distortion::stretch(ctx.mesh, &faces, &uv);
-    if s.flipped > 0 || s.l2 > near || self_overlap(&uv, eps).is_some() {
+    let s = distortion::stretch(ctx.mesh, &j.faces, &j.uv);
+    if s.flipped > 0 || s.l2 > near || self_overlap(&j.uv, eps).is_some() {
         return false;
     }
     done[k] = Laid {
-        faces,
+        faces: j.faces,
         cuts: both_cuts(&done[k], &done[part]),
-        uv,
+        uv: j.uv,
         stretch: s,
         gusset: false,
     };
     true
-}
-
-/// The rotation (as a unit complex number) and shift that best move the first points of
-/// `pairs` onto the second (least squares); `None` for fewer than two distinct points.
-pub(super) fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
-    let n = pairs.len() as f64;
-    let cp = pairs.iter().map(|p| p.0).sum::<DVec2>() / n;
-    let cq = pairs.iter().map(|p| p.1).sum::<DVec2>() / n;
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for &(p, q) in pairs {
-        let (a, b) = (p - cp, q - cq);
-        dot += a.dot(b);
-        cross += a.perp_dot(b);
-    }
-    let r = DVec2::new(dot, cross);
-    let len = r.length();
-    if len <= 1e-300 || !len.is_finite() {
-        return None;
-    }
-    let turn = r / len;
-    Some((turn, cq - turn.rotate(cp)))
 }

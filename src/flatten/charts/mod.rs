@@ -62,6 +62,16 @@
 //! decide (a part cut off, a dart tried) is kept, up to a bound, and not made again when that
 //! chart's turn comes.
 //!
+//! **Parts start from the whole** (`lay_from`, [`param::relax_from`]): a half of a chart split
+//! for stretch or a flip, a part of one split or cut off where it overlaps itself, and two
+//! pieces merged into one are not laid anew: they start from the layout they had within the
+//! whole (the two pieces: one moved onto the other along their common boundary) and are only
+//! relaxed by the stretch minimisation, which stops early from there. The halves of a tube and
+//! the rest of a chart after a gusset start anew (their layout within the whole, spiralled or
+//! with the slit's sides overlapping, is a poor start), and so do darts (a dart closed in the
+//! start opens too slowly). A part the whole's layout does not fit (its corners at one vertex
+//! apart, a triangle flipped) is laid anew.
+//!
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
 //! and without overlap (`merge`), else grafted onto its neighbours as they lie: its faces
@@ -74,7 +84,9 @@
 //! Matching raises L2 a little (the inside absorbs what the boundary gave up), so a chart near
 //! the tolerance may be cut further. Layouts over the tolerance are not matched while they are
 //! still to be cut or split; a chart left over it at the end is matched then, or halved when
-//! its matched layout would overlap or flip (`MATCH_ROUNDS` rounds).
+//! its matched layout would overlap or flip (`MATCH_ROUNDS` rounds). So is a chart whose border
+//! edges are still further from their 3D lengths than [`FlattenOptions::seam_tolerance`] (its
+//! matching could not be had without a flip).
 
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
@@ -86,9 +98,11 @@ use crate::surface::MaterialKind;
 use crate::surface::Surface;
 use glam::DVec2;
 use std::collections::HashMap;
+use std::sync::Arc;
 
 mod darts;
 mod exact;
+mod join;
 mod merge;
 mod overlap;
 
@@ -122,6 +136,11 @@ pub struct FlattenOptions {
     /// boundary ([`crate::geom::proxy::cylinder_error`], §5.2.3); default 1e-3, the segmentation's
     /// `η` (`surface::dcharts::DChartsOptions::eta`).
     pub reattach_eta: f64,
+    /// Largest difference between a border edge of a piece laid flat and in 3D, over its 3D
+    /// length (see the module doc's "Seams that match"): half the material's seam tolerance
+    /// (issue 20: paper 0.2 %, metal 0.1 %, fabric 1 %), so that the two sides of a seam
+    /// differ by at most that (default paper's, 0.001).
+    pub seam_tolerance: f64,
 }
 
 impl Default for FlattenOptions {
@@ -135,6 +154,7 @@ impl Default for FlattenOptions {
             gussets: 2,
             exact: true,
             reattach_eta: 1e-3,
+            seam_tolerance: seam_tolerance(MaterialKind::Paper),
         }
     }
 }
@@ -144,8 +164,18 @@ impl FlattenOptions {
     pub fn for_material(kind: MaterialKind) -> Self {
         FlattenOptions {
             tolerance: material_tolerance(kind),
+            seam_tolerance: seam_tolerance(kind),
             ..Default::default()
         }
+    }
+}
+
+/// Half the seam tolerance of a material (see [`FlattenOptions::seam_tolerance`]).
+fn seam_tolerance(kind: MaterialKind) -> f64 {
+    match kind {
+        MaterialKind::Paper => 0.001,
+        MaterialKind::Fabric => 0.005,
+        MaterialKind::Metal => 0.0005,
     }
 }
 
@@ -226,6 +256,51 @@ struct Todo {
     /// Cut off a larger chart for overlapping it ([`cut_off`]): to be re-attached to a
     /// neighbour if one fits ([`reattach`]).
     cut_off: bool,
+    /// What its layout starts from.
+    start: Start,
+}
+
+/// What a chart's layout starts from: nothing (laid anew by the parameteriser), the layout of
+/// a larger chart it is part of ([`Charts::lay_from`]), or a layout already made (a part cut
+/// off: [`cut_off`] lays the parts to decide).
+enum Start {
+    Anew,
+    Within(Arc<Whole>),
+    Laid(Vec<Vec<DVec2>>, Stretch),
+}
+
+/// The layout of a chart waiting to be laid (`t`), for its parts to start from.
+fn whole(t: &Todo, uv: &[Vec<DVec2>]) -> Option<Arc<Whole>> {
+    Some(Whole::new(&t.faces, uv))
+}
+
+/// A chart's faces and their layout (per face corner), for its parts to start from.
+struct Whole {
+    /// (face, index into `uv`), sorted by face.
+    index: Vec<(usize, usize)>,
+    uv: Vec<Vec<DVec2>>,
+}
+
+impl Whole {
+    fn new(faces: &[usize], uv: &[Vec<DVec2>]) -> Arc<Whole> {
+        let mut index: Vec<(usize, usize)> = faces.iter().copied().zip(0..).collect();
+        index.sort_unstable();
+        Arc::new(Whole {
+            index,
+            uv: uv.to_vec(),
+        })
+    }
+
+    /// The layout of `faces` (each one of the whole's), in their order.
+    fn restrict(&self, faces: &[usize]) -> Option<Vec<Vec<DVec2>>> {
+        faces
+            .iter()
+            .map(|&f| {
+                let k = self.index.binary_search_by_key(&f, |x| x.0).ok()?;
+                Some(self.uv[self.index[k].1].clone())
+            })
+            .collect()
+    }
 }
 
 /// The error for a face that cannot be laid flat (shared by the threads that lay charts).
@@ -285,6 +360,44 @@ impl Charts<'_> {
 
     /// [`Charts::lay`] without the copies.
     fn lay_anew(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
+        let (local, ids) = self.opened(faces, cuts);
+        let p = match param::parameterize(&local, &ids, self.method) {
+            Ok(p) => p,
+            // A sliver triangle cannot be laid flat in any chart: say which (mesh numbering).
+            Err(param::ParamError::Degenerate { face, line, angle }) => {
+                return Err(param::ParamError::Degenerate {
+                    face: faces.get(face).copied().unwrap_or(face),
+                    line,
+                    angle,
+                })
+            }
+            Err(_) => return Ok(Layout::Refused),
+        };
+        Ok(self.finish(&local, &ids, p))
+    }
+
+    /// Part of a chart laid out from the whole chart's layout (see [`param::relax_from`]): the
+    /// whole was laid anew, so its part starts near its own optimum and only needs relaxing.
+    /// A part the whole's layout does not fit (corners of one vertex apart where the part has
+    /// no cut, a flipped triangle) is laid anew ([`Charts::lay`]).
+    fn lay_from(
+        &self,
+        faces: &[usize],
+        cuts: &[usize],
+        whole: Option<&Whole>,
+    ) -> Result<Layout, param::ParamError> {
+        if let Some(start) = whole.and_then(|w| w.restrict(faces)) {
+            let (local, ids) = self.opened(faces, cuts);
+            if let Some(p) = param::relax_from(&local, &ids, self.method, &start) {
+                return Ok(self.finish(&local, &ids, p));
+            }
+        }
+        self.lay(faces, cuts)
+    }
+
+    /// The chart's faces opened along `cuts` as a mesh of its own (vertices split along the
+    /// cuts), and its faces' indices.
+    fn opened(&self, faces: &[usize], cuts: &[usize]) -> (Mesh, Vec<usize>) {
         let op = open(self.mesh, self.topo, faces, &|e| {
             cuts.binary_search(&e).is_ok()
         });
@@ -299,28 +412,21 @@ impl Charts<'_> {
                 })
                 .collect(),
         };
-        let ids: Vec<usize> = (0..faces.len()).collect();
-        let p = match param::parameterize(&local, &ids, self.method) {
-            Ok(p) => p,
-            // A sliver triangle cannot be laid flat in any chart: say which (mesh numbering).
-            Err(param::ParamError::Degenerate { face, line, angle }) => {
-                return Err(param::ParamError::Degenerate {
-                    face: faces.get(face).copied().unwrap_or(face),
-                    line,
-                    angle,
-                })
-            }
-            Err(_) => return Ok(Layout::Refused),
-        };
+        (local, (0..faces.len()).collect())
+    }
+
+    /// A layout as the charts keep it: seams matched when it is within `match_below`,
+    /// refused when not finite, counter-clockwise.
+    fn finish(&self, local: &Mesh, ids: &[usize], p: param::ChartParam) -> Layout {
         // Seams as long flat as in 3D, the stretch taken up inside (issue 20).
         let p = if p.stretch.l2 <= self.match_below {
-            param::match_seams(&local, &ids, &p)
+            param::match_seams(local, ids, &p)
         } else {
             p
         };
         let mut uv = p.uv;
         if uv.iter().any(|c| c.iter().any(|q| !q.is_finite())) {
-            return Ok(Layout::Refused);
+            return Layout::Refused;
         }
         // Counter-clockwise, as the pattern stage expects.
         let total: f64 = uv.iter().map(|c| polygon::signed_area(c)).sum();
@@ -330,11 +436,40 @@ impl Charts<'_> {
                     q.x = -q.x;
                 }
             }
-            distortion::stretch(&local, &ids, &uv)
+            distortion::stretch(local, ids, &uv)
         } else {
             p.stretch
         };
-        Ok(Layout::Laid(uv, stretch))
+        Layout::Laid(uv, stretch)
+    }
+
+    /// The largest difference between a boundary edge's flat and 3D length, over the 3D
+    /// length, in the layout `l` (edges on its border and along its cuts): about 1e-7 where
+    /// its seams were matched ([`param::match_seams`]).
+    fn seam_error(&self, l: &Laid) -> f64 {
+        let mut inside = vec![false; self.mesh.faces.len()];
+        for &f in &l.faces {
+            inside[f] = true;
+        }
+        let mut worst: f64 = 0.0;
+        for (&f, uv) in l.faces.iter().zip(&l.uv) {
+            let verts = &self.mesh.faces[f].verts;
+            let n = verts.len();
+            for (j, &e) in self.topo.face_edges[f].iter().enumerate() {
+                let joined = l.cuts.binary_search(&e).is_err()
+                    && self.topo.edges[e].uses.len() == 2
+                    && self.topo.edges[e].uses.iter().all(|u| inside[u.0]);
+                if joined {
+                    continue;
+                }
+                let d3 =
+                    self.mesh.vertices[verts[j]].distance(self.mesh.vertices[verts[(j + 1) % n]]);
+                if d3 > 0.0 {
+                    worst = worst.max((uv[j].distance(uv[(j + 1) % n]) - d3).abs() / d3);
+                }
+            }
+        }
+        worst
     }
 
     /// Cuts that make the chart a disk: `cuts` when they do, else `cuts` with more
@@ -384,6 +519,7 @@ impl Charts<'_> {
                 faces,
                 splits: 0,
                 cut_off: false,
+                start: Start::Anew,
             })
             .collect()
     }
@@ -400,12 +536,22 @@ impl Charts<'_> {
         done: &mut Vec<Laid>,
         degenerate: &Degenerate<'_>,
     ) -> Result<(), FlattenError> {
-        let Some(cuts) = self.disk(&t.faces, &t.cuts) else {
-            return self.split_or_fail(todo, &t, degenerate);
+        let layout = match std::mem::replace(&mut t.start, Start::Anew) {
+            // Laid to decide, its cuts already those of a disk.
+            Start::Laid(uv, s) => Ok(Layout::Laid(uv, s)),
+            start => {
+                let Some(cuts) = self.disk(&t.faces, &t.cuts) else {
+                    return self.split_or_fail(todo, &t, degenerate);
+                };
+                t.cuts = cuts;
+                match start {
+                    Start::Within(whole) => self.lay_from(&t.faces, &t.cuts, Some(&whole)),
+                    _ => self.lay(&t.faces, &t.cuts),
+                }
+            }
         };
-        t.cuts = cuts;
         let nf = self.mesh.faces.len();
-        let layout = self.lay(&t.faces, &t.cuts).map_err(|e| match e {
+        let layout = layout.map_err(|e| match e {
             param::ParamError::Degenerate { face, .. } => degenerate(face.min(nf - 1)),
             _ => degenerate(t.faces[0]),
         })?;
@@ -420,7 +566,7 @@ impl Charts<'_> {
                     return Ok(());
                 }
             }
-            if stretch.flipped > 0 && self.split_in_two(todo, &t, t.splits) {
+            if stretch.flipped > 0 && self.split_in_two(todo, &t, t.splits, whole(&t, &uv)) {
                 return Ok(());
             }
         }
@@ -462,13 +608,14 @@ impl Charts<'_> {
         t: &Todo,
         degenerate: &Degenerate<'_>,
     ) -> Result<(), FlattenError> {
-        if t.faces.len() == 1 || !self.split_in_two(todo, t, t.splits) {
+        if t.faces.len() == 1 || !self.split_in_two(todo, t, t.splits, None) {
             return Err(degenerate(t.faces[0]));
         }
         Ok(())
     }
 
-    /// Push the two halves of a chart (cuts kept where they fall inside a half).
+    /// Push the two halves of a chart (cuts kept where they fall inside a half), each to
+    /// start from the `whole` chart's layout when there is one.
     fn push_halves(
         &self,
         todo: &mut Vec<Todo>,
@@ -476,30 +623,40 @@ impl Charts<'_> {
         b: Vec<usize>,
         t: &Todo,
         splits: usize,
+        whole: Option<Arc<Whole>>,
     ) {
         let (ca, cb) = (self.cuts_within(&a, &t.cuts), self.cuts_within(&b, &t.cuts));
+        let start = || whole.clone().map_or(Start::Anew, Start::Within);
         todo.push(Todo {
             faces: b,
             splits,
             cuts: cb,
             cut_off: false,
+            start: start(),
         });
         todo.push(Todo {
             faces: a,
             splits,
             cuts: ca,
             cut_off: false,
+            start: start(),
         });
     }
 
-    /// Push the halves of a chart split along the bisector of its two most distant faces;
-    /// false when it does not split.
-    fn split_in_two(&self, todo: &mut Vec<Todo>, t: &Todo, splits: usize) -> bool {
+    /// Push the halves of a chart split along the bisector of its two most distant faces
+    /// (see [`Charts::push_halves`]); false when it does not split.
+    fn split_in_two(
+        &self,
+        todo: &mut Vec<Todo>,
+        t: &Todo,
+        splits: usize,
+        whole: Option<Arc<Whole>>,
+    ) -> bool {
         let (a, b) = bisect(self.graph, &t.faces);
         if a.is_empty() || b.is_empty() {
             return false;
         }
-        self.push_halves(todo, a, b, t, splits);
+        self.push_halves(todo, a, b, t, splits, whole);
         true
     }
 
@@ -516,13 +673,14 @@ impl Charts<'_> {
         eps: f64,
     ) -> bool {
         // A chart cut open into a disk (a tube) is halved instead, as a whole.
-        if !t.cuts.is_empty() && self.split_in_two(todo, t, t.splits) {
+        if !t.cuts.is_empty() && self.split_in_two(todo, t, t.splits, None) {
             return true;
         }
         // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
         let pairs = overlaps(uv, eps, OVERLAP_PAIRS);
         let (fx, fy) = (t.faces[x], t.faces[y]);
-        if let Some((rest, parts)) = cut_off(self, &t.faces, &t.cuts, &[fx], &[fy], &pairs, uv, eps)
+        if let Some((rest, parts)) =
+            cut_off(self, &t.faces, &t.cuts, &[fx], &[fy], &pairs, uv, eps, true)
         {
             let area = |fs: &[usize]| fs.iter().map(|&f| self.graph.area[f]).sum::<f64>();
             let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
@@ -533,6 +691,7 @@ impl Charts<'_> {
                         splits: t.splits,
                         cuts: p.cuts,
                         cut_off: true,
+                        start: Start::Laid(p.uv, p.stretch),
                     });
                 }
                 todo.push(Todo {
@@ -540,13 +699,14 @@ impl Charts<'_> {
                     splits: t.splits,
                     cuts: rest.cuts,
                     cut_off: t.cut_off,
+                    start: Start::Laid(rest.uv, rest.stretch),
                 });
                 return true;
             }
         }
         let (a, b) = split_between(self.graph, &t.faces, t.faces[x], t.faces[y]);
         if !a.is_empty() && !b.is_empty() {
-            self.push_halves(todo, a, b, t, t.splits);
+            self.push_halves(todo, a, b, t, t.splits, whole(t, uv));
             return true;
         }
         false
@@ -567,6 +727,8 @@ impl Charts<'_> {
         done: &mut Vec<Laid>,
     ) -> Result<(), FlattenError> {
         let inherited = t.cuts.clone();
+        // The layout the halves of a split start from (before darts: they get their own).
+        let first = (stretch.l2 > opts.tolerance).then(|| whole(&t, &uv));
         let mut laid = Laid {
             faces: t.faces,
             cuts: t.cuts,
@@ -592,8 +754,9 @@ impl Charts<'_> {
                 splits: t.splits,
                 cuts: inherited,
                 cut_off: t.cut_off,
+                start: Start::Anew,
             };
-            if self.split_in_two(todo, &t, t.splits + 1) {
+            if self.split_in_two(todo, &t, t.splits + 1, first.flatten()) {
                 return Ok(());
             }
             laid.faces = t.faces;
@@ -652,24 +815,37 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
         let mut todo = Vec::new();
         let mut keep = Vec::with_capacity(done.len());
         for mut l in done.drain(..) {
-            if l.stretch.l2 <= opts.tolerance {
+            if l.stretch.l2 <= opts.tolerance && ctx.seam_error(&l) <= opts.seam_tolerance {
                 keep.push(l);
                 continue;
             }
-            if let Ok(Layout::Laid(uv, s)) = all.lay(&l.faces, &l.cuts) {
-                if s.flipped <= l.stretch.flipped && self_overlap(&uv, overlap_eps).is_none() {
-                    (l.uv, l.stretch) = (uv, s);
-                    keep.push(l);
+            let whole = Whole::new(&l.faces, &l.uv);
+            if let Ok(Layout::Laid(uv, s)) = all.lay_from(&l.faces, &l.cuts, Some(&whole)) {
+                let (faces, cuts) = (std::mem::take(&mut l.faces), std::mem::take(&mut l.cuts));
+                let matched = Laid {
+                    faces,
+                    cuts,
+                    uv,
+                    stretch: s,
+                    gusset: l.gusset,
+                };
+                if s.flipped <= l.stretch.flipped
+                    && ctx.seam_error(&matched) <= opts.seam_tolerance
+                    && self_overlap(&matched.uv, overlap_eps).is_none()
+                {
+                    keep.push(matched);
                     continue;
                 }
+                (l.faces, l.cuts) = (matched.faces, matched.cuts);
             }
             let t = Todo {
                 faces: l.faces.clone(),
                 splits: opts.max_splits,
                 cuts: l.cuts.clone(),
                 cut_off: false,
+                start: Start::Anew,
             };
-            if l.faces.len() < 2 || !ctx.split_in_two(&mut todo, &t, opts.max_splits) {
+            if l.faces.len() < 2 || !ctx.split_in_two(&mut todo, &t, opts.max_splits, Some(whole)) {
                 keep.push(l);
             }
         }

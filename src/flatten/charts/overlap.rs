@@ -8,10 +8,11 @@
 //! faces go to the side of the pair they are nearer to through the opened chart (ties to the
 //! first); at most 8 rounds of cutting off.
 
-use super::{Charts, FlattenOptions, Laid, Layout};
+use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::geom::polygon;
 use crate::geom::proxy;
 use glam::DVec2;
+use std::sync::Arc;
 
 /// Two faces (indices into `uv`) of one chart's layout that overlap deeper than `eps`, if
 /// any.
@@ -79,12 +80,14 @@ pub(super) fn cut_off(
     pairs: &[(usize, usize)],
     uv: &[Vec<DVec2>],
     eps: f64,
+    warm: bool,
 ) -> Option<(Laid, Vec<Laid>)> {
     let within = Within::new(ctx, faces, cuts);
     let mut sides = Sides::new(&within, a, b);
     let mut off = sides.first_cut(faces, pairs, uv, ctx.mesh.faces.len());
-    let rest = within.rest(&sides, &mut off, eps)?;
-    let pieces = within.pieces(&off, eps)?;
+    let whole = warm.then(|| Whole::new(faces, uv));
+    let rest = within.rest(&sides, &mut off, whole.clone(), eps)?;
+    let pieces = within.pieces(&off, whole.as_deref(), eps)?;
     Some((rest, pieces))
 }
 
@@ -168,7 +171,13 @@ impl<'a> Within<'a> {
     /// The rest of the chart once the faces `off` are cut off: its largest connected part,
     /// laid flat; while it still overlaps, its overlapping faces on the side cut off go too
     /// (at most 8 rounds). `None` when it cannot be laid flat without a flip or an overlap.
-    fn rest(&self, sides: &Sides, off: &mut [bool], eps: f64) -> Option<Laid> {
+    fn rest(
+        &self,
+        sides: &Sides,
+        off: &mut [bool],
+        mut whole: Option<Arc<Whole>>,
+        eps: f64,
+    ) -> Option<Laid> {
         let (ctx, faces, cuts) = (self.ctx, self.faces, self.cuts);
         let nf = off.len();
         for _ in 0..8 {
@@ -202,7 +211,7 @@ impl<'a> Within<'a> {
                 return None;
             }
             let rc = ctx.disk(&rest, &ctx.cuts_within(&rest, cuts))?;
-            let Ok(Layout::Laid(ruv, rs)) = ctx.lay(&rest, &rc) else {
+            let Ok(Layout::Laid(ruv, rs)) = ctx.lay_from(&rest, &rc, whole.as_deref()) else {
                 return None;
             };
             if rs.flipped > 0 {
@@ -217,6 +226,10 @@ impl<'a> Within<'a> {
                     stretch: rs,
                     gusset: false,
                 });
+            }
+            // The next round starts from this one's layout.
+            if whole.is_some() {
+                whole = Some(Whole::new(&rest, &ruv));
             }
             let mut grew = false;
             for (x, y) in more {
@@ -237,7 +250,7 @@ impl<'a> Within<'a> {
 
     /// The faces cut off, by connected piece (face order: ascending), each laid flat (cut
     /// into a disk where needed); `None` when one flips or overlaps itself.
-    fn pieces(&self, off: &[bool], eps: f64) -> Option<Vec<Laid>> {
+    fn pieces(&self, off: &[bool], whole: Option<&Whole>, eps: f64) -> Option<Vec<Laid>> {
         let (ctx, cuts) = (self.ctx, self.cuts);
         let mut seen = vec![false; off.len()];
         let mut pieces = Vec::new();
@@ -248,7 +261,7 @@ impl<'a> Within<'a> {
             let mut comp = self.flood(f0, off, &mut seen);
             comp.sort_unstable();
             let pc = ctx.disk(&comp, &ctx.cuts_within(&comp, cuts))?;
-            let Ok(Layout::Laid(puv, ps)) = ctx.lay(&comp, &pc) else {
+            let Ok(Layout::Laid(puv, ps)) = ctx.lay_from(&comp, &pc, whole) else {
                 return None;
             };
             if ps.flipped > 0 || (comp.len() > 1 && self_overlap(&puv, eps).is_some()) {
@@ -344,7 +357,12 @@ pub(super) fn merge_into(
     let Some(cuts) = ctx.disk(&faces, &both_cuts(&done[k], &done[part])) else {
         return false;
     };
-    let Ok(Layout::Laid(uv, s)) = ctx.lay(&faces, &cuts) else {
+    // Started from the two layouts as they lie, one moved onto the other.
+    let laid = match super::join::moved_onto(ctx, done, k, part) {
+        Some(j) => ctx.lay_from(&faces, &cuts, Some(&Whole::new(&j.faces, &j.uv))),
+        None => ctx.lay(&faces, &cuts),
+    };
+    let Ok(Layout::Laid(uv, s)) = laid else {
         return false;
     };
     if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {

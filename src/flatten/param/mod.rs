@@ -55,13 +55,16 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
-use glam::{DMat2, DVec2, DVec3};
+use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
 mod abf;
 mod seams;
+mod stretch;
 
 use abf::abf_angles;
+use stretch::minimise_stretch;
+
 pub use seams::match_seams;
 
 /// Smallest triangle angle accepted (radians).
@@ -830,11 +833,8 @@ pub fn parameterize(
 /// Sweeps of the stretch minimisation that `Best` runs on the kept layout.
 pub(crate) const STRETCH_SWEEPS: usize = 60;
 
-/// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4) from a flip-free layout: a
-/// nonlinear Gauss–Seidel over the vertices, each moved by a backtracking line search down the
-/// gradient of the whole chart's scale-free L2 stretch, E = (Σ A₃·(a + c)) · (Σ A₂) (the L2²
-/// of [`distortion::stretch`] up to a constant). A move that would flip or collapse a triangle
-/// is refused, so the result stays flip-free, and E never increases.
+/// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4, [`stretch`]) from a
+/// flip-free layout: it stays flip-free, and its L2 stretch never increases.
 fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> ChartParam {
     if start.stretch.flipped > 0 {
         return start.clone();
@@ -847,6 +847,41 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
     }
 }
 
+/// The chart of `faces` laid out from `start` (a position per face corner, counter-clockwise:
+/// a larger chart's layout restricted to these faces, or this chart's own) by the sweeps of
+/// [`refine`], without laying it anew: the start is already near the chart's optimum, so the
+/// sweeps stop early. `None` when `start` is not a layout of this chart (the corners of one
+/// vertex apart, a flipped or collapsed triangle) or the chart is refused; the caller then
+/// lays it anew ([`parameterize`]).
+pub fn relax_from(
+    mesh: &Mesh,
+    faces: &[usize],
+    method: ParamMethod,
+    start: &[Vec<DVec2>],
+) -> Option<ChartParam> {
+    let chart = build_chart(mesh, faces).ok()?;
+    if start.len() != chart.corners.len() {
+        return None;
+    }
+    let mut uv: Vec<Option<DVec2>> = vec![None; chart.pos.len()];
+    for (cs, pts) in chart.corners.iter().zip(start) {
+        if cs.len() != pts.len() {
+            return None;
+        }
+        for (&v, &p) in cs.iter().zip(pts) {
+            match uv[v] {
+                Some(q) if q.distance(p) > 1e-9 * (1.0 + q.length()) => return None,
+                Some(_) => {}
+                _ => uv[v] = Some(p),
+            }
+        }
+    }
+    let uv: Vec<DVec2> = uv.into_iter().collect::<Option<_>>()?;
+    let nv = uv.len();
+    let uv = minimise_stretch(&chart, uv, &vec![false; nv], STRETCH_SWEEPS)?;
+    Some(finish(mesh, faces, &chart, method, uv))
+}
+
 /// A layout per chart face corner as one position per local vertex.
 fn vertex_uv(chart: &Chart, face_uv: &[Vec<DVec2>]) -> Vec<DVec2> {
     let mut uv = vec![DVec2::ZERO; chart.pos.len()];
@@ -856,131 +891,6 @@ fn vertex_uv(chart: &Chart, face_uv: &[Vec<DVec2>]) -> Vec<DVec2> {
         }
     }
     uv
-}
-
-/// The sweeps of [`refine`] on a flip-free layout `uv` (per local vertex), the vertices marked
-/// `fixed` left where they are, at most `sweeps` sweeps; `None` when `uv` has a flipped or
-/// collapsed triangle.
-fn minimise_stretch(
-    chart: &Chart,
-    mut uv: Vec<DVec2>,
-    fixed: &[bool],
-    sweeps: usize,
-) -> Option<Vec<DVec2>> {
-    let nv = chart.pos.len();
-    let shapes = shapes_from_3d(chart);
-    // Per triangle: 3D edge matrix in its own plane, 3D area.
-    let q: Vec<DMat2> = shapes
-        .iter()
-        .map(|s| DMat2::from_cols(s[1] - s[0], s[2] - s[0]))
-        .collect();
-    let a3: Vec<f64> = q.iter().map(|m| 0.5 * m.determinant()).collect();
-    let mut vt: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nv];
-    for (t, tri) in chart.tris.iter().enumerate() {
-        for (c, &v) in tri.iter().enumerate() {
-            vt[v].push((t, c));
-        }
-    }
-    // (A₃·f, A₂) of a triangle with the given flat corners; None if not positive.
-    let term = |t: usize, p: [DVec2; 3]| -> Option<(f64, f64)> {
-        let pm = DMat2::from_cols(p[1] - p[0], p[2] - p[0]);
-        let det = pm.determinant();
-        if !(det > 0.0 && det.is_finite()) {
-            return None;
-        }
-        let g = q[t] * pm.inverse();
-        let f = g.x_axis.length_squared() + g.y_axis.length_squared();
-        Some((a3[t] * f, 0.5 * det))
-    };
-    let corners = |t: usize, uv: &[DVec2]| chart.tris[t].map(|v| uv[v]);
-    let totals = |uv: &[DVec2]| -> Option<(f64, f64)> {
-        let (mut s, mut a) = (0.0, 0.0);
-        for t in 0..chart.tris.len() {
-            let (x, y) = term(t, corners(t, uv))?;
-            s += x;
-            a += y;
-        }
-        Some((s, a))
-    };
-    let (mut s_tot, mut a_tot) = totals(&uv)?;
-    let e0 = s_tot * a_tot;
-    let mut e_prev = e0;
-    for _sweep in 0..sweeps {
-        for v in (0..nv).filter(|&v| !fixed[v]) {
-            // Local sums and gradient.
-            let (mut s_loc, mut a_loc) = (0.0, 0.0);
-            let (mut gs, mut ga) = (DVec2::ZERO, DVec2::ZERO);
-            let mut reach = f64::INFINITY;
-            for &(t, c) in &vt[v] {
-                let p = corners(t, &uv);
-                let pm = DMat2::from_cols(p[1] - p[0], p[2] - p[0]);
-                let m = pm.inverse();
-                let det = pm.determinant();
-                let g = q[t] * m;
-                s_loc += a3[t] * (g.x_axis.length_squared() + g.y_axis.length_squared());
-                a_loc += 0.5 * det;
-                let h = m * g.transpose() * g;
-                let dfdp = h.transpose() * (-2.0 * a3[t]);
-                let dadp = m.transpose() * (0.5 * det);
-                let pick = |d: DMat2| match c {
-                    1 => d.x_axis,
-                    2 => d.y_axis,
-                    _ => -(d.x_axis + d.y_axis),
-                };
-                gs += pick(dfdp);
-                ga += pick(dadp);
-                reach = reach.min(
-                    p[(c + 1) % 3]
-                        .distance(p[c])
-                        .min(p[(c + 2) % 3].distance(p[c])),
-                );
-            }
-            let (s_rest, a_rest) = (s_tot - s_loc, a_tot - a_loc);
-            let e_here = s_tot * a_tot;
-            let grad = gs * a_tot + ga * s_tot;
-            let gl = grad.length();
-            if !(gl > 0.0 && gl.is_finite()) {
-                continue;
-            }
-            let dir = -grad / gl;
-            let mut step = 0.5 * reach;
-            let old = uv[v];
-            for _ in 0..12 {
-                uv[v] = old + dir * step;
-                let mut ok = true;
-                let (mut s_new, mut a_new) = (0.0, 0.0);
-                for &(t, _) in &vt[v] {
-                    match term(t, corners(t, &uv)) {
-                        Some((x, y)) => {
-                            s_new += x;
-                            a_new += y;
-                        }
-                        None => {
-                            ok = false;
-                            break;
-                        }
-                    }
-                }
-                if ok && (s_rest + s_new) * (a_rest + a_new) < e_here {
-                    s_tot = s_rest + s_new;
-                    a_tot = a_rest + a_new;
-                    break;
-                }
-                uv[v] = old;
-                step *= 0.5;
-            }
-        }
-        // Fresh sums (no drift), and stop when a sweep gains little.
-        let (s, a) = totals(&uv)?;
-        s_tot = s;
-        a_tot = a;
-        let e = s * a;
-        if e > e_prev * (1.0 - 1e-5) {
-            break;
-        }
-        e_prev = e;
-    }
-    Some(uv)
 }
 
 #[cfg(test)]

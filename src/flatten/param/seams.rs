@@ -18,6 +18,11 @@
 //!   turn to where its edges can have their length, a stiff one then makes the lengths exact
 //!   (a residual of about the inner force divided by W).
 //! - The start is the parameteriser's result (conformal, then stretch-minimised), already close.
+//! - A relaxation that flips a triangle (a boundary edge pulled across its neighbours) is
+//!   taken only partway, as far as nothing flips (halving from half the way, six times at
+//!   most), and relaxed again from there ([`ATTEMPTS`] relaxations at most): the boundary
+//!   comes nearer its lengths each time, and a chart whose lengths cannot all be had without a
+//!   flip keeps the nearest flip-free layout.
 //! - The result is kept only if it flips no triangle the start did not and its boundary is
 //!   nearer the 3D lengths; else the start is returned as it was. A chart whose boundary is
 //!   within [`EXACT`] of its 3D lengths is returned at once (an exactly developable chart).
@@ -37,6 +42,8 @@ pub(crate) const WEIGHTS: [f64; 3] = [1.0, 100.0, 1e5];
 pub(crate) const ITERATIONS: usize = 12;
 /// Sweeps of the stretch minimisation inside the matched boundary.
 pub(crate) const SWEEPS: usize = 15;
+/// Relaxations at most, each from partway to where the last one flipped a triangle.
+pub(crate) const ATTEMPTS: usize = 4;
 /// Largest relative difference between a boundary edge's flat and 3D length left alone.
 pub(crate) const EXACT: f64 = 1e-7;
 
@@ -80,9 +87,38 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
             })
         })
         .collect();
-    let Some(relaxed) = relax(&chart.tris, &shapes, &cots, &edges, uv.clone()) else {
-        return start.clone();
+    // Where the relaxed layout flips a triangle, the next attempt starts partway there.
+    let flips = |uv: &[DVec2]| {
+        chart
+            .tris
+            .iter()
+            .filter(|t| (uv[t[1]] - uv[t[0]]).perp_dot(uv[t[2]] - uv[t[0]]) <= 0.0)
+            .count()
     };
+    let allowed = flips(&uv);
+    let mut from = uv.clone();
+    for _ in 0..ATTEMPTS {
+        let Some(r) = relax(&chart.tris, &shapes, &cots, &edges, from.clone()) else {
+            break;
+        };
+        if flips(&r) <= allowed {
+            from = r;
+            break;
+        }
+        let partway = (1..=6).map(|j| 0.5f64.powi(j)).find_map(|t| {
+            let p: Vec<DVec2> = from
+                .iter()
+                .zip(&r)
+                .map(|(&a, &b)| a + (b - a) * t)
+                .collect();
+            (flips(&p) <= allowed).then_some(p)
+        });
+        match partway {
+            Some(p) => from = p,
+            None => break,
+        }
+    }
+    let relaxed = from;
     // The inside relaxed to the least L2 stretch the matched boundary allows.
     let relaxed =
         minimise_stretch(&chart, relaxed.clone(), &chart.boundary, SWEEPS).unwrap_or(relaxed);

@@ -1,0 +1,132 @@
+//! Two laid pieces as one layout, one moved rigidly onto the other along their common
+//! boundary: what [`super::merge`] joins without laying anything out again (`attach`), and
+//! where a merge laid out again starts from ([`super::overlap::merge_into`]).
+//!
+//! Choices: the rigid motion is the least-squares fit of the common vertices (2D Kabsch, no
+//! scaling: both layouts have their 3D size); a corner of the moved piece within twice the
+//! worst misfit of the vertex it stands for is put where the other piece has that vertex, so
+//! the two share their common vertices exactly.
+
+use super::{Charts, Laid};
+use glam::DVec2;
+use std::collections::HashMap;
+
+/// Two laid pieces as one layout, one moved onto the other ([`moved_onto`]).
+pub(super) struct Joined {
+    /// The faces of both, `done[k]`'s first.
+    pub faces: Vec<usize>,
+    /// Their layout: `done[k]`'s as it lies, `done[part]`'s moved.
+    pub uv: Vec<Vec<DVec2>>,
+    /// Common edges, their mesh vertices, their length.
+    pub edges: usize,
+    pub verts: usize,
+    pub length: f64,
+    /// Farthest a common vertex of `done[part]` ends from where `done[k]` has it.
+    pub worst: f64,
+}
+
+/// `done[part]`'s layout moved onto `done[k]`'s by the rigid motion that best fits their
+/// common boundary ([`fit`]), each corner of `done[part]` within twice the worst misfit of a
+/// common vertex put where `done[k]` has that vertex; `None` when they share no edge, or a
+/// common vertex is in two places in `done[k]`.
+pub(super) fn moved_onto(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Option<Joined> {
+    let in_k: HashMap<usize, usize> = done[k]
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| (f, i))
+        .collect();
+    // The common edges: each end as `part` has it and where `done[k]` has it.
+    let mut pairs: Vec<(DVec2, DVec2)> = Vec::new();
+    let mut at: HashMap<usize, DVec2> = HashMap::new();
+    let (mut edges, mut length) = (0usize, 0.0);
+    for (pi, &f) in done[part].faces.iter().enumerate() {
+        let n = ctx.mesh.faces[f].verts.len();
+        for i in 0..n {
+            let e = &ctx.topo.edges[ctx.topo.face_edges[f][i]];
+            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
+                continue;
+            };
+            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
+                continue;
+            };
+            let m = ctx.mesh.faces[g].verts.len();
+            let (a, b) = (
+                ctx.mesh.faces[f].verts[i],
+                ctx.mesh.faces[f].verts[(i + 1) % n],
+            );
+            let here = [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]];
+            // The edge runs the other way round in `g`.
+            let there = [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]];
+            for (v, (p, q)) in [a, b].into_iter().zip(here.into_iter().zip(there)) {
+                match at.get(&v) {
+                    Some(old) if old.distance(q) > 1e-9 * (1.0 + q.length()) => return None,
+                    Some(_) => {}
+                    None => {
+                        at.insert(v, q);
+                        pairs.push((p, q));
+                    }
+                }
+            }
+            edges += 1;
+            length += ctx.mesh.vertices[a].distance(ctx.mesh.vertices[b]);
+        }
+    }
+    if edges == 0 {
+        return None;
+    }
+    let (turn, shift) = fit(&pairs)?;
+    let moved = |p: DVec2| turn.rotate(p) + shift;
+    let worst = pairs
+        .iter()
+        .map(|&(p, q)| moved(p).distance(q))
+        .fold(0.0, f64::max);
+    let mut faces = done[k].faces.clone();
+    let mut uv = done[k].uv.clone();
+    for (&f, corners) in done[part].faces.iter().zip(&done[part].uv) {
+        let verts = &ctx.mesh.faces[f].verts;
+        faces.push(f);
+        uv.push(
+            verts
+                .iter()
+                .zip(corners)
+                .map(|(v, &p)| {
+                    let p = moved(p);
+                    match at.get(v) {
+                        Some(&q) if q.distance(p) <= 2.0 * worst + 1e-9 * (1.0 + q.length()) => q,
+                        _ => p,
+                    }
+                })
+                .collect(),
+        );
+    }
+    Some(Joined {
+        faces,
+        uv,
+        edges,
+        verts: at.len(),
+        length,
+        worst,
+    })
+}
+
+/// The rotation (as a unit complex number) and shift that best move the first points of
+/// `pairs` onto the second (least squares); `None` for fewer than two distinct points.
+fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
+    let n = pairs.len() as f64;
+    let cp = pairs.iter().map(|p| p.0).sum::<DVec2>() / n;
+    let cq = pairs.iter().map(|p| p.1).sum::<DVec2>() / n;
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for &(p, q) in pairs {
+        let (a, b) = (p - cp, q - cq);
+        dot += a.dot(b);
+        cross += a.perp_dot(b);
+    }
+    let r = DVec2::new(dot, cross);
+    let len = r.length();
+    if len <= 1e-300 || !len.is_finite() {
+        return None;
+    }
+    let turn = r / len;
+    Some((turn, cq - turn.rotate(cp)))
+}
