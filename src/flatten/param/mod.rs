@@ -1006,4 +1006,44 @@ mod tests {
             assert!((p.stretch.l2 - 1.0).abs() < 1e-12, "{:?}", p.stretch);
         }
     }
+
+    /// A layout resumed from a start: from the chart's own layout its stretch only goes
+    /// down; from a larger chart's layout restricted to half its faces (as a split's half
+    /// starts), the half comes out flip-free, no more stretched than that start, and within
+    /// 1e-3 of the half laid anew; a start that is not a layout of the chart (corners of one
+    /// vertex apart, a flipped triangle, a corner missing) is refused.
+    #[test]
+    fn relaxing_from_a_start_never_raises_stretch_and_refuses_a_start_that_does_not_fit() {
+        let m = bumpy_grid();
+        let faces: Vec<usize> = (0..m.faces.len()).collect();
+        let whole = parameterize(&m, &faces, ParamMethod::Best).expect("whole");
+        let again = relax_from(&m, &faces, ParamMethod::Best, &whole.uv).expect("again");
+        assert!(again.stretch.l2 <= whole.stretch.l2 + 1e-12);
+        assert_eq!(again.stretch.flipped, 0);
+        let half: Vec<usize> = (0..faces.len() / 2).collect();
+        let start: Vec<Vec<DVec2>> = half.iter().map(|&f| whole.uv[f].clone()).collect();
+        let from = distortion::stretch(&m, &half, &start);
+        let relaxed = relax_from(&m, &half, ParamMethod::Best, &start).expect("half");
+        let anew = parameterize(&m, &half, ParamMethod::Best).expect("half anew");
+        assert_eq!(relaxed.stretch.flipped, 0);
+        assert!(relaxed.stretch.l2 <= from.l2 + 1e-12);
+        assert!(
+            (relaxed.stretch.l2 - anew.stretch.l2).abs() < 1e-3,
+            "{} vs {}",
+            relaxed.stretch.l2,
+            anew.stretch.l2
+        );
+        // Corners of one vertex apart.
+        let mut apart = whole.uv.clone();
+        apart[0][0] += DVec2::new(0.01, 0.0);
+        assert!(relax_from(&m, &faces, ParamMethod::Best, &apart).is_none());
+        // A flipped triangle.
+        let mut mirrored = whole.uv.clone();
+        for c in mirrored[5].iter_mut() {
+            c.x = -c.x;
+        }
+        assert!(relax_from(&m, &[5], ParamMethod::Best, &mirrored[5..6]).is_none());
+        // A face without its layout.
+        assert!(relax_from(&m, &faces, ParamMethod::Best, &whole.uv[1..]).is_none());
+    }
 }
