@@ -289,7 +289,8 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
 /// more than the whole. The split now prefers, among partitions with the fewest parts, the one
 /// with fewest parts over the material's tolerance, and a part still over it is named in a
 /// warning of its surface (report.json) saying why. Knot1 in metal at 300 mm on A4 had three
-/// parts over L2 1.001 (1a, 8b, 11a); now one, with its warning.
+/// parts over L2 1.001 (1a, 8b, 11a); now one, with its warning. And its small pieces are
+/// merged, shared out or grafted: at most 2 are left under 1 % of the area.
 #[test]
 fn corpus_knot_in_metal_split_parts_stay_within_the_tolerance_or_say_why() {
     require_shared!();
@@ -310,11 +311,16 @@ fn corpus_knot_in_metal_split_parts_stay_within_the_tolerance_or_say_why() {
             over.push((p.name.clone(), s.l2));
         }
     }
+    let total: f64 = pieces.iter().map(|p| p.area).sum();
+    let small = pieces.iter().filter(|p| p.area < 0.01 * total).count();
     println!(
-        "knot1 metal: {} pieces, over L2 1.001: {over:?}",
+        "knot1 metal: {} pieces, {small} under 1 % of the area, over L2 1.001: {over:?}",
         pieces.len()
     );
     assert!(over.len() <= 1, "{over:?}");
+    // A small piece that fits no neighbour laid out as one is shared out with one
+    // (`merge::rebalance`: 277 + 16 faces become 96 + 197): 3 small pieces before, 2 now.
+    assert!(small <= 2, "{small} pieces under 1 % of the area");
     for (name, _) in &over {
         assert!(
             flat.surface

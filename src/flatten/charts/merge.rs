@@ -8,7 +8,10 @@
 //! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too;
 //! then another round, while the last one merged any (a piece that failed early may fit a
 //! neighbour a later merge has changed). The merged chart keeps the cuts of both (and more
-//! where it is not a disk).
+//! where it is not a disk). A small piece that no neighbour takes is shared out with one of
+//! its [`REBALANCE_TRIES`] nearest: the two are halved anew and kept as the halves when
+//! neither half is small and both keep the tolerance (`rebalance`; the count of pieces stays);
+//! else it is grafted onto its neighbours as they lie ([`graft`]).
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
@@ -26,8 +29,9 @@
 use super::exact::graft;
 use super::join::moved_onto;
 use super::overlap::{both_cuts, merge_into, self_overlap, Owners};
-use super::{Charts, FlattenOptions, Laid};
+use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
+use crate::geom::cut::bisect;
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
@@ -73,13 +77,25 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
             .into_iter()
             .take(MERGE_TRIES)
             .collect();
-        // Laid out again as one, else grafted onto the neighbours as they lie.
+        // Laid out again as one, else shared out with a neighbour, else grafted onto the
+        // neighbours as they lie.
         if let Some(k) = near
             .iter()
             .copied()
             .find(|&k| merge_into(ctx, done, k, si, opts, eps))
         {
             owners.absorb(done, k, si);
+        } else if let Some(k) = near
+            .iter()
+            .take(REBALANCE_TRIES)
+            .copied()
+            .find(|&k| rebalance(ctx, done, k, si, small, opts, eps))
+        {
+            for (p, l) in [(k, &done[k]), (si, &done[si])] {
+                for &f in &l.faces {
+                    owners.owner[f] = p;
+                }
+            }
         } else if let Some(took) = graft(ctx, done, &near, si, opts.tolerance, eps) {
             for (k, faces) in took {
                 for f in faces {
@@ -90,6 +106,66 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
         }
     }
     owners.drop_gone(done);
+}
+
+/// Neighbours a small piece is shared out with at most ([`rebalance`]).
+const REBALANCE_TRIES: usize = 2;
+
+/// Share the faces of a small piece `done[part]` and its neighbour `done[k]` out anew: the
+/// two as one chart are halved along the bisector of their two faces farthest apart
+/// ([`bisect`]), and each half laid out, starting from the two layouts joined
+/// ([`moved_onto`]). Kept, the halves becoming `done[k]` and `done[part]`, when neither half
+/// is under `small` in area and each is flip-free, without overlap, within the tolerance and
+/// with its seams matched; false, leaving both as they were, otherwise.
+fn rebalance(
+    ctx: &Charts,
+    done: &mut [Laid],
+    k: usize,
+    part: usize,
+    small: f64,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> bool {
+    let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
+    let mut faces = done[k].faces.clone();
+    faces.extend(&done[part].faces);
+    let (a, b) = bisect(ctx.graph, &faces);
+    if area(&a) < small || area(&b) < small {
+        return false;
+    }
+    let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
+    let cuts = both_cuts(&done[k], &done[part]);
+    let mut halves = Vec::with_capacity(2);
+    for half in [a, b] {
+        let Some(hc) = ctx.disk(&half, &ctx.cuts_within(&half, &cuts)) else {
+            return false;
+        };
+        let Ok(Layout::Laid(uv, s)) = ctx.lay_from(&half, &hc, joined.as_deref()) else {
+            return false;
+        };
+        let laid = Laid {
+            faces: half,
+            cuts: hc,
+            uv,
+            stretch: s,
+            gusset: false,
+        };
+        if s.flipped > 0
+            || s.l2 > opts.tolerance
+            || ctx.seam_error(&laid) > opts.seam_tolerance
+            || self_overlap(&laid.uv, eps).is_some()
+        {
+            return false;
+        }
+        halves.push(laid);
+    }
+    let (hb, ha) = (halves.pop(), halves.pop());
+    if let (Some(ha), Some(hb)) = (ha, hb) {
+        done[k] = ha;
+        done[part] = hb;
+        return true;
+    }
+    false
 }
 
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).
