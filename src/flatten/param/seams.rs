@@ -158,6 +158,7 @@ fn relax(
     let n = uv.len();
     // The pinned vertex keeps its place softly: translation is free in the energy.
     let pin = edges.first().map_or(0, |e| e.0);
+    let mut symbolic: Option<SymbolicLlt<usize>> = None;
     for &w in &WEIGHTS {
         let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(tris.len() * 9);
         let mut add = |i: usize, j: usize, c: f64| {
@@ -175,8 +176,12 @@ fn relax(
         }
         trip.push(Triplet::new(pin, pin, 1.0));
         let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).ok()?;
-        let sym = SymbolicLlt::try_new(m.symbolic(), Side::Lower).ok()?;
-        let llt = Llt::try_new_with_symbolic(sym, m.as_ref(), Side::Lower).ok()?;
+        // Every weight has the same pattern: one ordering and symbolic factorisation.
+        let sym = match &symbolic {
+            Some(sym) => sym,
+            None => symbolic.insert(SymbolicLlt::try_new(m.symbolic(), Side::Lower).ok()?),
+        };
+        let llt = Llt::try_new_with_symbolic(sym.clone(), m.as_ref(), Side::Lower).ok()?;
         for _ in 0..ITERATIONS {
             let mut rhs = vec![DVec2::ZERO; n];
             for ((tri, s), c) in tris.iter().zip(shapes).zip(cots) {
