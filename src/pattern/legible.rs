@@ -374,18 +374,27 @@ impl Room {
         if !self.inside(q, within) {
             return 0.0;
         }
-        let (lo, hi) = (q - DVec2::splat(cap), q + DVec2::splat(cap));
+        // Boxes growing from 1/64 of `cap`: whatever is nearer than a box's half side meets
+        // the box, so the first box holding something that near gives the distance.
         let mut ids = std::mem::take(&mut self.scratch);
-        let mut d = cap;
-        self.grid.query(lo, hi, &mut ids);
-        for &k in &ids {
-            let (a, b) = self.segments[k as usize];
-            d = d.min(polygon::segment_distance(q, a, b));
-        }
-        self.text_grid.query(lo, hi, &mut ids);
-        for &k in &ids {
-            d = d.min(self.texts[k as usize].distance(q));
-        }
+        let mut r = cap / 64.0;
+        let d = loop {
+            r = (2.0 * r).min(cap);
+            let (lo, hi) = (q - DVec2::splat(r), q + DVec2::splat(r));
+            let mut d = cap;
+            self.grid.query(lo, hi, &mut ids);
+            for &k in &ids {
+                let (a, b) = self.segments[k as usize];
+                d = d.min(polygon::segment_distance(q, a, b));
+            }
+            self.text_grid.query(lo, hi, &mut ids);
+            for &k in &ids {
+                d = d.min(self.texts[k as usize].distance(q));
+            }
+            if d <= r || r >= cap || !r.is_finite() {
+                break d;
+            }
+        };
         self.scratch = ids;
         d
     }
