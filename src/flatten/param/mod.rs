@@ -37,7 +37,8 @@
 //!   raises L2 and never flips a triangle (a developable chart, already at 1.0, stays as it
 //!   is); `method` still names the conformal method it started from. It lowers L2 at the cost
 //!   of conformality (shear) and, on strongly curved charts, of L∞: `Lscm` and `Abf` give the
-//!   pure conformal layouts.
+//!   pure conformal layouts. [`relax_from`] runs the same minimisation from a given layout
+//!   (a part of a larger chart, as it lay in the whole) instead of laying the chart anew.
 //! - **Polygon faces** (more than 3 corners) are ear-clipped in their best-fit plane
 //!   (`distortion::face_triangles`); their `uv` is still one point per original corner.
 //! - **Refused** (a [`ParamError`] naming the face and its OBJ line): no faces, a face index out
