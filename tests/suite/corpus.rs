@@ -35,6 +35,19 @@ fn meshes() -> Vec<PathBuf> {
     v
 }
 
+/// `flatcut cut MESH --size 300 --material KIND`'s spec: the mesh at 300 mm, the material's
+/// default thickness.
+fn spec_at_300(mesh: &std::path::Path, kind: MaterialKind) -> Spec {
+    let mut spec = Spec::from_mesh(mesh);
+    spec.size = Some(300.0);
+    spec.material = Material {
+        kind,
+        thickness: kind.default_thickness(),
+        ..Material::default()
+    };
+    spec
+}
+
 /// What one run measured.
 struct Row {
     pieces: usize,
@@ -51,13 +64,7 @@ struct Row {
 fn run(mesh: &std::path::Path, kind: MaterialKind) -> Row {
     let what = format!("{} in {kind}", mesh.display());
     let start = Instant::now();
-    let mut spec = Spec::from_mesh(mesh);
-    spec.size = Some(300.0);
-    spec.material = Material {
-        kind,
-        thickness: kind.default_thickness(),
-        ..Material::default()
-    };
+    let spec = spec_at_300(mesh, kind);
     let (flats, pieces) =
         flatcut::pipeline::pieces(&spec, true).unwrap_or_else(|e| panic!("{what}: {e}"));
     for flat in &flats {
@@ -235,13 +242,10 @@ fn corpus_pieces_do_not_depend_on_the_size() {
 /// nest then refused it. Every part now fits the sheet in an orientation the nest tries.
 #[test]
 fn split_couplingdown_in_fabric_fits_every_part_on_a4() {
-    let mut spec = Spec::from_mesh(&shared_data("meshes/couplingdown.obj"));
-    spec.size = Some(300.0);
-    spec.material = Material {
-        kind: MaterialKind::Fabric,
-        thickness: MaterialKind::Fabric.default_thickness(),
-        ..Material::default()
-    };
+    let spec = spec_at_300(
+        &shared_data("meshes/couplingdown.obj"),
+        MaterialKind::Fabric,
+    );
     let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     let s = &spec.sheet;
     let room = flatcut::pattern::split::Room::inside(s.width, s.height, s.margin);
@@ -294,13 +298,7 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
 #[test]
 fn corpus_knot_in_metal_split_parts_stay_within_the_tolerance_or_say_why() {
     require_shared!();
-    let mut spec = Spec::from_mesh(&shared_data("meshes/knot1.obj"));
-    spec.size = Some(300.0);
-    spec.material = Material {
-        kind: MaterialKind::Metal,
-        thickness: MaterialKind::Metal.default_thickness(),
-        ..Material::default()
-    };
+    let spec = spec_at_300(&shared_data("meshes/knot1.obj"), MaterialKind::Metal);
     let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
     let flat = &flats[0];
     let mut over = Vec::new();

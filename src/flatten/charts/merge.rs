@@ -135,13 +135,10 @@ fn rebalance(
     }
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
     let cuts = both_cuts(&done[k], &done[part]);
-    let mut halves = Vec::with_capacity(2);
-    for half in [a, b] {
-        let Some(hc) = ctx.disk(&half, &ctx.cuts_within(&half, &cuts)) else {
-            return false;
-        };
+    let lay = |half: Vec<usize>| -> Option<Laid> {
+        let hc = ctx.disk(&half, &ctx.cuts_within(&half, &cuts))?;
         let Ok(Layout::Laid(uv, s)) = ctx.lay_from(&half, &hc, joined.as_deref()) else {
-            return false;
+            return None;
         };
         let laid = Laid {
             faces: half,
@@ -150,22 +147,21 @@ fn rebalance(
             stretch: s,
             gusset: false,
         };
-        if s.flipped > 0
-            || s.l2 > opts.tolerance
-            || ctx.seam_error(&laid) > opts.seam_tolerance
-            || self_overlap(&laid.uv, eps).is_some()
-        {
-            return false;
-        }
-        halves.push(laid);
-    }
-    let (hb, ha) = (halves.pop(), halves.pop());
-    if let (Some(ha), Some(hb)) = (ha, hb) {
-        done[k] = ha;
-        done[part] = hb;
-        return true;
-    }
-    false
+        (s.flipped == 0
+            && s.l2 <= opts.tolerance
+            && ctx.seam_error(&laid) <= opts.seam_tolerance
+            && self_overlap(&laid.uv, eps).is_none())
+        .then_some(laid)
+    };
+    let Some(ha) = lay(a) else {
+        return false;
+    };
+    let Some(hb) = lay(b) else {
+        return false;
+    };
+    done[k] = ha;
+    done[part] = hb;
+    true
 }
 
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).

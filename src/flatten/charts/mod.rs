@@ -818,22 +818,16 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
             }
             let whole = Whole::new(&l.faces, &l.uv);
             if let Ok(Layout::Laid(uv, s)) = all.lay_from(&l.faces, &l.cuts, Some(&whole)) {
-                let (faces, cuts) = (std::mem::take(&mut l.faces), std::mem::take(&mut l.cuts));
-                let matched = Laid {
-                    faces,
-                    cuts,
-                    uv,
-                    stretch: s,
-                    gusset: l.gusset,
-                };
-                if s.flipped <= l.stretch.flipped
-                    && ctx.seam_error(&matched) <= opts.seam_tolerance
-                    && self_overlap(&matched.uv, overlap_eps).is_none()
+                let was = (std::mem::replace(&mut l.uv, uv), l.stretch);
+                l.stretch = s;
+                if s.flipped <= was.1.flipped
+                    && ctx.seam_error(&l) <= opts.seam_tolerance
+                    && self_overlap(&l.uv, overlap_eps).is_none()
                 {
-                    keep.push(matched);
+                    keep.push(l);
                     continue;
                 }
-                (l.faces, l.cuts) = (matched.faces, matched.cuts);
+                (l.uv, l.stretch) = was;
             }
             let t = Todo {
                 faces: l.faces.clone(),
