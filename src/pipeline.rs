@@ -130,6 +130,12 @@ pub fn sized_surfaces(spec: &Spec) -> Result<Vec<crate::surface::Surface>, Error
     Ok(surfaces)
 }
 
+/// The room of the spec's sheet inside its margins.
+fn sheet_room(spec: &Spec) -> crate::pattern::split::Room {
+    let s = &spec.sheet;
+    crate::pattern::split::Room::inside(s.width, s.height, s.margin)
+}
+
 /// Surfaces → flats → pieces (after [`sized_surfaces`]).
 fn flatten_surfaces(
     spec: &Spec,
@@ -137,6 +143,7 @@ fn flatten_surfaces(
     quiet: bool,
 ) -> Result<(Vec<Flat>, Vec<Piece>), Error> {
     let mut flats = Vec::new();
+    let pattern = spec.pattern_options();
     for (surface, s) in surfaces.into_iter().zip(&spec.surfaces) {
         // Whatever its size came from, a surface lies within the range flatcut works in.
         plausible_surface(&surface).map_err(|e| {
@@ -158,9 +165,15 @@ fn flatten_surfaces(
                 eprintln!("flatcut: warning: {w}");
             }
         }
-        // Charted (smooth) surfaces are parameterised, the rest unfolded exactly.
+        // Charted (smooth) surfaces are parameterised, the rest unfolded exactly; pieces are
+        // not merged past what fits the sheet when pieces are split to fit it.
+        let room = match spec.pattern.split.unwrap_or_default() {
+            crate::pattern::split::Split::Auto => Some(sheet_room(spec).for_faces(&pattern)),
+            crate::pattern::split::Split::None => None,
+        };
         let opts = crate::flatten::charts::FlattenOptions {
             unfold: crate::flatten::UnfoldOptions::default(),
+            room,
             ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
         };
         let flat = crate::flatten::charts::flatten(surface, &opts)?;
@@ -176,13 +189,12 @@ fn flatten_surfaces(
         }
         flats.push(flat);
     }
-    let opts = spec.pattern_options();
+    let opts = pattern;
     let pieces =
         match spec.pattern.split.unwrap_or_default() {
             crate::pattern::split::Split::None => crate::pattern::build(&flats, &opts)?,
             crate::pattern::split::Split::Auto => {
-                let s = &spec.sheet;
-                let room = crate::pattern::split::Room::inside(s.width, s.height, s.margin);
+                let room = sheet_room(spec);
                 let before: Vec<usize> = flats.iter().map(|f| f.surface.warnings.len()).collect();
                 let pieces = crate::pattern::split::build_to_fit(&mut flats, &opts, &room)
                     .map_err(|e| Error::In {

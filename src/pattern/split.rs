@@ -81,6 +81,18 @@ impl Room {
         }
     }
 
+    /// The room a piece's faces may take before it is split: this room less, on every side,
+    /// what the material adds around them (tab height or seam allowance, half the kerf), as
+    /// [`build_to_fit`] estimates it; `[width, height]`, the height infinite on a roll. What
+    /// the flatten stage keeps a merge of two pieces within ([`crate::flatten::charts::FlattenOptions::room`]).
+    pub fn for_faces(&self, opts: &PatternOptions) -> [f64; 2] {
+        let grow = 2.0 * grow_estimate(opts);
+        [
+            self.width - grow,
+            self.height.map_or(f64::INFINITY, |h| h - grow),
+        ]
+    }
+
     /// Positive and finite (a roll's length aside): something can be placed at all.
     fn usable(&self) -> bool {
         self.width.is_finite()

@@ -86,8 +86,13 @@ fn fandisk_few_charts_near_isometric() {
         seg.count, seg.iterations, seg.added, seg.merged, seg.split, flat.islands.len(), s.l2, s.linf, s.shear_l2, s.flipped
     );
     check_flat(&flat);
-    assert!(flat.islands.len() <= 10, "{} pieces", flat.islands.len());
+    // Issue 20: at most 6 (the thesis: 4); pieces joined across its curved creases when they
+    // lie flat as one (`merge_laid`) bring it from 8 to 7.
+    assert!(flat.islands.len() <= 7, "{} pieces", flat.islands.len());
     assert!(s.l2 <= 1.001, "L2 {}", s.l2);
+    let (each, _) = fcharts::stretch(&flat);
+    let worst = each.iter().map(|p| p.l2).fold(1.0, f64::max);
+    assert!(worst <= 1.001, "worst piece L2 {worst}");
     assert_eq!(s.flipped, 0);
 }
 
@@ -1189,10 +1194,11 @@ fn torus_with_a_hole_and_genus_two_are_cut_into_disks() {
 
 /// Issue 20: a chart still over the material's tolerance once it may be split no further is
 /// laid out exactly (`charts::exact`). The saddle as one chart, with no split, dart or gusset
-/// allowed, was one piece over paper's L2 1.003 with a warning; laid out exactly every piece
-/// is isometric (each face's edges as long as in 3D) and nothing overlaps (deeper than the
+/// allowed, was one piece over paper's L2 1.003 with a warning; laid out exactly its pieces
+/// are isometric (each face's edges as long as in 3D) and nothing overlaps (deeper than the
 /// unfolder's tolerance, as in every exact unfolding); a saddle does not lie flat in one
-/// piece, so there are several.
+/// piece, so there are several. Neighbouring pieces that lie flat as one within a third of
+/// the tolerance are joined afterwards (`merge_laid`); at least half the faces stay exact.
 #[test]
 fn a_chart_that_cannot_be_split_further_is_laid_out_exactly() {
     let mesh = saddle(50.0, 30.0, 24);
@@ -1229,9 +1235,15 @@ fn a_chart_that_cannot_be_split_further_is_laid_out_exactly() {
         flat.surface.cuts.len()
     );
     assert!(flat.islands.len() > 1);
+    // Exact pieces, or two of them that lie flat as one well within the tolerance (a third
+    // of it: `merge_laid`).
     for (k, s) in per.iter().enumerate() {
-        assert!(s.l2 <= 1.0 + 1e-9 && s.flipped == 0, "piece {k}: {s:?}");
+        assert!(
+            s.l2 <= 1.0 + (tol - 1.0) / 3.0 && s.flipped == 0,
+            "piece {k}: {s:?}"
+        );
     }
+    let exact: Vec<bool> = per.iter().map(|s| s.l2 <= 1.0 + 1e-9).collect();
     assert!(
         flat.surface.warnings.is_empty(),
         "{:?}",
@@ -1239,7 +1251,12 @@ fn a_chart_that_cannot_be_split_further_is_laid_out_exactly() {
     );
     assert_eq!(flatcut::flatten::unfold::find_overlap(&flat), None);
     let m = &flat.surface.mesh;
+    let mut checked = 0;
     for (f, face) in m.faces.iter().enumerate() {
+        if !exact[flat.face_island[f]] {
+            continue;
+        }
+        checked += 1;
         let k = face.verts.len();
         for i in 0..k {
             let d3 = m.vertices[face.verts[i]].distance(m.vertices[face.verts[(i + 1) % k]]);
@@ -1247,6 +1264,8 @@ fn a_chart_that_cannot_be_split_further_is_laid_out_exactly() {
             assert!((d2 - d3).abs() <= 1e-9 * d3, "face {f}: {d2} vs {d3}");
         }
     }
+    println!("{checked} of {n} faces in pieces laid exactly");
+    assert!(2 * checked >= n, "{checked} of {n} faces laid exactly");
     assert_eq!(lay(true).face_2d, flat.face_2d, "same input, same output");
 }
 

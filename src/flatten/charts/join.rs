@@ -6,8 +6,13 @@
 //! scaling: both layouts have their 3D size); a corner of the moved piece within twice the
 //! worst misfit of the vertex it stands for is put where the other piece has that vertex, so
 //! the two share their common vertices exactly.
+//!
+//! Whether a merged layout fits the sheet ([`fits_room`]) is judged here too: a layout fits the
+//! room when the box of its minimum-area rectangle does, at a quarter turn (as the nest turns
+//! pieces; a grain line, which fixes the turn, is not known here).
 
 use super::{Charts, Laid};
+use crate::geom::polygon;
 use glam::DVec2;
 use std::collections::HashMap;
 
@@ -129,4 +134,19 @@ fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
     }
     let turn = r / len;
     Some((turn, cq - turn.rotate(cp)))
+}
+
+/// Whether a layout fits `room` (width, height; see [`super::FlattenOptions::room`]), if
+/// any: the box of its minimum-area rectangle, at a quarter turn.
+pub(super) fn fits_room(room: Option<[f64; 2]>, uv: &[Vec<DVec2>]) -> bool {
+    let Some(room) = room else {
+        return true;
+    };
+    let pts: Vec<DVec2> = uv.iter().flatten().copied().collect();
+    let turn = DVec2::from_angle(polygon::min_area_rect_angle(&pts));
+    let Some((lo, hi)) = polygon::bounds(pts.iter().map(|&p| turn.rotate(p))) else {
+        return true;
+    };
+    let size = hi - lo;
+    (size.x <= room[0] && size.y <= room[1]) || (size.y <= room[0] && size.x <= room[1])
 }

@@ -25,10 +25,22 @@
 //! the small pieces). Nothing is laid out again, so a failed join costs a pass over the two
 //! pieces. Pieces are tried smallest first, with the same neighbours as above, in rounds until
 //! none joins; a pair that failed is not tried again unless one of the two has grown since.
+//!
+//! Last, neighbouring pieces of any size are laid out again as one ([`merge_laid`]): across a
+//! curved fold the two sides are the same curve in 3D but not in the plane, so no rigid motion
+//! joins their layouts, yet the two as one may lie flat within the tolerance. A trial costs a
+//! layout (started from the two joined), so pairs are chosen by what decides it cheaply: the
+//! angle defects (discrete Gaussian curvature) of the vertices the merge makes interior, summed
+//! with their signs (a crease folded without stretch has none; a saw-tooth seam's ± cancel),
+//! least first, under [`LAID_DEFECT`]; the trials lay out at most [`LAID_BUDGET`] times the
+//! surface's faces. A merge is kept as `attach`'s are (within [`NEAR_SHARE`] of the tolerance)
+//! and, when the pieces are split to fit the sheet, only when the merged piece fits it
+//! ([`super::FlattenOptions::room`]): two pieces that each fit the sheet are better than one
+//! the split cuts up again, and two that do not are split apart all the same.
 
 use super::exact::graft;
-use super::join::moved_onto;
-use super::overlap::{both_cuts, merge_into, self_overlap, Owners};
+use super::join::{fits_room, moved_onto};
+use super::overlap::{both_cuts, laid_as_one, merge_into, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -228,4 +240,87 @@ fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps
         gusset: false,
     };
     true
+}
+
+/// Pairs [`merge_laid`] tries only when the angle defects of the vertices their merge makes
+/// interior sum to less than this (radians, either sign): more cannot lie flat as one.
+const LAID_DEFECT: f64 = 1.0;
+/// Faces [`merge_laid`]'s trials lay out in all, at most, as a multiple of the surface's.
+const LAID_BUDGET: usize = 2;
+
+/// Join neighbouring pieces of any size laid out again as one (see the module doc): pairs
+/// whose merge makes interior vertices of little angle defect in all, least first, each
+/// union started from the two layouts joined ([`laid_as_one`]) and kept when flip-free,
+/// without overlap, within [`NEAR_SHARE`] of the tolerance and with its seams matched.
+pub(super) fn merge_laid(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    let near = 1.0 + (opts.tolerance - 1.0) * NEAR_SHARE;
+    let defect = distortion::angle_defect(ctx.mesh);
+    let mut around = vec![0usize; ctx.mesh.vertices.len()];
+    for face in &ctx.mesh.faces {
+        for &v in &face.verts {
+            around[v] += 1;
+        }
+    }
+    let mut budget = LAID_BUDGET * ctx.mesh.faces.len();
+    let mut owners = Owners::new(ctx.mesh.faces.len(), done);
+    let mut failed = std::collections::HashSet::new();
+    'rounds: loop {
+        let mut pairs = Vec::new();
+        for si in (0..done.len()).filter(|&k| !owners.gone[k]) {
+            for k in owners.neighbours(ctx, done, si) {
+                // Each pair once, the larger piece keeping its place.
+                if (done[k].faces.len(), si) > (done[si].faces.len(), k) {
+                    let d = merged_defect(ctx, &defect, &around, &done[k], &done[si]);
+                    if d.abs() < LAID_DEFECT {
+                        pairs.push((d.abs(), k, si));
+                    }
+                }
+            }
+        }
+        pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        for (_, k, si) in pairs {
+            let key = (k, done[k].faces.len(), si, done[si].faces.len());
+            let size = done[k].faces.len() + done[si].faces.len();
+            if failed.contains(&key) || size > budget {
+                continue;
+            }
+            budget -= size;
+            let kept = laid_as_one(ctx, done, k, si).filter(|l| {
+                l.stretch.flipped == 0
+                    && l.stretch.l2 <= near
+                    && ctx.seam_error(l) <= opts.seam_tolerance
+                    && fits_room(opts.room, &l.uv)
+                    && self_overlap(&l.uv, eps).is_none()
+            });
+            if let Some(l) = kept {
+                done[k] = l;
+                owners.absorb(done, k, si);
+                continue 'rounds;
+            }
+            failed.insert(key);
+        }
+        break;
+    }
+    owners.drop_gone(done);
+}
+
+/// The sum of the angle defects (`defect`, per vertex) of the vertices that `a` and `b` share
+/// and that have all their faces (`around`, per vertex) in the two.
+fn merged_defect(ctx: &Charts, defect: &[f64], around: &[usize], a: &Laid, b: &Laid) -> f64 {
+    let mut count: std::collections::HashMap<usize, [usize; 2]> = Default::default();
+    for (side, l) in [a, b].into_iter().enumerate() {
+        for &f in &l.faces {
+            for &v in &ctx.mesh.faces[f].verts {
+                count.entry(v).or_default()[side] += 1;
+            }
+        }
+    }
+    let mut common: Vec<usize> = count
+        .into_iter()
+        .filter(|&(v, [x, y])| x > 0 && y > 0 && x + y == around[v])
+        .map(|(v, _)| v)
+        .collect();
+    // Summed in one order, for the same figure on every run.
+    common.sort_unstable();
+    common.iter().map(|&v| defect[v]).sum()
 }

@@ -75,7 +75,8 @@
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
 //! and without overlap (`merge`), else grafted onto its neighbours as they lie: its faces
-//! unfolded exactly onto their layouts (`exact::graft`).
+//! unfolded exactly onto their layouts (`exact::graft`). Then neighbouring pieces of any size
+//! are joined where they lie flat as one well within the tolerance (`merge`).
 //!
 //! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
 //! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
@@ -141,6 +142,11 @@ pub struct FlattenOptions {
     /// (issue 20: paper 0.2 %, metal 0.1 %, fabric 1 %), so that the two sides of a seam
     /// differ by at most that (default paper's, 0.001).
     pub seam_tolerance: f64,
+    /// The box (width, height in mm; the height infinite on a roll) a piece may take before
+    /// the pattern stage splits it to fit the sheet: two pieces that each fit it are not
+    /// merged into one that does not (at a quarter turn of its minimum-area rectangle, as the
+    /// nest places it). `None` (default): no limit.
+    pub room: Option<[f64; 2]>,
 }
 
 impl Default for FlattenOptions {
@@ -155,6 +161,7 @@ impl Default for FlattenOptions {
             exact: true,
             reattach_eta: 1e-3,
             seam_tolerance: seam_tolerance(MaterialKind::Paper),
+            room: None,
         }
     }
 }
@@ -802,6 +809,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     reattach(&ctx, &mut done, opts, overlap_eps);
     merge::merge_small(&ctx, &mut done, opts, overlap_eps);
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
+    merge::merge_laid(&ctx, &mut done, opts, overlap_eps);
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {

@@ -352,30 +352,40 @@ pub(super) fn merge_into(
     opts: &FlattenOptions,
     eps: f64,
 ) -> bool {
+    match laid_as_one(ctx, done, k, part) {
+        Some(l)
+            if l.stretch.flipped == 0
+                && l.stretch.l2 <= opts.tolerance
+                && self_overlap(&l.uv, eps).is_none() =>
+        {
+            done[k] = l;
+            true
+        }
+        _ => false,
+    }
+}
+
+/// `done[k]` and `done[part]` laid out as one chart (the cuts of both, more where the union
+/// is not a disk), started from the two layouts as they lie, one moved onto the other
+/// ([`super::join::moved_onto`]); `None` when it cannot be laid out. Not checked.
+pub(super) fn laid_as_one(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Option<Laid> {
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
-    let Some(cuts) = ctx.disk(&faces, &both_cuts(&done[k], &done[part])) else {
-        return false;
-    };
-    // Started from the two layouts as they lie, one moved onto the other.
+    let cuts = ctx.disk(&faces, &both_cuts(&done[k], &done[part]))?;
     let laid = match super::join::moved_onto(ctx, done, k, part) {
         Some(j) => ctx.lay_from(&faces, &cuts, Some(&Whole::new(&j.faces, &j.uv))),
         None => ctx.lay(&faces, &cuts),
     };
-    let Ok(Layout::Laid(uv, s)) = laid else {
-        return false;
+    let Ok(Layout::Laid(uv, stretch)) = laid else {
+        return None;
     };
-    if s.flipped > 0 || s.l2 > opts.tolerance || self_overlap(&uv, eps).is_some() {
-        return false;
-    }
-    done[k] = Laid {
+    Some(Laid {
         faces,
         cuts,
         uv,
-        stretch: s,
+        stretch,
         gusset: false,
-    };
-    true
+    })
 }
 
 /// The cuts of two charts merged into one (sorted).
