@@ -246,7 +246,7 @@ fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps
 /// interior sum to less than this (radians, either sign): more cannot lie flat as one.
 const LAID_DEFECT: f64 = 1.0;
 /// Faces [`merge_laid`]'s trials lay out in all, at most, as a multiple of the surface's.
-const LAID_BUDGET: usize = 2;
+const LAID_BUDGET: usize = 1;
 
 /// Join neighbouring pieces of any size laid out again as one (see the module doc): pairs
 /// whose merge makes interior vertices of little angle defect in all, least first, each
@@ -269,7 +269,9 @@ pub(super) fn merge_laid(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptio
         for si in (0..done.len()).filter(|&k| !owners.gone[k]) {
             for k in owners.neighbours(ctx, done, si) {
                 // Each pair once, the larger piece keeping its place.
-                if (done[k].faces.len(), si) > (done[si].faces.len(), k) {
+                if (done[k].faces.len(), si) > (done[si].faces.len(), k)
+                    && joined_l2(&done[k], &done[si]) <= near
+                {
                     let d = merged_defect(ctx, &defect, &around, &done[k], &done[si]);
                     if d.abs() < LAID_DEFECT {
                         pairs.push((d.abs(), k, si));
@@ -302,6 +304,18 @@ pub(super) fn merge_laid(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptio
         break;
     }
     owners.drop_gone(done);
+}
+
+/// The L2 stretch of `a` and `b` as they lie, as one: what their union laid out again has at
+/// least (its layout restricted to either is a layout of it, and each was laid out to
+/// stretch least), seam matching and the minimisation's own shortfall aside.
+fn joined_l2(a: &Laid, b: &Laid) -> f64 {
+    let (sa, sb) = (&a.stretch, &b.stretch);
+    let area = sa.area_3d + sb.area_3d;
+    if area <= 0.0 {
+        return f64::INFINITY;
+    }
+    ((sa.area_3d * sa.l2 * sa.l2 + sb.area_3d * sb.l2 * sb.l2) / area).sqrt()
 }
 
 /// The sum of the angle defects (`defect`, per vertex) of the vertices that `a` and `b` share
