@@ -15,6 +15,7 @@
 //!   (D-Charts), shared by the surface and flatten stages.
 //! - [`similarity`]: the least-squares similarity (scale, rotation, translation) between two
 //!   point sets and its residuals (print-and-cut registration).
+//! - [`sparse`]: compressed-column matrices assembled from triplets, for faer's Cholesky.
 //! - [`unionfind`], [`heap`]: disjoint sets and a smallest-first heap entry.
 //! - [`rng`]: the crate's one seeded random number generator.
 //! - [`par`]: fork–join over the machine's cores (a join, a map over independent jobs) whose
@@ -43,4 +44,5 @@ pub mod proxy;
 pub mod rng;
 pub mod segment;
 pub mod similarity;
+pub mod sparse;
 pub mod unionfind;

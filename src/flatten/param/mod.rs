@@ -54,7 +54,7 @@ use crate::geom::mesh::Mesh;
 use crate::geom::unionfind::UnionFind;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::Triplet;
 use faer::{Mat, Side};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -580,8 +580,11 @@ fn spd_solve(
     if n == 0 {
         return Ok(Vec::new());
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, triplets).map_err(|e| {
-        chart.solver_error(method, format!("cannot build the sparse system: {e:?}"))
+    let a = crate::geom::sparse::from_triplets(n, triplets).ok_or_else(|| {
+        chart.solver_error(
+            method,
+            "cannot build the sparse system: an index out of range",
+        )
     })?;
     // The ordering and symbolic factorisation depend on the pattern only: reuse them.
     let sym = match symbolic {

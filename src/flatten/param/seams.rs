@@ -32,7 +32,7 @@ use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::Triplet;
 use faer::{Mat, Side};
 use glam::DVec2;
 
@@ -175,7 +175,7 @@ fn relax(
             add(a, b, w);
         }
         trip.push(Triplet::new(pin, pin, 1.0));
-        let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip).ok()?;
+        let m = crate::geom::sparse::from_triplets(n, &trip)?;
         // Every weight has the same pattern: one ordering and symbolic factorisation.
         let sym = match &symbolic {
             Some(sym) => sym,
