@@ -150,3 +150,26 @@ pub(super) fn fits_room(room: Option<[f64; 2]>, uv: &[Vec<DVec2>]) -> bool {
     let size = hi - lo;
     (size.x <= room[0] && size.y <= room[1]) || (size.y <= room[0] && size.x <= room[1])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_layout_fits_the_room_at_a_quarter_turn_of_its_least_rectangle() {
+        // A 100 x 20 mm strip of two triangles, turned by 30°.
+        let turn = DVec2::from_angle(30f64.to_radians());
+        let p = [(0.0, 0.0), (100.0, 0.0), (100.0, 20.0), (0.0, 20.0)]
+            .map(|(x, y)| turn.rotate(DVec2::new(x, y)) + DVec2::new(7.0, -3.0));
+        let uv = vec![vec![p[0], p[1], p[2]], vec![p[0], p[2], p[3]]];
+        assert!(fits_room(None, &uv));
+        assert!(fits_room(Some([100.5, 20.5]), &uv));
+        assert!(fits_room(Some([20.5, 100.5]), &uv), "a quarter turn");
+        assert!(fits_room(Some([100.5, f64::INFINITY]), &uv), "a roll");
+        assert!(!fits_room(Some([99.5, 20.5]), &uv));
+        assert!(!fits_room(Some([100.5, 19.5]), &uv));
+        // Judged as the nest turns it (its least rectangle square to the sheet), not as it
+        // lies: its box as it lies is 96.6 x 67.3 mm.
+        assert!(!fits_room(Some([97.0, 68.0]), &uv));
+    }
+}
