@@ -83,8 +83,9 @@ impl Room {
 
     /// The room a piece's faces may take before it is split: this room less, on every side,
     /// what the material adds around them (tab height or seam allowance, half the kerf), as
-    /// [`build_to_fit`] estimates it; `[width, height]`, the height infinite on a roll. What
-    /// the flatten stage keeps a merge of two pieces within ([`crate::flatten::charts::FlattenOptions::room`]).
+    /// [`build_to_fit`] estimates it; `[width, height]`, the height infinite on a roll. The
+    /// flatten stage merges no two pieces into one larger than that
+    /// ([`crate::flatten::charts::FlattenOptions::room`]).
     pub fn for_faces(&self, opts: &PatternOptions) -> [f64; 2] {
         let grow = 2.0 * grow_estimate(opts);
         [

@@ -35,8 +35,8 @@
 //! least first, under [`LAID_DEFECT`]; the trials lay out at most [`LAID_BUDGET`] times the
 //! surface's faces. A merge is kept as `attach`'s are (within [`NEAR_SHARE`] of the tolerance)
 //! and, when the pieces are split to fit the sheet, only when the merged piece fits it
-//! ([`super::FlattenOptions::room`]): two pieces that each fit the sheet are better than one
-//! the split cuts up again, and two that do not are split apart all the same.
+//! ([`super::FlattenOptions::room`]): a piece larger than the sheet is cut up again by the
+//! split, along lines that follow no feature, into more parts than the two pieces were.
 
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
@@ -243,7 +243,8 @@ fn attach(ctx: &Charts, done: &mut [Laid], k: usize, part: usize, near: f64, eps
 }
 
 /// Pairs [`merge_laid`] tries only when the angle defects of the vertices their merge makes
-/// interior sum to less than this (radians, either sign): more cannot lie flat as one.
+/// interior sum to less than this (radians, either sign): a bound on the trials; whether a
+/// pair lies flat as one is the layout's to say.
 const LAID_DEFECT: f64 = 1.0;
 /// Faces [`merge_laid`]'s trials lay out in all, at most, as a multiple of the surface's.
 const LAID_BUDGET: usize = 1;
