@@ -32,11 +32,13 @@
 //! layout (started from the two joined), so pairs are chosen by what decides it cheaply: the
 //! angle defects (discrete Gaussian curvature) of the vertices the merge makes interior, summed
 //! with their signs (a crease folded without stretch has none; a saw-tooth seam's ± cancel),
-//! least first, under [`LAID_DEFECT`]; the trials lay out at most [`LAID_BUDGET`] times the
-//! surface's faces. A merge is kept as `attach`'s are (within [`NEAR_SHARE`] of the tolerance)
-//! and, when the pieces are split to fit the sheet, only when the merged piece fits it
-//! ([`super::FlattenOptions::room`]): a piece larger than the sheet is cut up again by the
-//! split, along lines that follow no feature, into more parts than the two pieces were.
+//! least first, under [`LAID_DEFECT`]; only pairs whose two layouts as they lie, taken as one
+//! (about the least the union can have), stretch within the limit; and the trials lay out at
+//! most [`LAID_BUDGET`] times the surface's faces. A merge is kept as `attach`'s are (within
+//! [`NEAR_SHARE`] of the tolerance) and, when the pieces are split to fit the sheet, only
+//! when the merged piece fits it ([`super::FlattenOptions::room`]): a piece larger than the
+//! sheet is cut up again by the split, along lines that follow no feature, into more parts
+//! than the two pieces were.
 
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
@@ -307,8 +309,8 @@ pub(super) fn merge_laid(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptio
     owners.drop_gone(done);
 }
 
-/// The L2 stretch of `a` and `b` as they lie, as one: what their union laid out again has at
-/// least (its layout restricted to either is a layout of it, and each was laid out to
+/// The L2 stretch of `a` and `b` as they lie, as one: about the least their union laid out
+/// again has (its layout restricted to either is a layout of it, and each was laid out to
 /// stretch least), seam matching and the minimisation's own shortfall aside.
 fn joined_l2(a: &Laid, b: &Laid) -> f64 {
     let (sa, sb) = (&a.stretch, &b.stretch);
