@@ -111,6 +111,7 @@
 //!   rng.rs                     The crate's one seeded random number generator
 //!   segment.rs                 Distances between points and segments, in 2D and 3D
 //!   similarity.rs              Least-squares similarity fit in the plane (Umeyama 1991)
+//!   sparse.rs                  Sparse matrices for faer's Cholesky, assembled from triplets by column
 //!   unionfind.rs               Union-find (disjoint sets) over `0..n` with path halving
 //! nest/
 //!   mod.rs                     Nest stage
