@@ -309,8 +309,7 @@ fn corpus_knot_in_metal_split_parts_stay_within_the_tolerance_or_say_why() {
             over.push((p.name.clone(), s.l2));
         }
     }
-    let total: f64 = pieces.iter().map(|p| p.area).sum();
-    let small = pieces.iter().filter(|p| p.area < 0.01 * total).count();
+    let small = measure(&flats, &pieces).small;
     println!(
         "knot1 metal: {} pieces, {small} under 1 % of the area, over L2 1.001: {over:?}",
         pieces.len()
@@ -358,13 +357,12 @@ fn corpus_homer_in_fabric_matches_every_seam_of_its_largest_charts() {
 fn corpus_knot_in_fabric_is_not_joined_past_the_sheet() {
     require_shared!();
     let spec = spec_at_300(&shared_data("meshes/knot1.obj"), MaterialKind::Fabric);
-    let (_, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
-    let total: f64 = pieces.iter().map(|p| p.area).sum();
-    let small = pieces.iter().filter(|p| p.area < 0.01 * total).count();
+    let (flats, pieces) = flatcut::pipeline::pieces(&spec, true).unwrap();
+    let r = measure(&flats, &pieces);
     println!(
-        "knot1 fabric on A4: {} parts, {small} under 1 % of the area",
-        pieces.len()
+        "knot1 fabric on A4: {} parts, {} under 1 % of the area",
+        r.pieces, r.small
     );
-    assert!(pieces.len() <= 24, "{} parts", pieces.len());
-    assert!(small <= 2, "{small} parts under 1 % of the area");
+    assert!(r.pieces <= 24, "{} parts", r.pieces);
+    assert!(r.small <= 2, "{} parts under 1 % of the area", r.small);
 }

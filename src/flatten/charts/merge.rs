@@ -71,19 +71,18 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
 
 /// One round of [`merge_small`]: each small piece, smallest first, tried with its neighbours.
 fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
-    let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
-    let total: f64 = done.iter().map(|l| area(&l.faces)).sum();
+    let total: f64 = done.iter().map(|l| ctx.area(&l.faces)).sum();
     let small = SMALL_SHARE * total;
     let mut owners = Owners::new(ctx.mesh.faces.len(), done);
     let mut order: Vec<(f64, usize)> = done
         .iter()
         .enumerate()
-        .map(|(k, l)| (area(&l.faces), k))
+        .map(|(k, l)| (ctx.area(&l.faces), k))
         .filter(|&(a, _)| a < small)
         .collect();
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     for (_, si) in order {
-        if owners.gone[si] || area(&done[si].faces) >= small {
+        if owners.gone[si] || ctx.area(&done[si].faces) >= small {
             continue;
         }
         let near: Vec<usize> = owners
@@ -140,11 +139,10 @@ fn rebalance(
     opts: &FlattenOptions,
     eps: f64,
 ) -> bool {
-    let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
     let (a, b) = bisect(ctx.graph, &faces);
-    if area(&a) < small || area(&b) < small {
+    if ctx.area(&a) < small || ctx.area(&b) < small {
         return false;
     }
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
@@ -181,14 +179,13 @@ fn rebalance(
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).
 pub(super) fn merge_near(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     let near = 1.0 + (opts.tolerance - 1.0) * NEAR_SHARE;
-    let area = |fs: &[usize]| fs.iter().map(|&f| ctx.graph.area[f]).sum::<f64>();
     let mut owners = Owners::new(ctx.mesh.faces.len(), done);
     // Pairs that failed, with both pieces' face counts at the time.
     let mut failed = std::collections::HashSet::new();
     loop {
         let mut order: Vec<(f64, usize)> = (0..done.len())
             .filter(|&k| !owners.gone[k])
-            .map(|k| (area(&done[k].faces), k))
+            .map(|k| (ctx.area(&done[k].faces), k))
             .collect();
         order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         let mut merged = false;

@@ -445,6 +445,11 @@ impl Charts<'_> {
         Layout::Laid(uv, stretch)
     }
 
+    /// The 3D area of `faces`.
+    fn area(&self, faces: &[usize]) -> f64 {
+        faces.iter().map(|&f| self.graph.area[f]).sum()
+    }
+
     /// The largest difference between a boundary edge's flat and 3D length, over the 3D
     /// length, in the layout `l` (edges on its border and along its cuts): 1e-5 or less where
     /// its seams were matched ([`param::match_seams`]), 0 where it was laid out exactly.
@@ -686,9 +691,8 @@ impl Charts<'_> {
         if let Some((rest, parts)) =
             cut_off(self, &t.faces, &t.cuts, &[fx], &[fy], &pairs, uv, eps, true)
         {
-            let area = |fs: &[usize]| fs.iter().map(|&f| self.graph.area[f]).sum::<f64>();
-            let off: f64 = parts.iter().map(|p| area(&p.faces)).sum();
-            if off <= CUT_OFF_AREA * area(&t.faces) {
+            let off: f64 = parts.iter().map(|p| self.area(&p.faces)).sum();
+            if off <= CUT_OFF_AREA * self.area(&t.faces) {
                 for p in parts.into_iter().rev() {
                     todo.push(Todo {
                         faces: p.faces,

@@ -192,7 +192,7 @@ impl<'a> Within<'a> {
                     continue;
                 }
                 let comp = self.flood(f0, &free, &mut seen);
-                let area: f64 = comp.iter().map(|&f| ctx.graph.area[f]).sum();
+                let area = ctx.area(&comp);
                 if best.as_ref().is_none_or(|(a, _)| area > *a) {
                     best = Some((area, comp));
                 }
@@ -372,11 +372,8 @@ pub(super) fn laid_as_one(ctx: &Charts, done: &[Laid], k: usize, part: usize) ->
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
     let cuts = ctx.disk(&faces, &both_cuts(&done[k], &done[part]))?;
-    let laid = match super::join::moved_onto(ctx, done, k, part) {
-        Some(j) => ctx.lay_from(&faces, &cuts, Some(&Whole::new(&j.faces, &j.uv))),
-        None => ctx.lay(&faces, &cuts),
-    };
-    let Ok(Layout::Laid(uv, stretch)) = laid else {
+    let joined = super::join::moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
+    let Ok(Layout::Laid(uv, stretch)) = ctx.lay_from(&faces, &cuts, joined.as_deref()) else {
         return None;
     };
     Some(Laid {
