@@ -54,6 +54,12 @@ pub fn contains(poly: &[DVec2], p: DVec2) -> bool {
 pub fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
     let mut pts: Vec<DVec2> = points.iter().copied().filter(|p| p.is_finite()).collect();
     pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    hull_of_sorted(pts)
+}
+
+/// [`convex_hull`] of finite points already sorted by x, then y (as `total_cmp` orders them):
+/// Andrew's monotone chain, without the sort.
+pub fn hull_of_sorted(mut pts: Vec<DVec2>) -> Vec<DVec2> {
     pts.dedup();
     if pts.len() < 3 {
         return pts;
@@ -86,7 +92,11 @@ pub fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
 /// Rotation angle (radians) that turns the points so that their axis-aligned bounding box has
 /// the least area (rotating calipers over the hull edges), with the longer side along x.
 pub fn min_area_rect_angle(points: &[DVec2]) -> f64 {
-    let hull = convex_hull(points);
+    hull_rect_angle(&convex_hull(points))
+}
+
+/// [`min_area_rect_angle`] of a convex hull as [`convex_hull`] gives it.
+pub fn hull_rect_angle(hull: &[DVec2]) -> f64 {
     if hull.len() < 2 {
         return 0.0;
     }
@@ -450,6 +460,29 @@ mod tests {
         // In a corner: t from two outer sides, √2 (3 − t) from the hole's corner.
         let t = 3.0 * 2f64.sqrt() / (1.0 + 2f64.sqrt());
         assert!((r - t).abs() < 0.02 && contains_rings(&ring, c), "{c} {r}");
+    }
+
+    #[test]
+    fn the_hull_of_points_sorted_once_is_the_hull_of_any_subset() {
+        let mut rng = crate::geom::rng::Rng::new(7);
+        // On a coarse grid, so that points repeat and lie in line.
+        let mut all: Vec<DVec2> = (0..400)
+            .map(|_| v(rng.below(20) as f64, rng.below(12) as f64 * 0.5))
+            .collect();
+        all.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        for keep in [1, 2, 3, 7] {
+            let subset: Vec<DVec2> = all.iter().copied().step_by(keep).collect();
+            let mut shuffled = subset.clone();
+            rng.shuffle(&mut shuffled);
+            let hull = hull_of_sorted(subset);
+            assert_eq!(hull, convex_hull(&shuffled));
+            assert!(hull.len() >= 4 && signed_area(&hull) > 0.0);
+            assert_eq!(hull_rect_angle(&hull), min_area_rect_angle(&shuffled));
+        }
+        assert_eq!(
+            hull_of_sorted(vec![v(1.0, 1.0), v(1.0, 1.0)]),
+            vec![v(1.0, 1.0)]
+        );
     }
 
     #[test]

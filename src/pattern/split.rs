@@ -447,6 +447,9 @@ struct Island<'a> {
     grow: f64,
     /// [`PatternOptions::stretch_limit`], for an island laid out from charts.
     limit: Option<f64>,
+    /// Every face's corners with the face (local), sorted by x then y: the hull of a large
+    /// set of faces is taken from it without sorting again.
+    sorted: Vec<(DVec2, usize)>,
 }
 
 impl<'a> Island<'a> {
@@ -491,6 +494,13 @@ impl<'a> Island<'a> {
             .iter()
             .map(|&f| flat.surface.mesh.face_area(f))
             .collect();
+        let mut sorted: Vec<(DVec2, usize)> = faces
+            .iter()
+            .enumerate()
+            .flat_map(|(u, &f)| flat.face_2d[f].iter().map(move |&p| (p, u)))
+            .filter(|(p, _)| p.is_finite())
+            .collect();
+        sorted.sort_by(|a, b| a.0.x.total_cmp(&b.0.x).then(a.0.y.total_cmp(&b.0.y)));
         Island {
             flat,
             faces,
@@ -502,6 +512,7 @@ impl<'a> Island<'a> {
             room: *room,
             grow: 0.0,
             limit: opts.stretch_limit.filter(|_| flat.surface.charts.is_some()),
+            sorted,
         }
     }
 
@@ -520,12 +531,28 @@ impl<'a> Island<'a> {
 
     /// Overflow (mm) of a set of local faces, grown by `self.grow` unless it is one face.
     fn overflow(&self, set: &[usize]) -> f64 {
-        let pts: Vec<DVec2> = set
-            .iter()
-            .flat_map(|&u| self.flat.face_2d[self.faces[u]].iter().copied())
-            .collect();
+        // A large set's hull from the corners sorted once, a small one's by sorting its own.
+        let hull = if set.len() * 8 < self.faces.len() {
+            let pts: Vec<DVec2> = set
+                .iter()
+                .flat_map(|&u| self.flat.face_2d[self.faces[u]].iter().copied())
+                .collect();
+            polygon::convex_hull(&pts)
+        } else {
+            let mut inside = vec![false; self.faces.len()];
+            for &u in set {
+                inside[u] = true;
+            }
+            let pts = self
+                .sorted
+                .iter()
+                .filter(|(_, u)| inside[*u])
+                .map(|(p, _)| *p);
+            polygon::hull_of_sorted(pts.collect())
+        };
+        let pts = hull;
         let grow = if set.len() == 1 { 0.0 } else { self.grow };
-        let angles = rect_angles(polygon::min_area_rect_angle(&pts), self.grain);
+        let angles = rect_angles(polygon::hull_rect_angle(&pts), self.grain);
         let room = Room {
             width: self.room.width - 2.0 * grow,
             height: self.room.height.map(|h| h - 2.0 * grow),
