@@ -91,6 +91,20 @@ impl Grid {
         out.sort_unstable();
         out.dedup();
     }
+    /// Whether `hit` holds for an item listed in the cells of the box `lo`–`hi`, cell by cell,
+    /// stopping at the first (an item in several cells may be tried more than once): what
+    /// [`Grid::query`] then a search gives, without gathering and sorting the candidates.
+    pub fn any(&self, lo: DVec2, hi: DVec2, mut hit: impl FnMut(u32) -> bool) -> bool {
+        for i in self.col(lo.x)..=self.col(hi.x) {
+            for j in self.row(lo.y)..=self.row(hi.y) {
+                if self.cells[j * self.nx + i].iter().any(|&k| hit(k)) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
     /// The items listed in the cells from `q`'s to the grid's right edge, in `q`'s row, each
     /// once, in order (the candidates a ray from `q` towards +x may cross); false, with `out`
     /// empty, when `q` is outside the grid.
@@ -124,5 +138,18 @@ mod tests {
         assert_eq!(out, vec![0, 1]);
         g.query(DVec2::new(900.0, 100.0), DVec2::new(950.0, 150.0), &mut out);
         assert!(out.is_empty(), "{out:?}");
+        // `any` tries the same candidates, and stops at the first that holds.
+        let (lo, hi) = (DVec2::new(499.0, 349.0), DVec2::new(501.0, 351.0));
+        let mut tried = Vec::new();
+        assert!(g.any(lo, hi, |k| {
+            tried.push(k);
+            k == 1
+        }));
+        assert!(
+            tried.contains(&1) && tried.iter().all(|&k| k <= 1),
+            "{tried:?}"
+        );
+        assert!(!g.any(lo, hi, |k| k == 2));
+        assert!(!g.any(DVec2::new(900.0, 100.0), DVec2::new(950.0, 150.0), |_| true));
     }
 }

@@ -240,9 +240,7 @@ impl Obstacles {
         let c = SQUARE_CLEARANCE_MM;
         let lo = at - DVec2::splat(c);
         let hi = at + DVec2::new(bw + c, bh + c);
-        let mut near = Vec::new();
-        self.grid.query(lo, hi, &mut near);
-        if near.iter().any(|&k| {
+        if self.grid.any(lo, hi, |k| {
             let (p, q) = self.segments[k as usize];
             segment_meets_box(p, q, lo, hi)
         }) {
