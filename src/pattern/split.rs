@@ -531,8 +531,9 @@ impl<'a> Island<'a> {
 
     /// Overflow (mm) of a set of local faces, grown by `self.grow` unless it is one face.
     fn overflow(&self, set: &[usize]) -> f64 {
-        // A large set's hull from the corners sorted once, a small one's by sorting its own.
-        let hull = if set.len() * 8 < self.faces.len() {
+        // Its hull: a large set's from the corners sorted once, a small one's by sorting its
+        // own. The box of the hull is the box of the set.
+        let pts = if set.len() * 8 < self.faces.len() {
             let pts: Vec<DVec2> = set
                 .iter()
                 .flat_map(|&u| self.flat.face_2d[self.faces[u]].iter().copied())
@@ -550,7 +551,6 @@ impl<'a> Island<'a> {
                 .map(|(p, _)| *p);
             polygon::hull_of_sorted(pts.collect())
         };
-        let pts = hull;
         let grow = if set.len() == 1 { 0.0 } else { self.grow };
         let angles = rect_angles(polygon::hull_rect_angle(&pts), self.grain);
         let room = Room {

@@ -146,9 +146,10 @@ fn material_on_grid(
 }
 
 /// The segments of a shape by the cells of a uniform grid over its box, for the distance from
-/// a point to the nearest ([`super::shape::boundary_dist`]) without measuring every segment: the cells are
-/// searched in square rings around the point's until the nearest found is closer than any
-/// farther ring can be. The least of the same distances, so the same figure to the bit.
+/// a point to the nearest ([`super::shape::boundary_dist`]) without measuring every segment:
+/// the cells are searched in square rings around the point's until the nearest found is
+/// closer than any farther ring can be. The least of the same distances, so the same figure
+/// to the bit.
 struct Nearest {
     lo: DVec2,
     cell: f64,
