@@ -170,12 +170,15 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
     }
     seams.sort_by_key(|(id, _)| *id);
     let mut placed: Vec<Vec<Shape>> = vec![Vec::new(); pieces.len()];
+    // Per piece, the rings a new tab keeps clear of: each placed tab grown by TAB_GAP (grown
+    // once, when it is placed).
+    let mut gaps: Vec<Vec<Vec<DVec2>>> = vec![Vec::new(); pieces.len()];
     for (_, sides) in seams {
         let mut sides = sides;
         sides.sort_by_key(|&(pi, si)| !pieces[pi].seams[si].is_a);
         let cands: Vec<Option<Candidate>> = sides
             .iter()
-            .map(|&(pi, si)| candidate(&pieces[pi], si, &placed[pi], opts.tab_height))
+            .map(|&(pi, si)| candidate(&pieces[pi], si, &gaps[pi], opts.tab_height))
             .collect();
         let chosen: Vec<usize> = match opts.tabs {
             Tabs::None => Vec::new(),
@@ -202,11 +205,12 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
                     area: c.area,
                 }
             } else {
-                match candidate(&pieces[pi], si, &placed[pi], opts.tab_height) {
+                match candidate(&pieces[pi], si, &gaps[pi], opts.tab_height) {
                     Some(c) => c,
                     None => continue,
                 }
             };
+            gaps[pi].extend(boolean::rings(boolean::offset(&c.region, TAB_GAP)));
             placed[pi].push(c.region);
             let p = &mut pieces[pi];
             p.seams[si].tab = true;
@@ -268,8 +272,9 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
     }
 }
 
-/// The tab on side `si` of a piece, clear of the piece and of the tabs already placed.
-fn candidate(p: &Piece, si: usize, placed: &[Shape], height: f64) -> Option<Candidate> {
+/// The tab on side `si` of a piece, clear of the piece and of the tabs already placed (`gaps`:
+/// each grown by [`TAB_GAP`]).
+fn candidate(p: &Piece, si: usize, gaps: &[Vec<DVec2>], height: f64) -> Option<Candidate> {
     let s = &p.seams[si];
     let chain = &s.points;
     if s.length < 4.0 * TAB_GAP {
@@ -277,7 +282,7 @@ fn candidate(p: &Piece, si: usize, placed: &[Shape], height: f64) -> Option<Cand
     }
     let mut h = height.min(0.45 * s.length);
     for _ in 0..3 {
-        let got = tab_region(p, si, placed, h);
+        let got = tab_region(p, si, gaps, h);
         if let Some(c) = got {
             if c.area >= 0.35 * nominal_area(chain, h) {
                 return Some(c);
@@ -294,7 +299,7 @@ fn nominal_area(chain: &[DVec2], h: f64) -> f64 {
     (len - h).max(0.0) * h
 }
 
-fn tab_region(p: &Piece, si: usize, placed: &[Shape], h: f64) -> Option<Candidate> {
+fn tab_region(p: &Piece, si: usize, gaps: &[Vec<DVec2>], h: f64) -> Option<Candidate> {
     let s = &p.seams[si];
     let chain = &s.points;
     let n = chain.len();
@@ -346,9 +351,7 @@ fn tab_region(p: &Piece, si: usize, placed: &[Shape], h: f64) -> Option<Candidat
             }
         }
     }
-    for t in placed {
-        clip.extend(boolean::rings(boolean::offset(t, TAB_GAP)));
-    }
+    clip.extend(gaps.iter().cloned());
     // Non-zero winding over the clip rings: the piece's holes (clockwise) stay open unless
     // something else (a gap band, a placed tab) covers them.
     let rest = boolean::difference(&boolean::rings(band), &clip);
