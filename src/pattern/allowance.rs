@@ -176,10 +176,16 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
     for (_, sides) in seams {
         let mut sides = sides;
         sides.sort_by_key(|&(pi, si)| !pieces[pi].seams[si].is_a);
-        let cands: Vec<Option<Candidate>> = sides
-            .iter()
-            .map(|&(pi, si)| candidate(&pieces[pi], si, &gaps[pi], opts.tab_height))
-            .collect();
+        // The two sides' candidates do not depend on each other: on two cores when there are.
+        let view: &[Piece] = pieces;
+        let cand = |(pi, si): (usize, usize)| candidate(&view[pi], si, &gaps[pi], opts.tab_height);
+        let cands: Vec<Option<Candidate>> = match sides[..] {
+            [x, y] => {
+                let (a, b) = crate::geom::par::join(|| cand(x), || cand(y));
+                vec![a, b]
+            }
+            _ => sides.iter().map(|&s| cand(s)).collect(),
+        };
         let chosen: Vec<usize> = match opts.tabs {
             Tabs::None => Vec::new(),
             Tabs::Both => (0..sides.len()).filter(|&i| cands[i].is_some()).collect(),
@@ -231,42 +237,53 @@ fn tabs(flat: &Flat, pieces: &mut [Piece], opts: &PatternOptions) {
             p.folds.extend(folds);
         }
     }
-    // Outline: the border with its tabs, when they make one simple shape.
-    for (p, tabs) in pieces.iter_mut().zip(placed) {
-        if tabs.is_empty() {
-            continue;
-        }
-        // Each tab grown by 0.01 mm, so that it overlaps its seam instead of meeting it along
-        // a line (no sliver between them survives the union); TAB_GAP leaves room for this.
-        let all: Vec<Vec<DVec2>> = tabs
-            .iter()
-            .flat_map(|t| boolean::rings(boolean::offset(t, 0.01)))
-            .collect();
-        let mut u = boolean::union(&p.outline, &all);
-        // Keep the border's own holes; fill the pockets (usually specks of a few µm² where a
-        // tab meets a corner of the border) that tabs close off.
-        let inside: Vec<DVec2> = p.border[1..]
-            .iter()
-            .filter_map(|h| {
-                let ccw: Vec<DVec2> = h.iter().rev().copied().collect();
-                polygon::pole(&[ccw], 0.01).map(|(c, _)| c)
-            })
-            .collect();
-        for shape in &mut u {
-            let mut k = 0;
-            shape.retain(|r| {
-                k += 1;
-                k == 1 || inside.iter().any(|c| polygon::contains(r, *c))
-            });
-        }
-        match single(u).and_then(|o| clean(&o)) {
-            Some(outline) if polygon::is_simple_ring(&outline[0]) => p.outline = outline,
-            _ => {
-                // Cannot happen with tabs kept apart by TAB_GAP; keep the piece cuttable.
-                p.folds.retain(|f| !f.tab);
-                for s in &mut p.seams {
-                    s.tab = false;
-                }
+    // Outline: the border with its tabs, when they make one simple shape; each piece on its
+    // own, so on two cores when there are.
+    let items: Vec<(&mut Piece, Vec<Shape>)> = pieces
+        .iter_mut()
+        .zip(placed)
+        .filter(|(_, tabs)| !tabs.is_empty())
+        .collect();
+    let weight: Vec<usize> = items
+        .iter()
+        .map(|(p, tabs)| tabs.len() + p.border.iter().map(Vec::len).sum::<usize>())
+        .collect();
+    crate::geom::par::map(items, &weight, &|(p, tabs)| outline_with_tabs(p, &tabs));
+}
+
+/// `p`'s outline with its `tabs` joined on, when they make one simple shape; else its tabs
+/// are dropped (the piece stays cuttable).
+fn outline_with_tabs(p: &mut Piece, tabs: &[Shape]) {
+    // Each tab grown by 0.01 mm, so that it overlaps its seam instead of meeting it along
+    // a line (no sliver between them survives the union); TAB_GAP leaves room for this.
+    let all: Vec<Vec<DVec2>> = tabs
+        .iter()
+        .flat_map(|t| boolean::rings(boolean::offset(t, 0.01)))
+        .collect();
+    let mut u = boolean::union(&p.outline, &all);
+    // Keep the border's own holes; fill the pockets (usually specks of a few µm² where a
+    // tab meets a corner of the border) that tabs close off.
+    let inside: Vec<DVec2> = p.border[1..]
+        .iter()
+        .filter_map(|h| {
+            let ccw: Vec<DVec2> = h.iter().rev().copied().collect();
+            polygon::pole(&[ccw], 0.01).map(|(c, _)| c)
+        })
+        .collect();
+    for shape in &mut u {
+        let mut k = 0;
+        shape.retain(|r| {
+            k += 1;
+            k == 1 || inside.iter().any(|c| polygon::contains(r, *c))
+        });
+    }
+    match single(u).and_then(|o| clean(&o)) {
+        Some(outline) if polygon::is_simple_ring(&outline[0]) => p.outline = outline,
+        _ => {
+            // Cannot happen with tabs kept apart by TAB_GAP; keep the piece cuttable.
+            p.folds.retain(|f| !f.tab);
+            for s in &mut p.seams {
+                s.tab = false;
             }
         }
     }
