@@ -89,6 +89,7 @@
 //!   unfold.rs                  Exact unfolding of polyhedral meshes
 //!   charts/
 //!     mod.rs                   Flattening of a segmented smooth surface
+//!     assemble.rs              The charts once laid, as one `Flat`
 //!     darts.rs                 Darts and gussets
 //!     overlap.rs               Overlap inside one chart's layout, and what is done about it (Julius 2006, thesis §5.3 "fixing …
 //!   param/

@@ -348,18 +348,12 @@ impl Room {
             return false;
         }
         let (lo, hi) = f.bounds();
-        let mut ids = std::mem::take(&mut self.scratch);
-        self.grid.query(lo, hi, &mut ids);
-        let mut ok = ids.iter().all(|&k| {
+        !self.grid.any(lo, hi, |k| {
             let (a, b) = self.segments[k as usize];
-            !f.hits_segment(a, b)
-        });
-        if ok {
-            self.text_grid.query(lo, hi, &mut ids);
-            ok = ids.iter().all(|&k| !f.overlaps(&self.texts[k as usize]));
-        }
-        self.scratch = ids;
-        ok
+            f.hits_segment(a, b)
+        }) && !self
+            .text_grid
+            .any(lo, hi, |k| f.overlaps(&self.texts[k as usize]))
     }
 
     /// Remembers a placed text.
