@@ -86,9 +86,11 @@ fn fandisk_few_charts_near_isometric() {
         seg.count, seg.iterations, seg.added, seg.merged, seg.split, flat.islands.len(), s.l2, s.linf, s.shear_l2, s.flipped
     );
     check_flat(&flat);
-    // Issue 20: at most 6 (the thesis: 4); pieces joined across its curved creases when they
-    // lie flat as one (`merge_laid`) bring it from 8 to 7.
-    assert!(flat.islands.len() <= 7, "{} pieces", flat.islands.len());
+    // Issue 20: at most 6 (the thesis: 4). Pieces joined across its curved creases when they
+    // lie flat as one (`merge_laid`) bring it from 8 to 7; the side-wall band, which overlaps
+    // where its rims fold over one another, has those cut off instead of being halved (7 to
+    // 6; halved, it gives 7).
+    assert!(flat.islands.len() <= 6, "{} pieces", flat.islands.len());
     assert!(s.l2 <= 1.001, "L2 {}", s.l2);
     let (each, _) = fcharts::stretch(&flat);
     let worst = each.iter().map(|p| p.l2).fold(1.0, f64::max);

@@ -30,7 +30,9 @@
 //!   overlap splits the chart between the two overlapping faces
 //!   (`split_between` of [`crate::geom::cut`]: each face goes with the nearer of the two,
 //!   through the chart); a chart that needed seams to be a disk (a tube whose layout
-//!   spirals over itself) is halved along the bisector instead;
+//!   spirals over itself) is halved along the bisector instead, unless it lies flat with
+//!   next to no stretch (`TUBE_CUT_OFF`): such a band overlaps where flanges standing at a
+//!   crease fold over one another, and has them cut off like any chart;
 //! - whose L2 stretch is over [`FlattenOptions::tolerance`] first gets darts (`darts`: up
 //!   to [`FlattenOptions::darts`] partial cuts from its boundary toward its most curved
 //!   region, then shortened while it stays within the tolerance), then gussets where the
@@ -73,10 +75,11 @@
 //! apart, a triangle flipped) is laid anew.
 //!
 //! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
-//! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free
-//! and without overlap (`merge`), else grafted onto its neighbours as they lie: its faces
-//! unfolded exactly onto their layouts (`exact::graft`). Then neighbouring pieces of any size
-//! are joined where they lie flat as one well within the tolerance (`merge`).
+//! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free,
+//! without overlap and with their seams matched (`merge`), else grafted onto its neighbours as
+//! they lie: its faces unfolded exactly onto their layouts (`exact::graft`). Then neighbouring
+//! pieces of any size are joined where they lie flat as one well within the tolerance
+//! (`merge`).
 //!
 //! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
 //! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
@@ -571,7 +574,8 @@ impl Charts<'_> {
         if t.faces.len() > 1 {
             // Overlapping parts go to different pieces: split between the two faces.
             if let Some(pair) = self_overlap(&uv, eps) {
-                if self.part_overlap(todo, &t, &uv, pair, eps) {
+                let developable = stretch.l2 - 1.0 <= TUBE_CUT_OFF * (opts.tolerance - 1.0);
+                if self.part_overlap(todo, &t, &uv, pair, eps, developable) {
                     return Ok(());
                 }
             }
@@ -672,9 +676,16 @@ impl Charts<'_> {
     }
 
     /// A chart whose layout `uv` overlaps itself at faces `(x, y)` (indices into its faces):
-    /// halved when it was cut open into a disk (a tube, as a whole), else a small overlapping
-    /// region cut off (§5.3, to be re-attached elsewhere), else split between the two faces.
-    /// True when the parts went onto `todo`.
+    /// halved when it was cut open into a disk (a tube, as a whole) and is not `developable`,
+    /// else a small overlapping region cut off (§5.3, to be re-attached elsewhere), else
+    /// halved when it is a tube, else split between the two faces. True when the parts went
+    /// onto `todo`.
+    ///
+    /// A tube laid out with next to no stretch (`developable`: within [`TUBE_CUT_OFF`] of the
+    /// tolerance) does not overlap because it spirals but because flanges that stand at a
+    /// crease from its band fold over one another when laid flat (fandisk's side walls and
+    /// the rims along them): cutting those off keeps the band whole, where halving it makes
+    /// two pieces whose own flanges overlap again.
     fn part_overlap(
         &self,
         todo: &mut Vec<Todo>,
@@ -682,9 +693,10 @@ impl Charts<'_> {
         uv: &[Vec<DVec2>],
         (x, y): (usize, usize),
         eps: f64,
+        developable: bool,
     ) -> bool {
-        // A chart cut open into a disk (a tube) is halved instead, as a whole.
-        if !t.cuts.is_empty() && self.split_in_two(todo, t, t.splits, None) {
+        let tube = !t.cuts.is_empty();
+        if tube && !developable && self.split_in_two(todo, t, t.splits, None) {
             return true;
         }
         // A small overlapping region is cut off (§5.3), to be re-attached elsewhere.
@@ -713,6 +725,9 @@ impl Charts<'_> {
                 });
                 return true;
             }
+        }
+        if tube && self.split_in_two(todo, t, t.splits, None) {
+            return true;
         }
         let (a, b) = split_between(self.graph, &t.faces, t.faces[x], t.faces[y]);
         if !a.is_empty() && !b.is_empty() {
@@ -905,6 +920,11 @@ pub fn stretch_of(flat: &Flat, faces: &[usize]) -> Stretch {
 /// A global overlap is cut off ([`overlap::cut_off`]) when the part cut off has at most this fraction
 /// of the chart's area; a larger one splits the chart between the two overlapping faces.
 const CUT_OFF_AREA: f64 = 0.25;
+
+/// A tube (a chart cut open into a disk) whose layout overlaps itself has the overlapping
+/// region cut off like any chart, instead of being halved, when its L2 stretch exceeds 1 by at
+/// most this share of the tolerance's (see [`Charts::part_overlap`]).
+const TUBE_CUT_OFF: f64 = 0.1;
 
 /// Rounds of matching the seams of charts left over the tolerance (halving those whose
 /// matched layout overlaps or flips) after all charts are laid.

@@ -342,8 +342,10 @@ impl Sides {
 }
 
 /// Lay `done[k]` and `done[part]` out as one chart (the cuts of both, more where the union is
-/// not a disk); when that is flip-free, within the tolerance and without overlap, it becomes
-/// `done[k]` and true is returned (`done[part]` is left for the caller to drop).
+/// not a disk); when that is flip-free, within the tolerance, without overlap and with its
+/// seams matched (`seam_error` within [`FlattenOptions::seam_tolerance`]: a union whose
+/// border cannot have its 3D lengths would only be halved again once all charts are laid), it
+/// becomes `done[k]` and true is returned (`done[part]` is left for the caller to drop).
 pub(super) fn merge_into(
     ctx: &Charts,
     done: &mut [Laid],
@@ -356,6 +358,7 @@ pub(super) fn merge_into(
         Some(l)
             if l.stretch.flipped == 0
                 && l.stretch.l2 <= opts.tolerance
+                && ctx.seam_error(&l) <= opts.seam_tolerance
                 && self_overlap(&l.uv, eps).is_none() =>
         {
             done[k] = l;
@@ -400,7 +403,8 @@ pub(super) fn both_cuts(a: &Laid, b: &Laid) -> Vec<usize> {
 /// piece); the criterion is the mean cylinder fitting error of the gusset's faces and two
 /// rings of the neighbour's faces around their common boundary below
 /// [`FlattenOptions::reattach_eta`]; the merged chart (cut into a disk where needed) must lay
-/// flat with no flip, no overlap and an L2 stretch within the tolerance. The piece a gusset
+/// flat with no flip, no overlap, an L2 stretch within the tolerance and its seams matched
+/// ([`merge_into`]). The piece a gusset
 /// was cut from fails the overlap test by construction (that is why it was cut off), unless
 /// its layout has changed since.
 pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
