@@ -34,7 +34,12 @@
 //! parts are the runs' connected pieces. For each sequence the greedy partition (each run as
 //! long as fits) gives the fewest runs K that sequence allows; the runs are then balanced to
 //! equal areas (each cut moved, within a quarter of a part's area, to where its seam costs
-//! least). Of all feasible partitions the one with fewest parts wins, then the lowest cost:
+//! least). A part under 1 % of the whole surface's area (issue 20's bound for a piece; the
+//! tip of a piece a run ends on, a piece of a run cut off from the rest) then takes faces from
+//! the parts beside it while it fits and they stay whole and not small; an island whose parts
+//! came out too large once built is partitioned again without this, grown parts being the
+//! likelier to. Of all feasible partitions the one with fewest parts wins, then the one with
+//! fewest parts over the stretch limit, then with fewest small parts, then the lowest cost:
 //! the seams' length over the square root of a part's area (edges where the surface does not
 //! bend — the diagonal of a flat quad, of a cone's planar strip between two rulings — and that
 //! are no named bend line count double, so seams run along folds and rulings), plus twice the
@@ -49,6 +54,11 @@ use std::collections::{HashMap, HashSet};
 
 /// Parts of an island: faces each.
 type Parts = Vec<Vec<usize>>;
+
+/// A part of a split piece under this share of the whole surface's area is small (issue 20:
+/// no piece under 1 % of the area) and is grown from its neighbours where it can
+/// (`grow_small`).
+const SMALL_PART: f64 = 0.01;
 
 /// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
 /// would cross a panel rather than follow a line of the surface.
@@ -220,6 +230,16 @@ pub fn build_to_fit(
                 .collect(),
         );
     }
+    // Parts under this share of the whole surface are grown where they can (`grow_small`).
+    let total: f64 = flats
+        .iter()
+        .map(|f| {
+            (0..f.surface.mesh.faces.len())
+                .map(|g| f.surface.mesh.face_area(g))
+                .sum::<f64>()
+        })
+        .sum();
+    let small = SMALL_PART * total;
     let mut last = pieces;
     let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
     let mut stuck: HashMap<(usize, usize), u32> = HashMap::new();
@@ -240,7 +260,12 @@ pub fn build_to_fit(
                 // The same growth gives the same partition: made once.
                 let parts = match cache.get(&(fi, ii)) {
                     Some((cg, parts)) if *cg == g => parts.clone(),
-                    _ => partition(flat, faces, g, opts, room, ii)?,
+                    _ => {
+                        // Small parts are grown only while the island's parts have not come
+                        // out too large: grown ones are the likelier to.
+                        let grow_small = !stuck.contains_key(&(fi, ii));
+                        partition(flat, faces, g, opts, room, ii, (small, grow_small))?
+                    }
                 };
                 cache.insert((fi, ii), (g, parts.clone()));
                 plans.push(Some(parts));
@@ -445,6 +470,10 @@ struct Island<'a> {
     grain: bool,
     room: Room,
     grow: f64,
+    /// Area (mm²) under which a part is small (`grow_small`).
+    small: f64,
+    /// Whether small parts are grown (`grow_small`).
+    grow_small: bool,
     /// [`PatternOptions::stretch_limit`], for an island laid out from charts.
     limit: Option<f64>,
     /// Every face's corners with the face (local), sorted by x then y: the hull of a large
@@ -511,6 +540,8 @@ impl<'a> Island<'a> {
             grain: opts.grain,
             room: *room,
             grow: 0.0,
+            small: 0.0,
+            grow_small: false,
             limit: opts.stretch_limit.filter(|_| flat.surface.charts.is_some()),
             sorted,
         }
@@ -661,9 +692,12 @@ fn partition(
     opts: &PatternOptions,
     room: &Room,
     island: usize,
+    (small, grow_parts): (f64, bool),
 ) -> Result<Vec<Vec<usize>>, PatternError> {
     let mut isl = Island::new(flat, faces, opts, room);
     isl.grow = grow;
+    isl.small = small;
+    isl.grow_small = grow_parts;
     for u in 0..faces.len() {
         if isl.overflow(&[u]) > 0.0 {
             return Err(face_too_large(&isl, u, island));
@@ -716,7 +750,7 @@ fn partition(
         }
         greedy_runs.push(cuts.len() - 1);
         if let Some(parts) = parts_of(order, &cuts) {
-            consider(&isl, merge(&isl, parts), total, &mut best);
+            consider(&isl, grow_small(&isl, merge(&isl, parts)), total, &mut best);
         }
     }
     let k_min = greedy_runs.iter().copied().min().unwrap_or(1);
@@ -728,7 +762,7 @@ fn partition(
         for k in ks {
             let cuts = balanced(&isl, order, k, total);
             if let Some(parts) = parts_of(order, &cuts) {
-                consider(&isl, merge(&isl, parts), total, &mut best);
+                consider(&isl, grow_small(&isl, merge(&isl, parts)), total, &mut best);
             }
         }
     }
@@ -793,13 +827,98 @@ fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     }
 }
 
-/// The best partition so far: (parts over the stretch limit, number of parts, cost) and the
-/// parts.
-type Best = Option<((usize, usize, f64), Vec<Vec<usize>>)>;
+/// Small parts grown: a part under [`Island::small`] (a run of a sequence that ends on a tip
+/// of the piece, or a piece of a run cut off from the rest) takes faces from the parts next to
+/// it, one at a time, until it is no longer small, as long as it still fits with the growth
+/// estimate to spare (a grown part's border is ragged, and the outline built on it reaches
+/// further) and the part the face leaves stays connected and not small. The face taken is the one with the most edges on
+/// the small part, then the nearest its centroid, so the part grows round rather than along
+/// its border; a part that can take none stays as it is.
+fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    let n = isl.faces.len();
+    let area = |p: &[usize]| p.iter().map(|&u| isl.area[u]).sum::<f64>();
+    let mut small: Vec<usize> = (0..parts.len())
+        .filter(|&k| area(&parts[k]) < isl.small)
+        .collect();
+    if small.is_empty() || parts.len() < 2 || !isl.grow_small {
+        return parts;
+    }
+    small.sort_by(|&a, &b| area(&parts[a]).total_cmp(&area(&parts[b])).then(a.cmp(&b)));
+    let mut part_of = vec![0; n];
+    for (k, p) in parts.iter().enumerate() {
+        for &u in p {
+            part_of[u] = k;
+        }
+    }
+    let mut stamp = vec![0usize; n];
+    let mut mark = 1;
+    for k in small {
+        let mut have = area(&parts[k]);
+        while have < isl.small {
+            let weight: f64 = parts[k]
+                .iter()
+                .map(|&u| isl.area[u])
+                .sum::<f64>()
+                .max(1e-300);
+            let centre = parts[k]
+                .iter()
+                .map(|&u| isl.centroid[u] * isl.area[u])
+                .sum::<DVec2>()
+                / weight;
+            // Faces next to the part: (face, edges on the part, distance to its centre).
+            let mut cands: Vec<(usize, usize, f64)> = Vec::new();
+            for &u in &parts[k] {
+                for &v in &isl.adj[u] {
+                    if part_of[v] == k {
+                        continue;
+                    }
+                    match cands.iter_mut().find(|c| c.0 == v) {
+                        Some(c) => c.1 += 1,
+                        None => cands.push((v, 1, isl.centroid[v].distance(centre))),
+                    }
+                }
+            }
+            cands.sort_by(|a, b| b.1.cmp(&a.1).then(a.2.total_cmp(&b.2)).then(a.0.cmp(&b.0)));
+            let mut took = None;
+            for &(v, _, _) in &cands {
+                let j = part_of[v];
+                if area(&parts[j]) - isl.area[v] < isl.small {
+                    continue;
+                }
+                let mut grown = parts[k].clone();
+                grown.push(v);
+                if isl.overflow(&grown) > -isl.grow {
+                    continue;
+                }
+                let rest: Vec<usize> = parts[j].iter().copied().filter(|&u| u != v).collect();
+                mark += 2;
+                if isl.components(&rest, &mut stamp, mark).len() != 1 {
+                    continue;
+                }
+                took = Some((v, j, grown, rest));
+                break;
+            }
+            let Some((v, j, grown, rest)) = took else {
+                break;
+            };
+            part_of[v] = k;
+            have += isl.area[v];
+            parts[k] = grown;
+            parts[j] = rest;
+        }
+        parts[k].sort_unstable();
+    }
+    parts
+}
 
-/// Keep `parts` if it beats the best so far: fewer parts over the stretch limit (a part of a
-/// layout can stretch more than the whole), then fewer parts, then a lower cost (seam length
-/// over a part's typical size, twice the largest part's excess area over the mean).
+/// The best partition so far: (number of parts, parts over the stretch limit, small parts,
+/// cost) and the parts.
+type Best = Option<((usize, usize, usize, f64), Vec<Vec<usize>>)>;
+
+/// Keep `parts` if it beats the best so far: fewer parts, then fewer parts over the stretch
+/// limit (a part of a layout can stretch more than the whole), then fewer small parts (under
+/// [`Island::small`]), then a lower cost (seam length over a part's typical size, twice the
+/// largest part's excess area over the mean).
 fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
     let mut part_of = vec![0; isl.faces.len()];
     for (k, p) in parts.iter().enumerate() {
@@ -820,12 +939,16 @@ fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
         .fold(0.0, f64::max);
     let cost = seam / mean.sqrt().max(1e-9) + 2.0 * (largest / mean.max(1e-300) - 1.0);
     let over = parts.iter().filter(|p| isl.over_limit(p)).count();
-    let score = (parts.len(), over, cost);
+    let small = parts
+        .iter()
+        .filter(|p| p.iter().map(|&u| isl.area[u]).sum::<f64>() < isl.small)
+        .count();
+    let score = (parts.len(), over, small, cost);
     let better = match best {
         None => true,
         Some((s, _)) => {
-            (score.0, score.1) < (s.0, s.1)
-                || ((score.0, score.1) == (s.0, s.1) && score.2 < s.2 - 1e-12)
+            (score.0, score.1, score.2) < (s.0, s.1, s.2)
+                || ((score.0, score.1, score.2) == (s.0, s.1, s.2) && score.3 < s.3 - 1e-12)
         }
     };
     if better {
@@ -916,6 +1039,75 @@ mod tests {
     fn part_letters_run_on_past_z() {
         let names: Vec<String> = [0, 1, 25, 26, 27, 701, 702].map(letters).into();
         assert_eq!(names, ["a", "b", "z", "aa", "ab", "zz", "aaa"]);
+    }
+
+    /// A row of 40 squares of 10 mm, flat: a part of two squares at its end takes squares from
+    /// the part beside it until it has 8 (800 mm², the "small" bound here), the other part
+    /// staying one strip; not past what fits the room; and not from a part that would then be
+    /// small itself.
+    #[test]
+    fn a_small_part_grows_from_its_neighbour_while_it_fits() {
+        let mut verts = Vec::new();
+        for i in 0..=40 {
+            verts.push(glam::DVec3::new(10.0 * i as f64, 0.0, 0.0));
+            verts.push(glam::DVec3::new(10.0 * i as f64, 10.0, 0.0));
+        }
+        let faces: Vec<[usize; 4]> = (0..40)
+            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
+            .collect();
+        let row = crate::surface::Surface {
+            name: "row".into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
+            ..Default::default()
+        };
+        let flat = unfold(row, &UnfoldOptions::default()).unwrap();
+        assert_eq!(flat.islands.len(), 1);
+        let all = &flat.islands[0];
+        // Local faces along the row, by the x of their centroid.
+        let opts = PatternOptions::default();
+        let grown = |room: f64, parts: Vec<Vec<usize>>| {
+            let room = Room {
+                width: room,
+                height: Some(room),
+            };
+            let mut isl = Island::new(&flat, all, &opts, &room);
+            isl.small = 800.0 - 1e-6;
+            isl.grow_small = true;
+            let mut by_x: Vec<usize> = (0..all.len()).collect();
+            by_x.sort_by(|&a, &b| isl.centroid[a].x.total_cmp(&isl.centroid[b].x));
+            let parts: Vec<Vec<usize>> = parts
+                .into_iter()
+                .map(|p| p.into_iter().map(|k| by_x[k]).collect())
+                .collect();
+            let out = grow_small(&isl, parts);
+            let xs: Vec<(f64, f64, usize)> = out
+                .iter()
+                .map(|p| {
+                    let x = p.iter().map(|&u| isl.centroid[u].x);
+                    (
+                        x.clone().fold(f64::MAX, f64::min),
+                        x.fold(0.0, f64::max),
+                        p.len(),
+                    )
+                })
+                .collect();
+            xs
+        };
+        let two = |a: usize, b: usize| vec![(0..a).collect(), (a..b).collect::<Vec<usize>>()];
+        // Grown to 8 squares, both parts still runs of the row.
+        assert_eq!(
+            grown(250.0, two(2, 40)),
+            [(5.0, 75.0, 8), (85.0, 395.0, 32)]
+        );
+        // A 55 mm room holds 5 squares: it stops there, still small.
+        assert_eq!(grown(55.0, two(2, 40)), [(5.0, 45.0, 5), (55.0, 395.0, 35)]);
+        // The part beside it has 8 squares: taking one would make it small.
+        let three = vec![(0..2).collect(), (2..10).collect(), (10..40).collect()];
+        assert_eq!(
+            grown(250.0, three),
+            [(5.0, 15.0, 2), (25.0, 95.0, 8), (105.0, 395.0, 30)]
+        );
     }
 
     /// A flat row of five 100 mm squares on a 250 × 250 mm room: three parts (two squares
