@@ -831,9 +831,9 @@ fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
 /// of the piece, or a piece of a run cut off from the rest) takes faces from the parts next to
 /// it, one at a time, until it is no longer small, as long as it still fits with the growth
 /// estimate to spare (a grown part's border is ragged, and the outline built on it reaches
-/// further) and the part the face leaves stays connected and not small. The face taken is the one with the most edges on
-/// the small part, then the nearest its centroid, so the part grows round rather than along
-/// its border; a part that can take none stays as it is.
+/// further) and the part the face leaves stays connected and not small. The face taken is the
+/// one with the most edges on the small part, then the nearest its centroid, so the part grows
+/// round rather than along its border; a part that can take none stays as it is.
 fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     let n = isl.faces.len();
     let area = |p: &[usize]| p.iter().map(|&u| isl.area[u]).sum::<f64>();
@@ -855,16 +855,11 @@ fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     for k in small {
         let mut have = area(&parts[k]);
         while have < isl.small {
-            let weight: f64 = parts[k]
-                .iter()
-                .map(|&u| isl.area[u])
-                .sum::<f64>()
-                .max(1e-300);
             let centre = parts[k]
                 .iter()
                 .map(|&u| isl.centroid[u] * isl.area[u])
                 .sum::<DVec2>()
-                / weight;
+                / have.max(1e-300);
             // Faces next to the part: (face, edges on the part, distance to its centre).
             let mut cands: Vec<(usize, usize, f64)> = Vec::new();
             for &u in &parts[k] {
@@ -1080,8 +1075,8 @@ mod tests {
                 .into_iter()
                 .map(|p| p.into_iter().map(|k| by_x[k]).collect())
                 .collect();
-            let out = grow_small(&isl, parts);
-            let xs: Vec<(f64, f64, usize)> = out
+            // Each part as (first x, last x, squares).
+            grow_small(&isl, parts)
                 .iter()
                 .map(|p| {
                     let x = p.iter().map(|&u| isl.centroid[u].x);
@@ -1091,8 +1086,7 @@ mod tests {
                         p.len(),
                     )
                 })
-                .collect();
-            xs
+                .collect::<Vec<(f64, f64, usize)>>()
         };
         let two = |a: usize, b: usize| vec![(0..a).collect(), (a..b).collect::<Vec<usize>>()];
         // Grown to 8 squares, both parts still runs of the row.

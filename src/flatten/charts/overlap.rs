@@ -404,9 +404,8 @@ pub(super) fn both_cuts(a: &Laid, b: &Laid) -> Vec<usize> {
 /// rings of the neighbour's faces around their common boundary below
 /// [`FlattenOptions::reattach_eta`]; the merged chart (cut into a disk where needed) must lay
 /// flat with no flip, no overlap, an L2 stretch within the tolerance and its seams matched
-/// ([`merge_into`]). The piece a gusset
-/// was cut from fails the overlap test by construction (that is why it was cut off), unless
-/// its layout has changed since.
+/// ([`merge_into`]). The piece a gusset was cut from fails the overlap test by construction
+/// (that is why it was cut off), unless its layout has changed since.
 pub(super) fn reattach(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     if !done.iter().any(|l| l.gusset) {
         return;
