@@ -1036,27 +1036,31 @@ mod tests {
         assert_eq!(names, ["a", "b", "z", "aa", "ab", "zz", "aaa"]);
     }
 
+    /// A flat row of `n` squares of `side` mm along x, as one surface.
+    fn row_of_squares(n: usize, side: f64) -> crate::surface::Surface {
+        let mut verts = Vec::new();
+        for i in 0..=n {
+            verts.push(glam::DVec3::new(side * i as f64, 0.0, 0.0));
+            verts.push(glam::DVec3::new(side * i as f64, side, 0.0));
+        }
+        let faces: Vec<[usize; 4]> = (0..n)
+            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
+            .collect();
+        crate::surface::Surface {
+            name: "row".into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
+            ..Default::default()
+        }
+    }
+
     /// A row of 40 squares of 10 mm, flat: a part of two squares at its end takes squares from
     /// the part beside it until it has 8 (800 mm², the "small" bound here), the other part
     /// staying one strip; not past what fits the room; and not from a part that would then be
     /// small itself.
     #[test]
     fn a_small_part_grows_from_its_neighbour_while_it_fits() {
-        let mut verts = Vec::new();
-        for i in 0..=40 {
-            verts.push(glam::DVec3::new(10.0 * i as f64, 0.0, 0.0));
-            verts.push(glam::DVec3::new(10.0 * i as f64, 10.0, 0.0));
-        }
-        let faces: Vec<[usize; 4]> = (0..40)
-            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
-            .collect();
-        let row = crate::surface::Surface {
-            name: "row".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
-            ..Default::default()
-        };
-        let flat = unfold(row, &UnfoldOptions::default()).unwrap();
+        let flat = unfold(row_of_squares(40, 10.0), &UnfoldOptions::default()).unwrap();
         assert_eq!(flat.islands.len(), 1);
         let all = &flat.islands[0];
         // Local faces along the row, by the x of their centroid.
@@ -1108,20 +1112,7 @@ mod tests {
     /// at most each), cut along square edges, one new seam each, the faces kept.
     #[test]
     fn a_row_of_squares_is_cut_between_squares() {
-        let mut verts = Vec::new();
-        for i in 0..=5 {
-            verts.push(glam::DVec3::new(100.0 * i as f64, 0.0, 0.0));
-            verts.push(glam::DVec3::new(100.0 * i as f64, 100.0, 0.0));
-        }
-        let faces: Vec<[usize; 4]> = (0..5)
-            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
-            .collect();
-        let row = crate::surface::Surface {
-            name: "row".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
-            ..Default::default()
-        };
+        let row = row_of_squares(5, 100.0);
         let mut flats = vec![unfold(row, &UnfoldOptions::default()).unwrap()];
         let room = Room {
             width: 250.0,
