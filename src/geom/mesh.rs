@@ -86,6 +86,11 @@ impl Mesh {
         0.5 * self.newell(f).length()
     }
 
+    /// Area of the whole mesh: its faces' areas summed ([`Mesh::face_area`]).
+    pub fn area(&self) -> f64 {
+        (0..self.faces.len()).map(|f| self.face_area(f)).sum()
+    }
+
     /// Unit normal of a face, or zero for a degenerate face.
     pub fn face_normal(&self, f: usize) -> DVec3 {
         self.newell(f).normalize_or_zero()

@@ -453,7 +453,7 @@ mod tests {
     }
 
     fn area(s: &crate::surface::Surface) -> f64 {
-        (0..s.mesh.faces.len()).map(|f| s.mesh.face_area(f)).sum()
+        s.mesh.area()
     }
 
     #[test]

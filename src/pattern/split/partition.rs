@@ -1,28 +1,5 @@
-//! Splitting pieces that do not fit the sheet (issue 21, items 4 and 5): a piece larger than
-//! the sheet inside its margins (or wider than the roll) at every orientation the nest tries is
-//! cut into parts along its own interior edges — the fold lines and flat interior edges of an
-//! unfolded mesh or chart, the rulings of a strip, a fitting or a bent sheet — so that every
-//! part fits; a part too large only because it is one face is an error naming both sizes.
-//!
-//! **Where.** The split changes the flat, not the pieces: the faces of the island stay where
-//! the flatten stage laid them (the unfolding is isometric, so a part of it is the unfolding of
-//! that part), the edges between two parts stop being joined (`Flat::joined`), and the parts
-//! become islands of their own. The pieces are then built again by [`super::build`], so a new
-//! seam is a seam like any other: found on both borders by [`super::marks`], with its id on
-//! both sides, notches, glue tabs or seam allowance by [`super::allowance`], its two sides
-//! measured on their own faces (equal lengths) and listed in report.json (with `"split":
-//! true`). Splitting the face set along mesh edges of the whole mesh and unfolding the parts
-//! again could join faces the unfolding had cut apart, but would redo the flatten stage's
-//! work and lose the chart layouts; parts of the existing layout keep them.
-//!
-//! **What fits.** The nest's construction places a piece turned so that its cut outline's
-//! minimum-area rectangle is axis-aligned, at one of four quarter turns (a piece with a grain
-//! line: grain along the sheet's y axis, either way); a piece fits when one of those boxes
-//! lies within the room. The same test is applied to the built pieces, so that a piece that
-//! fits today is never split and the bundled patterns' outputs do not change. Before a part is
-//! built, its size is estimated from its faces' corners grown on every side by what the
-//! material adds (tab height or seam allowance, half the kerf); a part that then does not fit
-//! once built has its island split again with the estimate grown by the overflow.
+//! Partitioning an island that does not fit the sheet into parts that do ([`partition`], for
+//! [`super::build_to_fit`]).
 //!
 //! **How** (the issue asks for few parts, straight and short seams, parts of similar size;
 //! the choices below are ours). The faces of the island are put in a sequence, in several
@@ -46,414 +23,27 @@
 //! largest part's excess area over the mean. On a large cone this gives what a shop lays out:
 //! equal segments joined along rulings, each with its own bend lines.
 
-use super::{PatternError, PatternOptions, Piece, Tabs};
+use super::{overflow, rect_angles, rect_size, Room};
 use crate::flatten::Flat;
 use crate::geom::polygon;
+use crate::pattern::{PatternError, PatternOptions};
 use glam::DVec2;
 use std::collections::{HashMap, HashSet};
-
-/// Parts of an island: faces each.
-type Parts = Vec<Vec<usize>>;
-
-/// A part of a split piece under this share of the whole surface's area is small (issue 20:
-/// no piece under 1 % of the area) and is grown from its neighbours where it can
-/// (`grow_small`).
-const SMALL_PART: f64 = 0.01;
 
 /// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
 /// would cross a panel rather than follow a line of the surface.
 const BENDS_RAD: f64 = 0.01 * std::f64::consts::PI / 180.0;
 
-/// Whether pieces too large for the sheet are split (`--split`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum Split {
-    /// Split them along their own lines so that every part fits.
-    #[default]
-    Auto,
-    /// Never: a piece that does not fit is refused by the nest.
-    None,
-}
-
-/// The room a piece must fit in (mm): the sheet inside its margins, or the roll's width
-/// inside its margins (`height: None`, unlimited length).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Room {
-    pub width: f64,
-    pub height: Option<f64>,
-}
-
-impl Room {
-    /// The room of a sheet (`height: None` for a roll) with `margin` kept on every side.
-    pub fn inside(width: f64, height: Option<f64>, margin: f64) -> Room {
-        Room {
-            width: width - 2.0 * margin,
-            height: height.map(|h| h - 2.0 * margin),
-        }
-    }
-
-    /// The room a piece's faces may take before it is split: this room less, on every side,
-    /// what the material adds around them (tab height or seam allowance, half the kerf), as
-    /// [`build_to_fit`] estimates it; `[width, height]`, the height infinite on a roll. The
-    /// flatten stage merges no two pieces into one larger than that
-    /// ([`crate::flatten::charts::FlattenOptions::room`]).
-    pub fn for_faces(&self, opts: &PatternOptions) -> [f64; 2] {
-        let grow = 2.0 * grow_estimate(opts);
-        [
-            self.width - grow,
-            self.height.map_or(f64::INFINITY, |h| h - grow),
-        ]
-    }
-
-    /// Positive and finite (a roll's length aside): something can be placed at all.
-    fn usable(&self) -> bool {
-        self.width.is_finite()
-            && self.width > 0.0
-            && self.height.is_none_or(|h| h.is_finite() && h > 0.0)
-    }
-
-    /// How far (mm) a box of this size sticks out of the room; ≤ 0 when it fits (within the
-    /// nest's 1e-9 mm).
-    fn overflow(&self, size: DVec2) -> f64 {
-        let over_y = self.height.map_or(f64::NEG_INFINITY, |h| size.y - h);
-        (size.x - self.width).max(over_y) - 1e-9
-    }
-
-    fn what(&self) -> &'static str {
-        if self.height.is_some() {
-            "sheet"
-        } else {
-            "roll"
-        }
-    }
-
-    fn height_text(&self) -> String {
-        self.height.map_or("∞".into(), |h| format!("{h:.1}"))
-    }
-}
-
-/// The least overflow (mm) of a point set over the orientations given (degrees): ≤ 0 fits.
-fn overflow(points: &[DVec2], angles_deg: &[f64], room: &Room) -> f64 {
-    angles_deg
-        .iter()
-        .map(|&deg| {
-            let r = turn(deg);
-            let (lo, hi) = polygon::bounds(points.iter().map(|p| r.rotate(*p))).unwrap_or_default();
-            room.overflow(hi - lo)
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// Rotation by `deg` degrees, exact for quarter turns (as the nest turns pieces).
-fn turn(deg: f64) -> DVec2 {
-    let q = deg.rem_euclid(360.0);
-    match q {
-        0.0 => DVec2::X,
-        90.0 => DVec2::Y,
-        180.0 => DVec2::NEG_X,
-        270.0 => DVec2::NEG_Y,
-        _ => DVec2::from_angle(q.to_radians()),
-    }
-}
-
-/// The orientations (degrees) the nest's construction tries for points whose minimum-area
-/// rectangle is at `angle` (radians): its four quarter turns, or with a grain the two that
-/// put the long side along y.
-fn rect_angles(angle: f64, grain: bool) -> Vec<f64> {
-    let quarters: &[f64] = if grain {
-        &[1.0, 3.0]
-    } else {
-        &[0.0, 1.0, 2.0, 3.0]
-    };
-    let a = angle.to_degrees();
-    quarters
-        .iter()
-        .map(|q| (a + 90.0 * q).rem_euclid(360.0))
-        .collect()
-}
-
-/// How far (mm) a built piece overflows the room at the nest's orientations: ≤ 0 fits.
-pub fn piece_overflow(piece: &Piece, room: &Room) -> f64 {
-    let Some(outer) = piece.outline.first() else {
-        return 0.0;
-    };
-    let angles = match piece.grain {
-        Some(g) => [90.0, 270.0]
-            .iter()
-            .map(|b| (b - g.to_degrees()).rem_euclid(360.0))
-            .collect(),
-        None => rect_angles(polygon::min_area_rect_angle(outer), false),
-    };
-    let pts: Vec<DVec2> = piece
-        .outline
-        .iter()
-        .filter(|r| r.len() >= 3)
-        .flatten()
-        .copied()
-        .collect();
-    overflow(&pts, &angles, room)
-}
-
-/// Whether a built piece fits the room in an orientation the nest tries.
-pub fn fits(piece: &Piece, room: &Room) -> bool {
-    piece_overflow(piece, room) <= 0.0
-}
-
-/// Build the pieces of every flat ([`super::build`]) so that each fits `room`: pieces that do
-/// not are split (see the module docs), changing their flat's islands and joined edges. When
-/// every piece fits as it is, the pieces are exactly [`super::build`]'s and the flats are
-/// untouched. A part that is a single face too large for the room is
-/// [`PatternError::TooLarge`].
-pub fn build_to_fit(
-    flats: &mut [Flat],
-    opts: &PatternOptions,
-    room: &Room,
-) -> Result<Vec<Piece>, PatternError> {
-    let pieces = super::build(flats, opts)?;
-    if !room.usable() || pieces.iter().all(|p| fits(p, room)) {
-        return Ok(pieces);
-    }
-    let originals: Vec<(Vec<Vec<usize>>, Vec<bool>)> = flats
-        .iter()
-        .map(|f| (f.islands.clone(), f.joined.clone()))
-        .collect();
-    // The growth estimate of every island that must be split (None: it fits as it is).
-    let base = grow_estimate(opts);
-    let mut grow: Vec<Vec<Option<f64>>> = Vec::new();
-    let mut k = 0;
-    for f in flats.iter() {
-        grow.push(
-            (0..f.islands.len())
-                .map(|_| {
-                    k += 1;
-                    (!fits(&pieces[k - 1], room)).then_some(base)
-                })
-                .collect(),
-        );
-    }
-    // Parts under this share of the whole surface are grown where they can (`grow_small`).
-    let total: f64 = flats
-        .iter()
-        .map(|f| {
-            (0..f.surface.mesh.faces.len())
-                .map(|g| f.surface.mesh.face_area(g))
-                .sum::<f64>()
-        })
-        .sum();
-    let small = SMALL_PART * total;
-    let mut last = pieces;
-    let mut cache: HashMap<(usize, usize), (f64, Parts)> = HashMap::new();
-    let mut stuck: HashMap<(usize, usize), u32> = HashMap::new();
-    for _round in 0..8 {
-        let mut tags = Vec::new();
-        let mut origin: Vec<(usize, usize, bool)> = Vec::new(); // (flat, island, one face)
-        let mut split_edges: Vec<HashSet<usize>> = Vec::new();
-        for (fi, flat) in flats.iter_mut().enumerate() {
-            let (islands, joined) = &originals[fi];
-            flat.islands = islands.clone();
-            flat.joined = joined.clone();
-            let mut plans = Vec::new();
-            for (ii, faces) in islands.iter().enumerate() {
-                let Some(g) = grow[fi][ii] else {
-                    plans.push(None);
-                    continue;
-                };
-                // The same growth gives the same partition: made once.
-                let parts = match cache.get(&(fi, ii)) {
-                    Some((cg, parts)) if *cg == g => parts.clone(),
-                    _ => {
-                        // Small parts are grown only while the island's parts have not come
-                        // out too large: grown ones are the likelier to.
-                        let grow_small = !stuck.contains_key(&(fi, ii));
-                        partition(flat, faces, g, opts, room, ii, (small, grow_small))?
-                    }
-                };
-                cache.insert((fi, ii), (g, parts.clone()));
-                plans.push(Some(parts));
-            }
-            let (t, o, cut) = apply(flat, &plans);
-            tags.push(t);
-            origin.extend(o.into_iter().map(|(ii, one)| (fi, ii, one)));
-            split_edges.push(cut);
-        }
-        let mut pieces = super::build_tagged(flats, &tags, opts)?;
-        let mut again = false;
-        for (p, &(fi, ii, one)) in pieces.iter().zip(&origin) {
-            let over = piece_overflow(p, room);
-            if over <= 0.0 {
-                continue;
-            }
-            if one {
-                return Err(too_large(p, room));
-            }
-            // Grown by the overflow (an island that fit as a whole now needs splitting too:
-            // possible only when the piece changed, which the same faces cannot), doubled
-            // each round the island still came out whole: the estimate can be short by much
-            // more than the overflow (a seam allowance mitred at a sharp corner reaches far
-            // past its width), while a part of a split island is only a little too large,
-            // unless it still is after two rounds (a new partition can land its parts just
-            // as far over: couplingdown in fabric, part 3a 0.12 mm over after 8 rounds).
-            let whole = cache
-                .get(&(fi, ii))
-                .is_none_or(|(_, parts)| parts.len() <= 1);
-            let k = stuck.entry((fi, ii)).or_insert(0u32);
-            let factor = if whole {
-                f64::from(1u32 << *k)
-            } else {
-                f64::from(1u32 << k.saturating_sub(2))
-            };
-            *k = (*k + 1).min(16);
-            let g = grow[fi][ii].get_or_insert(base);
-            *g += (0.5 * over + 0.5) * factor;
-            again = true;
-        }
-        let offset: Vec<usize> = flats
-            .iter()
-            .scan(0, |n, f| {
-                let at = *n;
-                *n += f.islands.len();
-                Some(at)
-            })
-            .collect();
-        for (fi, cut) in split_edges.iter().enumerate() {
-            let n = flats[fi].islands.len();
-            for p in &mut pieces[offset[fi]..offset[fi] + n] {
-                mark_split_seams(p, cut);
-            }
-        }
-        last = pieces;
-        if !again {
-            break;
-        }
-    }
-    explain_stretch(flats, &last, opts);
-    Ok(last)
-}
-
-/// A part of a split piece laid out from charts that stretches more than the material's
-/// tolerance (its layout is the piece's, within it as a whole) gets a warning on its surface
-/// saying so, which report.json lists.
-fn explain_stretch(flats: &mut [Flat], pieces: &[Piece], opts: &PatternOptions) {
-    let Some(limit) = opts.stretch_limit else {
-        return;
-    };
-    for p in pieces.iter().filter(|p| p.seams.iter().any(|s| s.split)) {
-        let Some(flat) = flats
-            .iter_mut()
-            .find(|f| f.surface.name == p.surface && f.surface.charts.is_some())
-        else {
-            continue;
-        };
-        let l2 = crate::flatten::charts::stretch_of(flat, &p.faces).l2;
-        if l2 > limit {
-            flat.surface.warnings.push(format!(
-                "surface `{}`: part {} stretches by L2 {l2:.5}, over the material's {limit:.4}: it is cut from a piece split to fit the sheet, laid out as that piece (within the tolerance as a whole), where the stretch gathers; a larger sheet keeps the piece whole",
-                p.surface, p.name
-            ));
-        }
-    }
-}
-
-/// What the material adds around a part at most (mm): tabs or seam allowance, half the kerf.
-fn grow_estimate(opts: &PatternOptions) -> f64 {
-    let tabs = if opts.tabs == Tabs::None {
-        0.0
-    } else {
-        opts.tab_height
-    };
-    tabs.max(opts.allowance).max(0.0) + 0.5 * opts.kerf.max(0.0)
-}
-
-/// Seam sides running along an edge the split cut are marked `split`.
-fn mark_split_seams(p: &mut Piece, cut: &HashSet<usize>) {
-    for s in &mut p.seams {
-        let Some(ring) = p.border_edges.get(s.ring).filter(|r| !r.is_empty()) else {
-            continue;
-        };
-        let n = ring.len();
-        s.split = (0..s.count).any(|i| cut.contains(&ring[(s.first + i) % n]));
-    }
-}
-
-/// The error for a single face that cannot fit, with its size and the room's.
-fn too_large(p: &Piece, room: &Room) -> PatternError {
-    let pts: Vec<DVec2> = p.outline.iter().flatten().copied().collect();
-    let r = turn(polygon::min_area_rect_angle(&pts).to_degrees());
-    let (lo, hi) = polygon::bounds(pts.iter().map(|q| r.rotate(*q))).unwrap_or_default();
-    let size = hi - lo;
-    PatternError::TooLarge {
-        surface: p.surface.clone(),
-        piece: p.name.clone(),
-        face: p.faces.first().map_or(0, |f| f + 1),
-        w: size.x.max(size.y),
-        h: size.x.min(size.y),
-        what: room.what(),
-        uw: room.width,
-        uh: room.height_text(),
-    }
-}
-
-/// Puts the parts of the split islands into the flat: edges between two parts are no longer
-/// joined, each part is an island (after the parts of the islands before it). Returns the
-/// islands' name tags (`3`, or `3a`, `3b`, … for the parts of island 3), each island's
-/// original island and whether it is a single face of a split island, and the edges cut.
-#[allow(clippy::type_complexity)]
-fn apply(
-    flat: &mut Flat,
-    plans: &[Option<Vec<Vec<usize>>>],
-) -> (Vec<String>, Vec<(usize, bool)>, HashSet<usize>) {
-    let mut islands = Vec::new();
-    let mut tags = Vec::new();
-    let mut origin = Vec::new();
-    for (ii, faces) in flat.islands.iter().enumerate() {
-        match &plans[ii] {
-            Some(parts) if parts.len() > 1 => {
-                for (j, part) in parts.iter().enumerate() {
-                    islands.push(part.clone());
-                    tags.push(format!("{}{}", ii + 1, letters(j)));
-                    origin.push((ii, part.len() == 1));
-                }
-            }
-            _ => {
-                islands.push(faces.clone());
-                tags.push(format!("{}", ii + 1));
-                origin.push((ii, faces.len() == 1));
-            }
-        }
-    }
-    for (k, faces) in islands.iter().enumerate() {
-        for &f in faces {
-            flat.face_island[f] = k;
-        }
-    }
-    let mut cut = HashSet::new();
-    for (e, edge) in flat.topology.edges.iter().enumerate() {
-        if flat.joined[e] && edge.uses.len() == 2 {
-            let (a, b) = (edge.uses[0].0, edge.uses[1].0);
-            if flat.face_island[a] != flat.face_island[b] {
-                flat.joined[e] = false;
-                cut.insert(e);
-            }
-        }
-    }
-    if let Some(charts) = flat.surface.charts.as_mut() {
-        charts.clone_from(&flat.face_island);
-    }
-    flat.islands = islands;
-    (tags, origin, cut)
-}
-
-/// `a`, `b`, … `z`, `aa`, `ab`, …
-fn letters(mut j: usize) -> String {
-    let mut s = Vec::new();
-    loop {
-        s.push(b'a' + (j % 26) as u8);
-        if j < 26 {
-            break;
-        }
-        j = j / 26 - 1;
-    }
-    s.reverse();
-    String::from_utf8(s).unwrap_or_default()
+/// How large the parts of an island are made.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sizes {
+    /// What the material adds around a part at most (mm): each part's faces must fit the room
+    /// shrunk by it on every side (a single face need only fit the room).
+    pub(super) grow: f64,
+    /// Area (mm²) under which a part is small (`grow_small`).
+    pub(super) small: f64,
+    /// Whether small parts are grown (`grow_small`).
+    pub(super) grow_small: bool,
 }
 
 /// One island being split: its faces (local indices), their centroids, areas and corners,
@@ -469,11 +59,7 @@ struct Island<'a> {
     links: Vec<(usize, usize, f64)>,
     grain: bool,
     room: Room,
-    grow: f64,
-    /// Area (mm²) under which a part is small (`grow_small`).
-    small: f64,
-    /// Whether small parts are grown (`grow_small`).
-    grow_small: bool,
+    sizes: Sizes,
     /// [`PatternOptions::stretch_limit`], for an island laid out from charts.
     limit: Option<f64>,
     /// Every face's corners with the face (local), sorted by x then y: the hull of a large
@@ -482,14 +68,20 @@ struct Island<'a> {
 }
 
 impl<'a> Island<'a> {
-    fn new(flat: &'a Flat, faces: &'a [usize], opts: &PatternOptions, room: &Room) -> Self {
+    fn new(
+        flat: &'a Flat,
+        faces: &'a [usize],
+        opts: &PatternOptions,
+        room: &Room,
+        sizes: Sizes,
+    ) -> Self {
         let n = faces.len();
         let mut local = HashMap::new();
         for (i, &f) in faces.iter().enumerate() {
             local.insert(f, i);
         }
         // Lines of the surface: where it bends at all, or a bend line it names.
-        let named = super::bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
+        let named = crate::pattern::bends::fold_angles(flat, opts.fold_threshold_deg.to_radians());
         let mut adj = vec![Vec::new(); n];
         let mut links = Vec::new();
         for (u, &f) in faces.iter().enumerate() {
@@ -539,9 +131,7 @@ impl<'a> Island<'a> {
             links,
             grain: opts.grain,
             room: *room,
-            grow: 0.0,
-            small: 0.0,
-            grow_small: false,
+            sizes,
             limit: opts.stretch_limit.filter(|_| flat.surface.charts.is_some()),
             sorted,
         }
@@ -560,7 +150,7 @@ impl<'a> Island<'a> {
         crate::flatten::distortion::stretch(&self.flat.surface.mesh, &faces, &uv).l2 > limit
     }
 
-    /// Overflow (mm) of a set of local faces, grown by `self.grow` unless it is one face.
+    /// Overflow (mm) of a set of local faces, grown by `self.sizes.grow` unless it is one face.
     fn overflow(&self, set: &[usize]) -> f64 {
         // Its hull: a large set's from the corners sorted once, a small one's by sorting its
         // own. The box of the hull is the box of the set.
@@ -582,7 +172,7 @@ impl<'a> Island<'a> {
                 .map(|(p, _)| *p);
             polygon::hull_of_sorted(pts.collect())
         };
-        let grow = if set.len() == 1 { 0.0 } else { self.grow };
+        let grow = if set.len() == 1 { 0.0 } else { self.sizes.grow };
         let angles = rect_angles(polygon::hull_rect_angle(&pts), self.grain);
         let room = Room {
             width: self.room.width - 2.0 * grow,
@@ -685,19 +275,15 @@ impl<'a> Island<'a> {
 
 /// Partition of one island into parts (global face ids) that each fit, estimated with
 /// `grow`; a single face that does not fit on its own is [`PatternError::TooLarge`].
-fn partition(
+pub(super) fn partition(
     flat: &Flat,
     faces: &[usize],
-    grow: f64,
     opts: &PatternOptions,
     room: &Room,
     island: usize,
-    (small, grow_parts): (f64, bool),
+    sizes: Sizes,
 ) -> Result<Vec<Vec<usize>>, PatternError> {
-    let mut isl = Island::new(flat, faces, opts, room);
-    isl.grow = grow;
-    isl.small = small;
-    isl.grow_small = grow_parts;
+    let isl = Island::new(flat, faces, opts, room, sizes);
     for u in 0..faces.len() {
         if isl.overflow(&[u]) > 0.0 {
             return Err(face_too_large(&isl, u, island));
@@ -827,7 +413,7 @@ fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     }
 }
 
-/// Small parts grown: a part under [`Island::small`] (a run of a sequence that ends on a tip
+/// Small parts grown: a part under [`Sizes::small`] (a run of a sequence that ends on a tip
 /// of the piece, or a piece of a run cut off from the rest) takes faces from the parts next to
 /// it, one at a time, until it is no longer small, as long as it still fits with the growth
 /// estimate to spare (a grown part's border is ragged, and the outline built on it reaches
@@ -838,9 +424,9 @@ fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     let n = isl.faces.len();
     let area = |p: &[usize]| p.iter().map(|&u| isl.area[u]).sum::<f64>();
     let mut small: Vec<usize> = (0..parts.len())
-        .filter(|&k| area(&parts[k]) < isl.small)
+        .filter(|&k| area(&parts[k]) < isl.sizes.small)
         .collect();
-    if small.is_empty() || parts.len() < 2 || !isl.grow_small {
+    if small.is_empty() || parts.len() < 2 || !isl.sizes.grow_small {
         return parts;
     }
     small.sort_by(|&a, &b| area(&parts[a]).total_cmp(&area(&parts[b])).then(a.cmp(&b)));
@@ -854,7 +440,7 @@ fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
     let mut mark = 1;
     for k in small {
         let mut have = area(&parts[k]);
-        while have < isl.small {
+        while have < isl.sizes.small {
             let centre = parts[k]
                 .iter()
                 .map(|&u| isl.centroid[u] * isl.area[u])
@@ -877,12 +463,12 @@ fn grow_small(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
             let mut took = None;
             for &(v, _, _) in &cands {
                 let j = part_of[v];
-                if area(&parts[j]) - isl.area[v] < isl.small {
+                if area(&parts[j]) - isl.area[v] < isl.sizes.small {
                     continue;
                 }
                 let mut grown = parts[k].clone();
                 grown.push(v);
-                if isl.overflow(&grown) > -isl.grow {
+                if isl.overflow(&grown) > -isl.sizes.grow {
                     continue;
                 }
                 let rest: Vec<usize> = parts[j].iter().copied().filter(|&u| u != v).collect();
@@ -912,7 +498,7 @@ type Best = Option<((usize, usize, usize, f64), Vec<Vec<usize>>)>;
 
 /// Keep `parts` if it beats the best so far: fewer parts, then fewer parts over the stretch
 /// limit (a part of a layout can stretch more than the whole), then fewer small parts (under
-/// [`Island::small`]), then a lower cost (seam length over a part's typical size, twice the
+/// [`Sizes::small`]), then a lower cost (seam length over a part's typical size, twice the
 /// largest part's excess area over the mean).
 fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
     let mut part_of = vec![0; isl.faces.len()];
@@ -936,7 +522,7 @@ fn consider(isl: &Island, parts: Vec<Vec<usize>>, total: f64, best: &mut Best) {
     let over = parts.iter().filter(|p| isl.over_limit(p)).count();
     let small = parts
         .iter()
-        .filter(|p| p.iter().map(|&u| isl.area[u]).sum::<f64>() < isl.small)
+        .filter(|p| p.iter().map(|&u| isl.area[u]).sum::<f64>() < isl.sizes.small)
         .count();
     let score = (parts.len(), over, small, cost);
     let better = match best {
@@ -1009,10 +595,7 @@ fn balanced(isl: &Island, order: &[usize], k: usize, total: f64) -> Vec<usize> {
 /// The error for face `u` of an island, too large for the room on its own.
 fn face_too_large(isl: &Island, u: usize, island: usize) -> PatternError {
     let f = isl.faces[u];
-    let pts = &isl.flat.face_2d[f];
-    let r = turn(polygon::min_area_rect_angle(pts).to_degrees());
-    let (lo, hi) = polygon::bounds(pts.iter().map(|q| r.rotate(*q))).unwrap_or_default();
-    let size = hi - lo;
+    let size = rect_size(&isl.flat.face_2d[f]);
     PatternError::TooLarge {
         surface: isl.flat.surface.name.clone(),
         piece: format!("{}", island + 1),
@@ -1029,30 +612,7 @@ fn face_too_large(isl: &Island, u: usize, island: usize) -> PatternError {
 mod tests {
     use super::*;
     use crate::flatten::{unfold, UnfoldOptions};
-
-    #[test]
-    fn part_letters_run_on_past_z() {
-        let names: Vec<String> = [0, 1, 25, 26, 27, 701, 702].map(letters).into();
-        assert_eq!(names, ["a", "b", "z", "aa", "ab", "zz", "aaa"]);
-    }
-
-    /// A flat row of `n` squares of `side` mm along x, as one surface.
-    fn row_of_squares(n: usize, side: f64) -> crate::surface::Surface {
-        let mut verts = Vec::new();
-        for i in 0..=n {
-            verts.push(glam::DVec3::new(side * i as f64, 0.0, 0.0));
-            verts.push(glam::DVec3::new(side * i as f64, side, 0.0));
-        }
-        let faces: Vec<[usize; 4]> = (0..n)
-            .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
-            .collect();
-        crate::surface::Surface {
-            name: "row".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
-            ..Default::default()
-        }
-    }
+    use crate::pattern::split::tests::row_of_squares;
 
     /// A row of 40 squares of 10 mm, flat: a part of two squares at its end takes squares from
     /// the part beside it until it has 8 (800 mm², the "small" bound here), the other part
@@ -1070,9 +630,12 @@ mod tests {
                 width: room,
                 height: Some(room),
             };
-            let mut isl = Island::new(&flat, all, &opts, &room);
-            isl.small = 800.0 - 1e-6;
-            isl.grow_small = true;
+            let sizes = Sizes {
+                grow: 0.0,
+                small: 800.0 - 1e-6,
+                grow_small: true,
+            };
+            let isl = Island::new(&flat, all, &opts, &room, sizes);
             let mut by_x: Vec<usize> = (0..all.len()).collect();
             by_x.sort_by(|&a, &b| isl.centroid[a].x.total_cmp(&isl.centroid[b].x));
             let parts: Vec<Vec<usize>> = parts
@@ -1106,40 +669,5 @@ mod tests {
             grown(250.0, three),
             [(5.0, 15.0, 2), (25.0, 95.0, 8), (105.0, 395.0, 30)]
         );
-    }
-
-    /// A flat row of five 100 mm squares on a 250 × 250 mm room: three parts (two squares
-    /// at most each), cut along square edges, one new seam each, the faces kept.
-    #[test]
-    fn a_row_of_squares_is_cut_between_squares() {
-        let row = row_of_squares(5, 100.0);
-        let mut flats = vec![unfold(row, &UnfoldOptions::default()).unwrap()];
-        let room = Room {
-            width: 250.0,
-            height: Some(250.0),
-        };
-        let opts = PatternOptions::default();
-        assert!(!fits(
-            &super::super::build(&flats, &opts).unwrap()[0],
-            &room
-        ));
-        let pieces = build_to_fit(&mut flats, &opts, &room).unwrap();
-        assert_eq!(pieces.len(), 3);
-        assert!(pieces.iter().all(|p| fits(p, &room)));
-        let mut sizes: Vec<usize> = pieces.iter().map(|p| p.faces.len()).collect();
-        sizes.sort_unstable();
-        assert_eq!(sizes, [1, 2, 2]);
-        let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
-        assert_eq!(names, ["1a", "1b", "1c"]);
-        let split: Vec<_> = pieces
-            .iter()
-            .flat_map(|p| &p.seams)
-            .filter(|s| s.split)
-            .collect();
-        assert_eq!(split.len(), 4);
-        assert!(split
-            .iter()
-            .all(|s| s.count == 1 && (s.length - 100.0).abs() < 1e-9));
-        assert_eq!(flats[0].islands.len(), 3);
     }
 }
