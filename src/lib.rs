@@ -91,6 +91,7 @@
 //!     mod.rs                   Flattening of a segmented smooth surface
 //!     assemble.rs              The charts once laid, as one `Flat`
 //!     darts.rs                 Darts and gussets
+//!     hinge.rs                 Small pieces hinged onto a neighbour by one edge, the rest of their common boundary a slit
 //!     overlap.rs               Overlap inside one chart's layout, and what is done about it (Julius 2006, thesis §5.3 "fixing …
 //!   param/
 //!     mod.rs                   Parameterisation of nearly developable disk-topology charts

@@ -79,7 +79,8 @@
 //! without overlap and with their seams matched (`merge`), else grafted onto its neighbours as
 //! they lie: its faces unfolded exactly onto their layouts (`exact::graft`). Then neighbouring
 //! pieces of any size are joined where they lie flat as one well within the tolerance
-//! (`merge`).
+//! (`merge`). Last, a piece still small is hinged onto a neighbour as it lies, by one edge of
+//! their common boundary, the rest of it a slit (`hinge`), where it fits beside it.
 //!
 //! **Seams that match** (issue 20): every layout within the tolerance has its boundary edges
 //! brought to their 3D lengths by [`param::match_seams`] before it is judged (overlap, flips,
@@ -107,6 +108,7 @@ use std::sync::Arc;
 mod assemble;
 mod darts;
 mod exact;
+mod hinge;
 mod join;
 mod merge;
 mod overlap;
@@ -831,6 +833,7 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     merge::merge_small(&ctx, &mut done, opts, overlap_eps);
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
     merge::merge_laid(&ctx, &mut done, opts, overlap_eps);
+    hinge::hinge_small(&ctx, &mut done, opts, overlap_eps);
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {
