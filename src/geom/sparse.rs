@@ -4,7 +4,10 @@
 //! Choices: the triplets are bucketed by column (a counting sort, linear in their number),
 //! each column sorted by row and its repeated entries summed in the order given, so the
 //! values do not depend on anything but the input (faer's own constructor sorts every triplet
-//! with a comparison sort).
+//! with a comparison sort). A solver that assembles systems of one pattern again and again
+//! (Newton steps, one chart laid twice) keeps the [`Pattern`]: where each triplet's value goes,
+//! so the next system of that pattern is filled in one pass, its values summed in the same
+//! order and so the same to the bit.
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 
@@ -14,43 +17,97 @@ pub fn from_triplets(
     n: usize,
     triplets: &[Triplet<usize, usize, f64>],
 ) -> Option<SparseColMat<usize, f64>> {
-    if triplets.iter().any(|t| t.row >= n || t.col >= n) {
-        return None;
+    Pattern::new(n, triplets).map(|p| p.matrix(triplets))
+}
+
+/// Where the values of a list of triplets go in their compressed-column matrix (see the
+/// module doc): built from one list, it fills any list with the same rows and columns in the
+/// same order.
+#[derive(Clone)]
+pub struct Pattern {
+    n: usize,
+    /// Each triplet's (row, column), in order.
+    keys: Vec<(usize, usize)>,
+    /// Each triplet's index into the matrix's values.
+    slot: Vec<usize>,
+    symbolic: SymbolicSparseColMat<usize>,
+}
+
+impl Pattern {
+    /// The pattern of `triplets` in an `n` × `n` matrix; `None` when an index is `n` or more.
+    pub fn new(n: usize, triplets: &[Triplet<usize, usize, f64>]) -> Option<Pattern> {
+        if triplets.iter().any(|t| t.row >= n || t.col >= n) {
+            return None;
+        }
+        // Bucket by column, keeping the triplets' order within a column.
+        let mut start = vec![0usize; n + 1];
+        for t in triplets {
+            start[t.col + 1] += 1;
+        }
+        for c in 0..n {
+            start[c + 1] += start[c];
+        }
+        let mut next = start.clone();
+        let mut entries = vec![(0usize, 0usize); triplets.len()];
+        for (i, t) in triplets.iter().enumerate() {
+            entries[next[t.col]] = (t.row, i);
+            next[t.col] += 1;
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx: Vec<usize> = Vec::with_capacity(triplets.len());
+        let mut slot = vec![0usize; triplets.len()];
+        col_ptr.push(0);
+        for c in 0..n {
+            let column = &mut entries[start[c]..start[c + 1]];
+            // Stable: equal rows keep their order, so they are summed as given.
+            column.sort_by_key(|e| e.0);
+            for &(r, i) in column.iter() {
+                if row_idx.len() == col_ptr[c] || row_idx.last() != Some(&r) {
+                    row_idx.push(r);
+                }
+                slot[i] = row_idx.len() - 1;
+            }
+            col_ptr.push(row_idx.len());
+        }
+        Some(Pattern {
+            n,
+            keys: triplets.iter().map(|t| (t.row, t.col)).collect(),
+            slot,
+            symbolic: SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx),
+        })
     }
-    // Bucket by column, keeping the triplets' order within a column.
-    let mut start = vec![0usize; n + 1];
-    for t in triplets {
-        start[t.col + 1] += 1;
+
+    /// The matrix's rows and columns.
+    pub fn symbolic(&self) -> &SymbolicSparseColMat<usize> {
+        &self.symbolic
     }
-    for c in 0..n {
-        start[c + 1] += start[c];
+
+    /// Whether `triplets` name the rows and columns this pattern was built from, in order.
+    pub fn fits(&self, n: usize, triplets: &[Triplet<usize, usize, f64>]) -> bool {
+        n == self.n
+            && triplets.len() == self.keys.len()
+            && triplets
+                .iter()
+                .zip(&self.keys)
+                .all(|(t, &(r, c))| t.row == r && t.col == c)
     }
-    let mut next = start.clone();
-    let mut entries = vec![(0usize, 0.0f64); triplets.len()];
-    for t in triplets {
-        entries[next[t.col]] = (t.row, t.val);
-        next[t.col] += 1;
-    }
-    let mut col_ptr = Vec::with_capacity(n + 1);
-    let mut row_idx = Vec::with_capacity(triplets.len());
-    let mut val = Vec::with_capacity(triplets.len());
-    col_ptr.push(0);
-    for c in 0..n {
-        let column = &mut entries[start[c]..start[c + 1]];
-        // Stable: equal rows keep their order, so they are summed as given.
-        column.sort_by_key(|e| e.0);
-        for &(r, v) in column.iter() {
-            if row_idx.len() > col_ptr[c] && row_idx.last() == Some(&r) {
-                *val.last_mut()? += v;
+
+    /// The matrix of `triplets`, which must [`Pattern::fits`] this pattern.
+    pub fn matrix(&self, triplets: &[Triplet<usize, usize, f64>]) -> SparseColMat<usize, f64> {
+        let mut val = vec![0.0f64; self.symbolic.row_idx().len()];
+        let mut set = vec![false; val.len()];
+        for (t, &k) in triplets.iter().zip(&self.slot) {
+            // The first value of an entry is taken as it is (so −0.0 stays −0.0), the
+            // next ones added in order.
+            if set[k] {
+                val[k] += t.val;
             } else {
-                row_idx.push(r);
-                val.push(v);
+                val[k] = t.val;
+                set[k] = true;
             }
         }
-        col_ptr.push(row_idx.len());
+        SparseColMat::new(self.symbolic.clone(), val)
     }
-    let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-    Some(SparseColMat::new(symbolic, val))
 }
 
 #[cfg(test)]
@@ -76,5 +133,38 @@ mod tests {
         assert_eq!(m.val(), &[4.0, 1.5, 3.0, -1.0, 5.0]);
         assert!(from_triplets(2, &trip).is_none(), "row 2 in a 2 x 2 matrix");
         assert_eq!(from_triplets(0, &[]).map(|m| m.val().len()), Some(0));
+    }
+
+    #[test]
+    fn a_pattern_fills_new_values_as_a_fresh_assembly_would() {
+        let t = |r, c, v| Triplet::new(r, c, v);
+        let trip = [
+            t(2, 0, 1.0),
+            t(0, 0, 4.0),
+            t(2, 0, 0.5),
+            t(1, 1, 3.0),
+            t(2, 1, -1.0),
+        ];
+        let p = Pattern::new(3, &trip).unwrap();
+        let again = [
+            t(2, 0, 0.1),
+            t(0, 0, 0.2),
+            t(2, 0, 0.7),
+            t(1, 1, -0.0),
+            t(2, 1, 9.0),
+        ];
+        assert!(p.fits(3, &again));
+        let (a, b) = (p.matrix(&again), from_triplets(3, &again).unwrap());
+        assert_eq!(a.symbolic().col_ptr(), b.symbolic().col_ptr());
+        assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx());
+        let bits = |m: &SparseColMat<usize, f64>| -> Vec<u64> {
+            m.val().iter().map(|x| x.to_bits()).collect()
+        };
+        assert_eq!(bits(&a), bits(&b));
+        assert_eq!(a.val(), &[0.2, 0.1 + 0.7, -0.0, 9.0]);
+        // Another order, another column, another size: does not fit.
+        assert!(!p.fits(3, &[again[1], again[0], again[2], again[3], again[4]]));
+        assert!(!p.fits(3, &again[..4]));
+        assert!(!p.fits(4, &again));
     }
 }

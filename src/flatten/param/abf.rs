@@ -31,7 +31,7 @@ pub(super) fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
     let mut lam2 = vec![0.0f64; 2 * abf.ni];
     let m2 = 2 * abf.ni;
     let mut converged = false;
-    let mut symbolic = None;
+    let mut solver = None;
     let mut last_norm = f64::INFINITY;
     for _iter in 0..ABF_MAX_ITER {
         let gr = abf.gradient(&alpha, &lam_t, &lam2);
@@ -56,7 +56,7 @@ pub(super) fn abf_angles(chart: &Chart) -> Result<Vec<[f64; 3]>, ParamError> {
         }
         last_norm = norm;
         let red = abf.reduced(&gr);
-        let x = spd_solve(chart, M, m2, &red.triplets, &red.rhs, &mut symbolic, 0)?;
+        let x = spd_solve(chart, M, m2, &red.triplets, &red.rhs, &mut solver, 0)?;
         let (d_alpha, d_lam_t, step) = abf.step(&gr, &red, &alpha, &x);
         if step.is_nan() || step <= 1e-6 {
             return Err(chart.solver_error(M, "the Newton step cannot keep the angles in (0, π)"));

@@ -51,6 +51,7 @@
 
 use super::distortion::{self, corner_angle, face_triangles, Stretch};
 use crate::geom::mesh::Mesh;
+use crate::geom::sparse::Pattern;
 use crate::geom::unionfind::UnionFind;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -567,37 +568,47 @@ fn shape_from_angles(a: [f64; 3]) -> [DVec2; 3] {
     ]
 }
 
-/// Solve a symmetric positive definite system given by its lower-triangle triplets.
+/// A system's pattern ([`Pattern`]) with its ordering and symbolic factorisation, which
+/// depend on the pattern only: kept by a solver for its next system, used again when that
+/// one [`Pattern::fits`] (each Newton step of ABF++, the LSCM solve of a chart laid by LSCM
+/// and again from ABF++'s angles).
+pub(super) struct Solver {
+    pattern: Pattern,
+    symbolic: SymbolicLlt<usize>,
+}
+
+/// Solve a symmetric positive definite system given by its lower-triangle triplets, with the
+/// `solver` kept from the last system where it fits (else made anew and kept).
 fn spd_solve(
     chart: &Chart,
     method: &'static str,
     n: usize,
     triplets: &[Triplet<usize, usize, f64>],
     rhs: &[f64],
-    symbolic: &mut Option<SymbolicLlt<usize>>,
+    solver: &mut Option<Solver>,
     refine: usize,
 ) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
         return Ok(Vec::new());
     }
-    let a = crate::geom::sparse::from_triplets(n, triplets).ok_or_else(|| {
-        chart.solver_error(
-            method,
-            "cannot build the sparse system: an index out of range",
-        )
-    })?;
-    // The ordering and symbolic factorisation depend on the pattern only: reuse them.
-    let sym = match symbolic {
-        Some(s) => s.clone(),
-        None => {
-            let s = SymbolicLlt::try_new(a.symbolic(), Side::Lower).map_err(|e| {
-                chart.solver_error(method, format!("cannot order the sparse system: {e:?}"))
+    let solver = match solver {
+        Some(s) if s.pattern.fits(n, triplets) => s,
+        _ => {
+            let pattern = Pattern::new(n, triplets).ok_or_else(|| {
+                chart.solver_error(
+                    method,
+                    "cannot build the sparse system: an index out of range",
+                )
             })?;
-            *symbolic = Some(s.clone());
-            s
+            let symbolic =
+                SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower).map_err(|e| {
+                    chart.solver_error(method, format!("cannot order the sparse system: {e:?}"))
+                })?;
+            solver.insert(Solver { pattern, symbolic })
         }
     };
-    let llt = Llt::try_new_with_symbolic(sym, a.as_ref(), Side::Lower)
+    let a = solver.pattern.matrix(triplets);
+    let llt = Llt::try_new_with_symbolic(solver.symbolic.clone(), a.as_ref(), Side::Lower)
         .map_err(|e| chart.solver_error(method, format!("the system is singular ({e:?})")))?;
     let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
     let x = llt.solve(&b);
@@ -631,6 +642,7 @@ fn lscm_solve(
     shapes: &[[DVec2; 3]],
     pin: [usize; 2],
     pin_pos: [DVec2; 2],
+    solver: &mut Option<Solver>,
 ) -> Result<Vec<DVec2>, ParamError> {
     let nv = chart.pos.len();
     // Free vertex k has unknowns u = 2k, v = 2k + 1.
@@ -697,7 +709,7 @@ fn lscm_solve(
             }
         }
     }
-    let x = spd_solve(chart, method, n, &triplets, &rhs, &mut None, 2)?;
+    let x = spd_solve(chart, method, n, &triplets, &rhs, solver, 2)?;
     Ok((0..nv)
         .map(|v| match var[v] {
             Some(kk) => DVec2::new(x[2 * kk], x[2 * kk + 1]),
@@ -759,6 +771,7 @@ fn run_lscm(
     faces: &[usize],
     chart: &Chart,
     pin: [usize; 2],
+    solver: &mut Option<Solver>,
 ) -> Result<ChartParam, ParamError> {
     let d = chart.pos[pin[0]].distance(chart.pos[pin[1]]);
     let uv = lscm_solve(
@@ -767,6 +780,7 @@ fn run_lscm(
         &shapes_from_3d(chart),
         pin,
         [DVec2::ZERO, DVec2::new(d, 0.0)],
+        solver,
     )?;
     Ok(finish(mesh, faces, chart, ParamMethod::Lscm, uv))
 }
@@ -776,6 +790,7 @@ fn run_abf(
     faces: &[usize],
     chart: &Chart,
     pin: [usize; 2],
+    solver: &mut Option<Solver>,
 ) -> Result<ChartParam, ParamError> {
     let angles = abf_angles(chart)?;
     let shapes: Vec<[DVec2; 3]> = angles.iter().map(|a| shape_from_angles(*a)).collect();
@@ -786,6 +801,7 @@ fn run_abf(
         &shapes,
         pin,
         [DVec2::ZERO, DVec2::new(d, 0.0)],
+        solver,
     )?;
     Ok(finish(mesh, faces, chart, ParamMethod::Abf, uv))
 }
@@ -799,18 +815,20 @@ pub fn parameterize(
 ) -> Result<ChartParam, ParamError> {
     let chart = build_chart(mesh, faces)?;
     let pin = pins(&chart);
+    // LSCM's system has one pattern whichever shapes it is given: one ordering for both.
+    let mut solver = None;
     match method {
-        ParamMethod::Lscm => run_lscm(mesh, faces, &chart, pin),
-        ParamMethod::Abf => run_abf(mesh, faces, &chart, pin),
+        ParamMethod::Lscm => run_lscm(mesh, faces, &chart, pin, &mut solver),
+        ParamMethod::Abf => run_abf(mesh, faces, &chart, pin, &mut solver),
         ParamMethod::Best => {
-            let l = run_lscm(mesh, faces, &chart, pin);
+            let l = run_lscm(mesh, faces, &chart, pin, &mut solver);
             if let Ok(l) = &l {
                 // Already isometric: nothing can do better.
                 if l.stretch.flipped == 0 && l.stretch.l2 - 1.0 < ISOMETRIC {
                     return Ok(l.clone());
                 }
             }
-            let a = run_abf(mesh, faces, &chart, pin);
+            let a = run_abf(mesh, faces, &chart, pin, &mut solver);
             let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
             let kept = match (l, a) {
                 (Ok(l), Ok(a)) => {
@@ -968,7 +986,7 @@ mod tests {
         assert_eq!(interior, 25);
         // Angles that satisfy the constraints rebuild a layout whose triangles have exactly
         // those angles (up to round-off): the reconstruction is consistent.
-        let p = run_abf(&m, &faces, &chart, pins(&chart)).expect("layout");
+        let p = run_abf(&m, &faces, &chart, pins(&chart), &mut None).expect("layout");
         // One triangle per face, faces in order: triangle t is face t.
         assert_eq!(p.uv.len(), alpha.len());
         for (t, (uv, al)) in p.uv.iter().zip(&alpha).enumerate() {

@@ -30,6 +30,7 @@
 use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
+use crate::geom::sparse::Pattern;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::Triplet;
@@ -158,7 +159,7 @@ fn relax(
     let n = uv.len();
     // The pinned vertex keeps its place softly: translation is free in the energy.
     let pin = edges.first().map_or(0, |e| e.0);
-    let mut symbolic: Option<SymbolicLlt<usize>> = None;
+    let mut solver: Option<(Pattern, SymbolicLlt<usize>)> = None;
     for &w in &WEIGHTS {
         let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(tris.len() * 9);
         let mut add = |i: usize, j: usize, c: f64| {
@@ -175,12 +176,15 @@ fn relax(
             add(a, b, w);
         }
         trip.push(Triplet::new(pin, pin, 1.0));
-        let m = crate::geom::sparse::from_triplets(n, &trip)?;
-        // Every weight has the same pattern: one ordering and symbolic factorisation.
-        let sym = match &symbolic {
-            Some(sym) => sym,
-            None => symbolic.insert(SymbolicLlt::try_new(m.symbolic(), Side::Lower).ok()?),
-        };
+        // Every weight has the same pattern: one assembly pattern, ordering and symbolic
+        // factorisation.
+        if !solver.as_ref().is_some_and(|s| s.0.fits(n, &trip)) {
+            let pattern = Pattern::new(n, &trip)?;
+            let sym = SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower).ok()?;
+            solver = Some((pattern, sym));
+        }
+        let (pattern, sym) = solver.as_ref()?;
+        let m = pattern.matrix(&trip);
         let llt = Llt::try_new_with_symbolic(sym.clone(), m.as_ref(), Side::Lower).ok()?;
         for _ in 0..ITERATIONS {
             let mut rhs = vec![DVec2::ZERO; n];
