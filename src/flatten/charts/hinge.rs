@@ -31,14 +31,14 @@ use glam::DVec2;
 use std::collections::HashMap;
 
 /// Candidate hinge edges tried per neighbour.
-const HINGE_TRIES: usize = 6;
+const HINGE_TRIES: usize = 64;
 /// Rounds at most (a hinged union still small may hinge again).
 const HINGE_ROUNDS: usize = 4;
 /// Candidates tried with the union relaxed, per neighbour.
 const RELAX_TRIES: usize = 2;
 /// How near (in mean common edge lengths) a common edge's ends must land to be joined when
 /// the union is relaxed.
-const HINGE_REACH: f64 = 0.25;
+const HINGE_REACH: f64 = 0.5;
 
 /// An edge of the common boundary of a small piece and a neighbour.
 struct Common {
