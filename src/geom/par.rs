@@ -1,7 +1,8 @@
 //! Fork–join parallelism whose results do not depend on the number of threads: [`join`] runs
 //! two closures, the second on a scoped thread when one of the process's spare threads is
 //! free (one fewer than the machine's cores, shared by every caller, nested calls included),
-//! else after the first on this one; [`map`] splits a list of independent jobs into halves
+//! else after the first on this one; [`speculate`] runs the second only when a spare thread
+//! is free; [`map`] splits a list of independent jobs into halves
 //! of about equal weight and joins them, so a job may itself fork (a chart whose halves are
 //! laid in parallel). Results always come back in the jobs' order.
 
@@ -55,6 +56,30 @@ where
         let ra = a();
         let rb = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
         (ra, rb)
+    })
+}
+
+/// `(a(), Some(b()))` with `b` on another thread when a spare one is free, else `(a(), None)`
+/// without running `b`: for work that is only worth doing beside other work (a second
+/// candidate tried while the first is, its result used only when the first fails).
+pub fn speculate<A, B, FA, FB>(a: FA, b: FB) -> (A, Option<B>)
+where
+    A: Send,
+    B: Send,
+    FA: FnOnce() -> A + Send,
+    FB: FnOnce() -> B + Send,
+{
+    if !take() {
+        return (a(), None);
+    }
+    std::thread::scope(|s| {
+        let hb = s.spawn(move || {
+            let _token = Token;
+            b()
+        });
+        let ra = a();
+        let rb = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        (ra, Some(rb))
     })
 }
 
@@ -114,6 +139,24 @@ mod tests {
         });
         let squares: Vec<u64> = out.iter().map(|r| r.0).collect();
         assert_eq!(squares, (0..50u64).map(|x| x * x).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn speculation_runs_beside_or_not_at_all() {
+        let ran = std::sync::atomic::AtomicBool::new(false);
+        let (a, b) = speculate(
+            || 1,
+            || {
+                ran.store(true, Ordering::SeqCst);
+                2
+            },
+        );
+        assert_eq!(a, 1);
+        // Run on a spare thread (and then its result is back) or not at all.
+        assert_eq!(b.is_some(), ran.load(Ordering::SeqCst));
+        if std::thread::available_parallelism().map_or(1, |p| p.get()) == 1 {
+            assert_eq!(b, None);
+        }
     }
 
     #[test]

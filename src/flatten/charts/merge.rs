@@ -42,7 +42,7 @@
 
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
-use super::overlap::{both_cuts, laid_as_one, merge_into, self_overlap, Owners};
+use super::overlap::{both_cuts, first_merge, laid_as_one, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -92,11 +92,8 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
             .collect();
         // Laid out again as one, else shared out with a neighbour, else grafted onto the
         // neighbours as they lie.
-        if let Some(k) = near
-            .iter()
-            .copied()
-            .find(|&k| merge_into(ctx, done, k, si, opts, eps))
-        {
+        if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps) {
+            done[k] = union;
             owners.absorb(done, k, si);
         } else if let Some(k) = near
             .iter()

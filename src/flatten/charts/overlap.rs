@@ -354,18 +354,62 @@ pub(super) fn merge_into(
     opts: &FlattenOptions,
     eps: f64,
 ) -> bool {
-    match laid_as_one(ctx, done, k, part) {
-        Some(l)
-            if l.stretch.flipped == 0
-                && l.stretch.l2 <= opts.tolerance
-                && ctx.seam_error(&l) <= opts.seam_tolerance
-                && self_overlap(&l.uv, eps).is_none() =>
-        {
+    match merged(ctx, done, k, part, opts, eps) {
+        Some(l) => {
             done[k] = l;
             true
         }
-        _ => false,
+        None => false,
     }
+}
+
+/// `done[k]` and `done[part]` laid out as one ([`laid_as_one`]), when the union is kept by the
+/// checks of [`merge_into`].
+fn merged(
+    ctx: &Charts,
+    done: &[Laid],
+    k: usize,
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<Laid> {
+    laid_as_one(ctx, done, k, part).filter(|l| {
+        l.stretch.flipped == 0
+            && l.stretch.l2 <= opts.tolerance
+            && ctx.seam_error(l) <= opts.seam_tolerance
+            && self_overlap(&l.uv, eps).is_none()
+    })
+}
+
+/// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
+/// the union, as trying them in order finds it; two are tried at a time where a spare thread
+/// is free ([`crate::geom::par::speculate`]), the second's result used only when the first
+/// fails.
+pub(super) fn first_merge(
+    ctx: &Charts,
+    done: &[Laid],
+    near: &[usize],
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<(usize, Laid)> {
+    let mut i = 0;
+    while let Some(&k) = near.get(i) {
+        let next = near.get(i + 1).copied();
+        let (first, second) = crate::geom::par::speculate(
+            || merged(ctx, done, k, part, opts, eps),
+            || next.and_then(|j| merged(ctx, done, j, part, opts, eps)),
+        );
+        if let Some(l) = first {
+            return Some((k, l));
+        }
+        match (next, second) {
+            (Some(j), Some(Some(l))) => return Some((j, l)),
+            (_, Some(None)) => i += 2,
+            _ => i += 1,
+        }
+    }
+    None
 }
 
 /// `done[k]` and `done[part]` laid out as one chart (the cuts of both, more where the union
