@@ -7,16 +7,23 @@
 //! sewn or glued as a seam between two pieces is). Nothing is laid out again and both layouts
 //! keep their stretch, so the union is within the tolerance when both were.
 //!
+//! Where no edge hinges without overlap, the slit's two sides often run side by side and
+//! cross a little (the two layouts of one curve differ by their stretch): then the best
+//! candidates are tried once more with every common edge whose ends land within
+//! [`HINGE_REACH`] of a mean common edge's length joined, and the union relaxed as a merged
+//! piece is ([`Charts::lay_from`]: started from the two as they lie) and checked as one is.
+//!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
 //!   also puts other common edges in place where the two boundaries run alike (a fold of a
 //!   developable), and those are joined too. Candidates are tried by the common length they
 //!   join, longest first (ties: longer hinge edge, then lower edge id), at most
-//!   [`HINGE_TRIES`] per neighbour.
+//!   [`HINGE_TRIES`] per neighbour, and relaxed the first [`RELAX_TRIES`].
 //! - **Which neighbour.** Those sharing the longest boundary first, as for merges.
 //! - **Kept when** the union is flip-free, within the tolerance, its seams matched, without
-//!   overlap (the moved piece against the neighbour's faces near it) and, when pieces are
-//!   split to fit the sheet, fitting it (else the split would cut it up again).
+//!   overlap (the moved piece against the neighbour's faces near it; a relaxed union as a
+//!   whole) and, when pieces are split to fit the sheet, fitting it (else the split would cut
+//!   it up again).
 //! - A common edge counts as in place when both its ends land within twice the seam tolerance
 //!   of its 3D length of the neighbour's: each side was matched to the 3D length within that
 //!   tolerance, so the hinge edge itself always is.
@@ -261,20 +268,7 @@ fn hinged(
     if !fits_room(opts.room, &[done[k].uv.as_slice(), &moved].concat()) {
         return None;
     }
-    // Overlap: the moved piece against itself and the neighbour's faces near it.
-    let (lo, hi) = polygon::bounds(moved.iter().flatten().copied())?;
-    let nearby: Vec<Vec<DVec2>> = done[k]
-        .uv
-        .iter()
-        .filter(|c| {
-            polygon::bounds(c.iter().copied()).is_some_and(|(a, b)| {
-                a.x <= hi.x + eps && a.y <= hi.y + eps && b.x >= lo.x - eps && b.y >= lo.y - eps
-            })
-        })
-        .cloned()
-        .chain(moved.iter().cloned())
-        .collect();
-    if !relax && self_overlap(&nearby, eps).is_some() {
+    if !relax && overlaps_near(&done[k].uv, &moved, eps) {
         return None;
     }
     let mut faces = done[k].faces.clone();
@@ -311,6 +305,25 @@ fn hinged(
         && stretch.l2 <= opts.tolerance
         && ctx.seam_error(&l) <= opts.seam_tolerance)
         .then_some(l)
+}
+
+/// Whether the `moved` piece overlaps itself or the faces of `fixed` near it (deeper than
+/// `eps`).
+fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
+    let Some((lo, hi)) = polygon::bounds(moved.iter().flatten().copied()) else {
+        return false;
+    };
+    let nearby: Vec<Vec<DVec2>> = fixed
+        .iter()
+        .filter(|c| {
+            polygon::bounds(c.iter().copied()).is_some_and(|(a, b)| {
+                a.x <= hi.x + eps && a.y <= hi.y + eps && b.x >= lo.x - eps && b.y >= lo.y - eps
+            })
+        })
+        .chain(moved)
+        .cloned()
+        .collect();
+    self_overlap(&nearby, eps).is_some()
 }
 
 #[cfg(test)]
