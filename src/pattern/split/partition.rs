@@ -291,66 +291,34 @@ pub(super) fn partition(
     }
     let total: f64 = isl.area.iter().sum();
     let n = faces.len();
-    let mut stamp = vec![0usize; n];
-    let mut mark = 1;
-    let mut best: Best = None;
     let orders = isl.orders();
-    // Runs [cuts[i], cuts[i + 1]) of an order, as parts if each fits.
-    let mut parts_of = |order: &[usize], cuts: &[usize]| -> Option<Vec<Vec<usize>>> {
-        let mut parts = Vec::new();
-        for w in cuts.windows(2) {
-            mark += 2;
-            for comp in isl.components(&order[w[0]..w[1]], &mut stamp, mark) {
-                if isl.overflow(&comp) > 0.0 {
-                    return None;
-                }
-                parts.push(comp);
-            }
-        }
-        Some(parts)
-    };
-    let mut greedy_runs = Vec::new();
-    for order in &orders {
-        // Greedy: each run as long as fits (binary search on its end).
-        let mut cuts = vec![0];
-        let mut s = 0;
-        while s < n {
-            let mut ok = |t: usize| parts_of(order, &[s, t]).is_some();
-            let t = if ok(n) {
-                n
-            } else {
-                // ok(lo) holds (every face fits alone, checked above), ok(hi) does not.
-                let (mut lo, mut hi) = (s + 1, n);
-                while hi - lo > 1 {
-                    let mid = (lo + hi) / 2;
-                    if ok(mid) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                lo
-            };
-            cuts.push(t);
-            s = t;
-        }
-        greedy_runs.push(cuts.len() - 1);
-        if let Some(parts) = parts_of(order, &cuts) {
-            consider(&isl, grow_small(&isl, merge(&isl, parts)), total, &mut best);
+    // Each order's greedy partition and its number of runs, then the balanced ones; the
+    // orders in parallel, the partitions considered in the orders' order.
+    let greedy = crate::geom::par::map(orders.iter().collect(), &[], &|order: &Vec<usize>| {
+        greedy(&isl, order)
+    });
+    let mut best: Best = None;
+    for (_, parts) in &greedy {
+        if let Some(parts) = parts {
+            consider(&isl, parts.clone(), total, &mut best);
         }
     }
-    let k_min = greedy_runs.iter().copied().min().unwrap_or(1);
-    for (order, &k_own) in orders.iter().zip(&greedy_runs) {
-        let mut ks = vec![k_min];
+    let k_min = greedy.iter().map(|g| g.0).min().unwrap_or(1);
+    let mut jobs = Vec::new();
+    for (order, &(k_own, _)) in orders.iter().zip(&greedy) {
+        jobs.push((order, k_min));
         if k_own != k_min {
-            ks.push(k_own);
+            jobs.push((order, k_own));
         }
-        for k in ks {
-            let cuts = balanced(&isl, order, k, total);
-            if let Some(parts) = parts_of(order, &cuts) {
-                consider(&isl, grow_small(&isl, merge(&isl, parts)), total, &mut best);
-            }
-        }
+    }
+    let balanced = crate::geom::par::map(jobs, &[], &|(order, k): (&Vec<usize>, usize)| {
+        let cuts = balanced(&isl, order, k, total);
+        Runs::new(n)
+            .parts(&isl, order, &cuts)
+            .map(|parts| grow_small(&isl, merge(&isl, parts)))
+    });
+    for parts in balanced.into_iter().flatten() {
+        consider(&isl, parts, total, &mut best);
     }
     let parts = best
         .map(|(_, p)| p)
@@ -359,6 +327,72 @@ pub(super) fn partition(
         .into_iter()
         .map(|p| p.into_iter().map(|u| faces[u]).collect())
         .collect())
+}
+
+/// The parts of runs of an order, as [`partition`] cuts them: stamps for
+/// [`Island::components`], fresh for each run.
+struct Runs {
+    stamp: Vec<usize>,
+    mark: usize,
+}
+
+impl Runs {
+    fn new(n: usize) -> Runs {
+        Runs {
+            stamp: vec![0; n],
+            mark: 1,
+        }
+    }
+
+    /// The runs [cuts[i], cuts[i + 1]) of `order`, as parts (each run's connected pieces) if
+    /// each fits.
+    fn parts(&mut self, isl: &Island, order: &[usize], cuts: &[usize]) -> Option<Vec<Vec<usize>>> {
+        let mut parts = Vec::new();
+        for w in cuts.windows(2) {
+            self.mark += 2;
+            for comp in isl.components(&order[w[0]..w[1]], &mut self.stamp, self.mark) {
+                if isl.overflow(&comp) > 0.0 {
+                    return None;
+                }
+                parts.push(comp);
+            }
+        }
+        Some(parts)
+    }
+}
+
+/// The greedy partition of an order (each run as long as fits, by binary search on its end):
+/// its number of runs, and its parts merged and grown ([`merge`], [`grow_small`]) when they
+/// fit.
+fn greedy(isl: &Island, order: &[usize]) -> (usize, Option<Vec<Vec<usize>>>) {
+    let n = order.len();
+    let mut runs = Runs::new(n);
+    let mut cuts = vec![0];
+    let mut s = 0;
+    while s < n {
+        let mut ok = |t: usize| runs.parts(isl, order, &[s, t]).is_some();
+        let t = if ok(n) {
+            n
+        } else {
+            // ok(lo) holds (every face fits alone, checked before), ok(hi) does not.
+            let (mut lo, mut hi) = (s + 1, n);
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                if ok(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
+        };
+        cuts.push(t);
+        s = t;
+    }
+    let parts = runs
+        .parts(isl, order, &cuts)
+        .map(|parts| grow_small(isl, merge(isl, parts)));
+    (cuts.len() - 1, parts)
 }
 
 /// Fewer parts: the smallest part that can join a neighbour (through a joined edge) and
