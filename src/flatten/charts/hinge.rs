@@ -29,8 +29,8 @@
 //!   tolerance, so the hinge edge itself always is.
 
 use super::join::fits_room;
-use super::merge::SMALL_SHARE;
-use super::overlap::{self_overlap, Owners};
+use super::merge::small_pieces;
+use super::overlap::{keeps, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::polygon;
@@ -46,6 +46,12 @@ const RELAX_TRIES: usize = 2;
 /// How near (in mean common edge lengths) a common edge's ends must land to be joined when
 /// the union is relaxed.
 const HINGE_REACH: f64 = 0.5;
+
+/// A rigid motion of the plane: a unit complex number (the turn) and a shift.
+type Motion = (DVec2, DVec2);
+
+/// Which common edges a motion joins.
+type Joins<'a> = &'a dyn Fn(Motion, &Common) -> bool;
 
 /// An edge of the common boundary of a small piece and a neighbour.
 struct Common {
@@ -64,18 +70,10 @@ struct Common {
 /// doc), smallest first, in rounds while one hinges.
 pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     for _ in 0..HINGE_ROUNDS {
-        let total: f64 = done.iter().map(|l| ctx.area(&l.faces)).sum();
-        let small = SMALL_SHARE * total;
+        let (small, order) = small_pieces(ctx, done);
         let mut owners = Owners::new(ctx.mesh.faces.len(), done);
-        let mut order: Vec<(f64, usize)> = done
-            .iter()
-            .enumerate()
-            .map(|(k, l)| (ctx.area(&l.faces), k))
-            .filter(|&(a, _)| a < small)
-            .collect();
-        order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         let mut any = false;
-        for (_, si) in order {
+        for si in order {
             if owners.gone[si] || ctx.area(&done[si].faces) >= small {
                 continue;
             }
@@ -136,7 +134,7 @@ fn common(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Vec<Common> {
 
 /// The rigid motion (unit complex turn, shift) that puts `c`'s ends as the small piece lays
 /// them onto the neighbour's: the turn of the edge's direction, the midpoints matched.
-fn motion(c: &Common) -> Option<(DVec2, DVec2)> {
+fn motion(c: &Common) -> Option<Motion> {
     let (d, t) = (c.here[1] - c.here[0], c.there[1] - c.there[0]);
     let r = DVec2::new(d.dot(t), d.perp_dot(t));
     let len = r.length();
@@ -159,8 +157,8 @@ fn hinge(
     eps: f64,
 ) -> bool {
     let commons = common(ctx, done, k, part);
-    let place = |(turn, shift): (DVec2, DVec2), p: DVec2| turn.rotate(p) + shift;
-    let in_place = |m: (DVec2, DVec2), c: &Common| {
+    let place = |(turn, shift): Motion, p: DVec2| turn.rotate(p) + shift;
+    let in_place = |m: Motion, c: &Common| {
         let near = 2.0 * opts.seam_tolerance * c.length + 1e-9 * (1.0 + c.there[0].length());
         (0..2).all(|i| place(m, c.here[i]).distance(c.there[i]) <= near)
     };
@@ -183,35 +181,30 @@ fn hinge(
             .then(y.1.total_cmp(&x.1))
             .then(x.2.cmp(&y.2))
     });
-    for &(_, _, _, i) in cands.iter().take(HINGE_TRIES) {
-        let Some(m) = motion(&commons[i]) else {
-            continue;
-        };
-        if let Some(l) = hinged(ctx, done, k, part, &commons, m, &in_place, opts, eps, false) {
-            done[k] = l;
-            return true;
-        }
-    }
-    // Joined wherever the two sides run within reach, the union relaxed.
+    // Then joined wherever the two sides run within reach, the union relaxed.
     let mean = commons.iter().map(|c| c.length).sum::<f64>() / commons.len().max(1) as f64;
-    let reach = |m: (DVec2, DVec2), c: &Common| {
+    let reach = |m: Motion, c: &Common| {
         (0..2).all(|i| place(m, c.here[i]).distance(c.there[i]) <= HINGE_REACH * mean)
     };
-    for &(_, _, _, i) in cands.iter().take(RELAX_TRIES) {
-        let Some(m) = motion(&commons[i]) else {
-            continue;
-        };
-        if let Some(l) = hinged(ctx, done, k, part, &commons, m, &reach, opts, eps, true) {
-            done[k] = l;
-            return true;
+    let tries: [(usize, Joins, bool); 2] =
+        [(HINGE_TRIES, &in_place, false), (RELAX_TRIES, &reach, true)];
+    for (n, joined, relax) in tries {
+        for &(_, _, _, i) in cands.iter().take(n) {
+            let Some(m) = motion(&commons[i]) else {
+                continue;
+            };
+            if let Some(l) = hinged(ctx, done, k, part, &commons, m, joined, opts, eps, relax) {
+                done[k] = l;
+                return true;
+            }
         }
     }
     false
 }
 
-/// `done[part]` moved by `m` beside `done[k]`, the common edges `in_place` joined (their ends
-/// put where `done[k]` has them) and the others cut; `None` unless it is kept (see the module
-/// doc).
+/// `done[part]` moved by `m` beside `done[k]`, the common edges it `joins` joined (their ends
+/// put where `done[k]` has them) and the others cut, the union `relax`ed or not; `None`
+/// unless it is kept (see the module doc).
 #[allow(clippy::too_many_arguments)]
 fn hinged(
     ctx: &Charts,
@@ -219,8 +212,8 @@ fn hinged(
     k: usize,
     part: usize,
     commons: &[Common],
-    m: (DVec2, DVec2),
-    in_place: &dyn Fn((DVec2, DVec2), &Common) -> bool,
+    m: Motion,
+    joins: Joins,
     opts: &FlattenOptions,
     eps: f64,
     relax: bool,
@@ -232,7 +225,7 @@ fn hinged(
     let mut cuts = done[k].cuts.clone();
     cuts.extend(&done[part].cuts);
     for c in commons {
-        if in_place(m, c) {
+        if joins(m, c) {
             for i in 0..2 {
                 snap.entry(c.verts[i])
                     .or_default()
@@ -275,25 +268,15 @@ fn hinged(
     faces.extend(&done[part].faces);
     let mut uv = done[k].uv.clone();
     uv.extend(moved);
-    if relax {
-        let whole = Whole::new(&faces, &uv);
-        let Ok(Layout::Laid(uv, stretch)) = ctx.lay_from(&faces, &cuts, Some(&whole)) else {
-            return None;
-        };
-        let l = Laid {
-            faces,
-            cuts,
-            uv,
-            stretch,
-            gusset: false,
-        };
-        return (stretch.flipped == 0
-            && stretch.l2 <= opts.tolerance
-            && ctx.seam_error(&l) <= opts.seam_tolerance
-            && self_overlap(&l.uv, eps).is_none())
-        .then_some(l);
-    }
-    let stretch = distortion::stretch(ctx.mesh, &faces, &uv);
+    let (uv, stretch) = if relax {
+        match ctx.lay_from(&faces, &cuts, Some(&Whole::new(&faces, &uv))) {
+            Ok(Layout::Laid(uv, stretch)) => (uv, stretch),
+            _ => return None,
+        }
+    } else {
+        let stretch = distortion::stretch(ctx.mesh, &faces, &uv);
+        (uv, stretch)
+    };
     let l = Laid {
         faces,
         cuts,
@@ -301,10 +284,15 @@ fn hinged(
         stretch,
         gusset: false,
     };
-    (stretch.flipped == 0
-        && stretch.l2 <= opts.tolerance
-        && ctx.seam_error(&l) <= opts.seam_tolerance)
-        .then_some(l)
+    // A rigid hinge's overlap was looked for where it can be (`overlaps_near`).
+    let kept = if relax {
+        keeps(ctx, &l, opts, eps)
+    } else {
+        stretch.flipped == 0
+            && stretch.l2 <= opts.tolerance
+            && ctx.seam_error(&l) <= opts.seam_tolerance
+    };
+    kept.then_some(l)
 }
 
 /// Whether the `moved` piece overlaps itself or the faces of `fixed` near it (deeper than

@@ -42,7 +42,7 @@
 
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
-use super::overlap::{both_cuts, first_merge, laid_as_one, self_overlap, Owners};
+use super::overlap::{both_cuts, first_merge, keeps, laid_as_one, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -71,17 +71,9 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
 
 /// One round of [`merge_small`]: each small piece, smallest first, tried with its neighbours.
 fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
-    let total: f64 = done.iter().map(|l| ctx.area(&l.faces)).sum();
-    let small = SMALL_SHARE * total;
+    let (small, order) = small_pieces(ctx, done);
     let mut owners = Owners::new(ctx.mesh.faces.len(), done);
-    let mut order: Vec<(f64, usize)> = done
-        .iter()
-        .enumerate()
-        .map(|(k, l)| (ctx.area(&l.faces), k))
-        .filter(|&(a, _)| a < small)
-        .collect();
-    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    for (_, si) in order {
+    for si in order {
         if owners.gone[si] || ctx.area(&done[si].faces) >= small {
             continue;
         }
@@ -116,6 +108,21 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
         }
     }
     owners.drop_gone(done);
+}
+
+/// The area under which a piece of `done` is small ([`SMALL_SHARE`] of the whole), and the
+/// small pieces, smallest first (ties: lower index).
+pub(super) fn small_pieces(ctx: &Charts, done: &[Laid]) -> (f64, Vec<usize>) {
+    let total: f64 = done.iter().map(|l| ctx.area(&l.faces)).sum();
+    let small = SMALL_SHARE * total;
+    let mut order: Vec<(f64, usize)> = done
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (ctx.area(&l.faces), k))
+        .filter(|&(a, _)| a < small)
+        .collect();
+    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    (small, order.into_iter().map(|(_, k)| k).collect())
 }
 
 /// Neighbours a small piece is shared out with at most ([`rebalance`]).
@@ -156,11 +163,7 @@ fn rebalance(
             stretch: s,
             gusset: false,
         };
-        (s.flipped == 0
-            && s.l2 <= opts.tolerance
-            && ctx.seam_error(&laid) <= opts.seam_tolerance
-            && self_overlap(&laid.uv, eps).is_none())
-        .then_some(laid)
+        keeps(ctx, &laid, opts, eps).then_some(laid)
     };
     let Some(ha) = lay(a) else {
         return false;

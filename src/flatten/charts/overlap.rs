@@ -373,12 +373,16 @@ fn merged(
     opts: &FlattenOptions,
     eps: f64,
 ) -> Option<Laid> {
-    laid_as_one(ctx, done, k, part).filter(|l| {
-        l.stretch.flipped == 0
-            && l.stretch.l2 <= opts.tolerance
-            && ctx.seam_error(l) <= opts.seam_tolerance
-            && self_overlap(&l.uv, eps).is_none()
-    })
+    laid_as_one(ctx, done, k, part).filter(|l| keeps(ctx, l, opts, eps))
+}
+
+/// Whether a layout made by merging pieces is kept: flip-free, within the tolerance, its seams
+/// matched and without overlap (deeper than `eps`).
+pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> bool {
+    l.stretch.flipped == 0
+        && l.stretch.l2 <= opts.tolerance
+        && ctx.seam_error(l) <= opts.seam_tolerance
+        && self_overlap(&l.uv, eps).is_none()
 }
 
 /// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
