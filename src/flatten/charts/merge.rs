@@ -11,7 +11,10 @@
 //! where it is not a disk). A small piece that no neighbour takes is shared out with one of
 //! its [`REBALANCE_TRIES`] nearest: the two are halved anew and kept as the halves when
 //! neither half is small and both keep the tolerance (`rebalance`; the count of pieces stays);
-//! else it is grafted onto its neighbours as they lie ([`graft`]).
+//! else it is grafted onto its neighbours as they lie ([`graft`]). The neighbours are tried
+//! two at a time where a spare thread is free, the first that takes it winning as in order
+//! (`first_merge`). What is still small once every merge below is done is hinged onto a
+//! neighbour by one edge ([`super::hinge`]).
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
