@@ -48,6 +48,18 @@ where
         let ra = a();
         return (ra, b());
     }
+    beside(a, b)
+}
+
+/// `(a(), b())`, `b` on a scoped thread holding the spare thread [`take`]n for it (given back
+/// when it ends, also when it panics). A panic in either is raised again here.
+fn beside<A, B, FA, FB>(a: FA, b: FB) -> (A, B)
+where
+    A: Send,
+    B: Send,
+    FA: FnOnce() -> A + Send,
+    FB: FnOnce() -> B + Send,
+{
     std::thread::scope(|s| {
         let hb = s.spawn(move || {
             let _token = Token;
@@ -72,15 +84,8 @@ where
     if !take() {
         return (a(), None);
     }
-    std::thread::scope(|s| {
-        let hb = s.spawn(move || {
-            let _token = Token;
-            b()
-        });
-        let ra = a();
-        let rb = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-        (ra, Some(rb))
-    })
+    let (ra, rb) = beside(a, b);
+    (ra, Some(rb))
 }
 
 /// `f` applied to every item, the list halved by `weight` (each half about half the total)

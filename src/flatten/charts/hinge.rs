@@ -28,7 +28,7 @@
 //!   of its 3D length of the neighbour's: each side was matched to the 3D length within that
 //!   tolerance, so the hinge edge itself always is.
 
-use super::join::fits_room;
+use super::join::{common, fits_room, Common};
 use super::merge::small_pieces;
 use super::overlap::{keeps, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
@@ -52,19 +52,6 @@ type Motion = (DVec2, DVec2);
 
 /// Which common edges a motion joins.
 type Joins<'a> = &'a dyn Fn(Motion, &Common) -> bool;
-
-/// An edge of the common boundary of a small piece and a neighbour.
-struct Common {
-    /// Topology edge id.
-    edge: usize,
-    /// Its two mesh vertices, as the small piece runs it.
-    verts: [usize; 2],
-    /// Its ends in the small piece's layout, and in the neighbour's (same order).
-    here: [DVec2; 2],
-    there: [DVec2; 2],
-    /// Its 3D length.
-    length: f64,
-}
 
 /// Hinge every small piece of `done` that has a neighbour it fits beside (see the module
 /// doc), smallest first, in rounds while one hinges.
@@ -91,45 +78,6 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
             break;
         }
     }
-}
-
-/// The common boundary of `done[part]` and `done[k]`; empty when they share no edge or a
-/// common vertex is in two places in `done[k]` along it.
-fn common(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Vec<Common> {
-    let in_k: HashMap<usize, usize> = done[k]
-        .faces
-        .iter()
-        .enumerate()
-        .map(|(i, &f)| (f, i))
-        .collect();
-    let mut out = Vec::new();
-    for (pi, &f) in done[part].faces.iter().enumerate() {
-        let n = ctx.mesh.faces[f].verts.len();
-        for i in 0..n {
-            let edge = ctx.topo.face_edges[f][i];
-            let e = &ctx.topo.edges[edge];
-            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
-                continue;
-            };
-            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
-                continue;
-            };
-            let m = ctx.mesh.faces[g].verts.len();
-            let verts = [
-                ctx.mesh.faces[f].verts[i],
-                ctx.mesh.faces[f].verts[(i + 1) % n],
-            ];
-            out.push(Common {
-                edge,
-                verts,
-                here: [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]],
-                // The edge runs the other way round in `g`.
-                there: [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]],
-                length: ctx.mesh.vertices[verts[0]].distance(ctx.mesh.vertices[verts[1]]),
-            });
-        }
-    }
-    out
 }
 
 /// The rigid motion (unit complex turn, shift) that puts `c`'s ends as the small piece lays
@@ -162,18 +110,17 @@ fn hinge(
         let near = 2.0 * opts.seam_tolerance * c.length + 1e-9 * (1.0 + c.there[0].length());
         (0..2).all(|i| place(m, c.here[i]).distance(c.there[i]) <= near)
     };
-    // Candidates: (joined length, hinge length, edge id, index), best first.
-    let mut cands: Vec<(f64, f64, usize, usize)> = commons
+    // Candidates: (joined length, hinge length, edge id, motion), best first.
+    let mut cands: Vec<(f64, f64, usize, Motion)> = commons
         .iter()
-        .enumerate()
-        .filter_map(|(i, c)| {
+        .filter_map(|c| {
             let m = motion(c)?;
             let joined: f64 = commons
                 .iter()
                 .filter(|o| in_place(m, o))
                 .map(|o| o.length)
                 .sum();
-            Some((joined, c.length, c.edge, i))
+            Some((joined, c.length, c.edge, m))
         })
         .collect();
     cands.sort_by(|x, y| {
@@ -181,7 +128,8 @@ fn hinge(
             .then(y.1.total_cmp(&x.1))
             .then(x.2.cmp(&y.2))
     });
-    // Then joined wherever the two sides run within reach, the union relaxed.
+    // Each candidate rigidly, then the best joined wherever the two sides run within reach,
+    // the union relaxed.
     let mean = commons.iter().map(|c| c.length).sum::<f64>() / commons.len().max(1) as f64;
     let reach = |m: Motion, c: &Common| {
         (0..2).all(|i| place(m, c.here[i]).distance(c.there[i]) <= HINGE_REACH * mean)
@@ -189,10 +137,7 @@ fn hinge(
     let tries: [(usize, Joins, bool); 2] =
         [(HINGE_TRIES, &in_place, false), (RELAX_TRIES, &reach, true)];
     for (n, joined, relax) in tries {
-        for &(_, _, _, i) in cands.iter().take(n) {
-            let Some(m) = motion(&commons[i]) else {
-                continue;
-            };
+        for &(_, _, _, m) in cands.iter().take(n) {
             if let Some(l) = hinged(ctx, done, k, part, &commons, m, joined, opts, eps, relax) {
                 done[k] = l;
                 return true;

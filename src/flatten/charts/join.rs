@@ -1,6 +1,7 @@
 //! Two laid pieces as one layout, one moved rigidly onto the other along their common
 //! boundary: what [`super::merge`] joins without laying anything out again (`attach`), and
-//! where a merge laid out again starts from ([`super::overlap::merge_into`]).
+//! where a merge laid out again starts from ([`super::overlap::merge_into`]). The common
+//! boundary itself ([`common`]) is also where [`super::hinge`] hinges a small piece.
 //!
 //! Choices: the rigid motion is the least-squares fit of the common vertices (2D Kabsch, no
 //! scaling: both layouts have their 3D size); a corner of the moved piece within twice the
@@ -35,51 +36,26 @@ pub(super) struct Joined {
 /// common vertex put where `done[k]` has that vertex; `None` when they share no edge, or a
 /// common vertex is in two places in `done[k]`.
 pub(super) fn moved_onto(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Option<Joined> {
-    let in_k: HashMap<usize, usize> = done[k]
-        .faces
-        .iter()
-        .enumerate()
-        .map(|(i, &f)| (f, i))
-        .collect();
-    // The common edges: each end as `part` has it and where `done[k]` has it.
-    let mut pairs: Vec<(DVec2, DVec2)> = Vec::new();
-    let mut at: HashMap<usize, DVec2> = HashMap::new();
-    let (mut edges, mut length) = (0usize, 0.0);
-    for (pi, &f) in done[part].faces.iter().enumerate() {
-        let n = ctx.mesh.faces[f].verts.len();
-        for i in 0..n {
-            let e = &ctx.topo.edges[ctx.topo.face_edges[f][i]];
-            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
-                continue;
-            };
-            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
-                continue;
-            };
-            let m = ctx.mesh.faces[g].verts.len();
-            let (a, b) = (
-                ctx.mesh.faces[f].verts[i],
-                ctx.mesh.faces[f].verts[(i + 1) % n],
-            );
-            let here = [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]];
-            // The edge runs the other way round in `g`.
-            let there = [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]];
-            for (v, (p, q)) in [a, b].into_iter().zip(here.into_iter().zip(there)) {
-                match at.get(&v) {
-                    Some(old) if old.distance(q) > 1e-9 * (1.0 + q.length()) => return None,
-                    Some(_) => {}
-                    None => {
-                        at.insert(v, q);
-                        pairs.push((p, q));
-                    }
-                }
-            }
-            edges += 1;
-            length += ctx.mesh.vertices[a].distance(ctx.mesh.vertices[b]);
-        }
-    }
-    if edges == 0 {
+    let commons = common(ctx, done, k, part);
+    if commons.is_empty() {
         return None;
     }
+    // Each common vertex as `part` has it and where `done[k]` has it.
+    let mut pairs: Vec<(DVec2, DVec2)> = Vec::new();
+    let mut at: HashMap<usize, DVec2> = HashMap::new();
+    for c in &commons {
+        for ((&v, &p), &q) in c.verts.iter().zip(&c.here).zip(&c.there) {
+            match at.get(&v) {
+                Some(old) if old.distance(q) > 1e-9 * (1.0 + q.length()) => return None,
+                Some(_) => {}
+                None => {
+                    at.insert(v, q);
+                    pairs.push((p, q));
+                }
+            }
+        }
+    }
+    let (edges, length) = (commons.len(), commons.iter().map(|c| c.length).sum());
     let (turn, shift) = fit(&pairs)?;
     let moved = |p: DVec2| turn.rotate(p) + shift;
     let worst = pairs
@@ -113,6 +89,58 @@ pub(super) fn moved_onto(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> 
         length,
         worst,
     })
+}
+
+/// An edge of the common boundary of two laid pieces (a part and a neighbour).
+pub(super) struct Common {
+    /// Topology edge id.
+    pub(super) edge: usize,
+    /// Its two mesh vertices, as the part runs it.
+    pub(super) verts: [usize; 2],
+    /// Its ends in the part's layout, and in the neighbour's (same order).
+    pub(super) here: [DVec2; 2],
+    pub(super) there: [DVec2; 2],
+    /// Its 3D length.
+    pub(super) length: f64,
+}
+
+/// The common boundary of `done[part]` and `done[k]`, in the order of `done[part]`'s faces
+/// and their edges; empty when they share no edge.
+pub(super) fn common(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Vec<Common> {
+    let in_k: HashMap<usize, usize> = done[k]
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| (f, i))
+        .collect();
+    let mut out = Vec::new();
+    for (pi, &f) in done[part].faces.iter().enumerate() {
+        let n = ctx.mesh.faces[f].verts.len();
+        for i in 0..n {
+            let edge = ctx.topo.face_edges[f][i];
+            let e = &ctx.topo.edges[edge];
+            let Some(&(g, j)) = e.uses.iter().find(|u| u.0 != f) else {
+                continue;
+            };
+            let (Some(&ki), 2) = (in_k.get(&g), e.uses.len()) else {
+                continue;
+            };
+            let m = ctx.mesh.faces[g].verts.len();
+            let verts = [
+                ctx.mesh.faces[f].verts[i],
+                ctx.mesh.faces[f].verts[(i + 1) % n],
+            ];
+            out.push(Common {
+                edge,
+                verts,
+                here: [done[part].uv[pi][i], done[part].uv[pi][(i + 1) % n]],
+                // The edge runs the other way round in `g`.
+                there: [done[k].uv[ki][(j + 1) % m], done[k].uv[ki][j]],
+                length: ctx.mesh.vertices[verts[0]].distance(ctx.mesh.vertices[verts[1]]),
+            });
+        }
+    }
+    out
 }
 
 /// The rotation (as a unit complex number) and shift that best move the first points of
