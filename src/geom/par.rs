@@ -2,7 +2,7 @@
 //! two closures, the second on a scoped thread when one of the process's spare threads is
 //! free (one fewer than the machine's cores, shared by every caller, nested calls included),
 //! else after the first on this one; [`speculate`] runs the second only when a spare thread
-//! is free; [`map`] splits a list of independent jobs into halves
+//! is free, and [`first`] tries candidates two at a time with it; [`map`] splits a list of independent jobs into halves
 //! of about equal weight and joins them, so a job may itself fork (a chart whose halves are
 //! laid in parallel). Results always come back in the jobs' order.
 
@@ -88,6 +88,31 @@ where
     (ra, Some(rb))
 }
 
+/// The first item, in order, for which `f` gives something, and what it gave: the items are
+/// tried two at a time where a spare thread is free ([`speculate`]), the second's result used
+/// only when the first gives nothing, so the answer is the one trying them in turn finds.
+pub fn first<T, R, F>(items: &[T], f: F) -> Option<(usize, R)>
+where
+    T: Sync,
+    R: Send,
+    F: Fn(&T) -> Option<R> + Sync,
+{
+    let mut i = 0;
+    while let Some(x) = items.get(i) {
+        let next = items.get(i + 1);
+        let (here, beside) = speculate(|| f(x), || next.and_then(&f));
+        if let Some(r) = here {
+            return Some((i, r));
+        }
+        match beside {
+            Some(Some(r)) => return Some((i + 1, r)),
+            Some(None) => i += 2,
+            None => i += 1,
+        }
+    }
+    None
+}
+
 /// `f` applied to every item, the list halved by `weight` (each half about half the total)
 /// and the halves [`join`]ed; the results in the items' order.
 pub fn map<T, R, F>(items: Vec<T>, weight: &[usize], f: &F) -> Vec<R>
@@ -162,6 +187,18 @@ mod tests {
         if std::thread::available_parallelism().map_or(1, |p| p.get()) == 1 {
             assert_eq!(b, None);
         }
+    }
+
+    #[test]
+    fn the_first_found_is_the_first_in_order() {
+        let items: Vec<u32> = (0..9).collect();
+        for want in 0..9u32 {
+            // Every item from `want` on gives something: the answer is `want` whichever ran.
+            let got = first(&items, |&x| (x >= want).then_some(x * 10));
+            assert_eq!(got, Some((want as usize, want * 10)));
+        }
+        assert_eq!(first(&items, |_| None::<u32>), None);
+        assert_eq!(first(&[] as &[u32], |&x| Some(x)), None);
     }
 
     #[test]

@@ -51,7 +51,7 @@ const HINGE_REACH: f64 = 0.5;
 type Motion = (DVec2, DVec2);
 
 /// Which common edges a motion joins.
-type Joins<'a> = &'a dyn Fn(Motion, &Common) -> bool;
+type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
 
 /// Hinge every small piece of `done` that has a neighbour it fits beside (see the module
 /// doc), smallest first, in rounds while one hinges.
@@ -137,11 +137,18 @@ fn hinge(
     let tries: [(usize, Joins, bool); 2] =
         [(HINGE_TRIES, &in_place, false), (RELAX_TRIES, &reach, true)];
     for (n, joined, relax) in tries {
-        for &(_, _, _, m) in cands.iter().take(n) {
-            if let Some(l) = hinged(ctx, done, k, part, &commons, m, joined, opts, eps, relax) {
-                done[k] = l;
-                return true;
-            }
+        let motions: Vec<Motion> = cands.iter().take(n).map(|c| c.3).collect();
+        let try_one =
+            |&m: &Motion| hinged(ctx, done, k, part, &commons, m, joined, opts, eps, relax);
+        // A relaxed trial lays the union out: two at a time where a spare thread is free.
+        let found = if relax {
+            crate::geom::par::first(&motions, try_one).map(|(_, l)| l)
+        } else {
+            motions.iter().find_map(try_one)
+        };
+        if let Some(l) = found {
+            done[k] = l;
+            return true;
         }
     }
     false

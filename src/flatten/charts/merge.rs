@@ -134,7 +134,7 @@ const REBALANCE_TRIES: usize = 2;
 /// Share the faces of a small piece `done[part]` and its neighbour `done[k]` out anew: the
 /// two as one chart are halved along the bisector of their two faces farthest apart
 /// ([`bisect`]), and each half laid out, starting from the two layouts joined
-/// ([`moved_onto`]). Kept, the halves becoming `done[k]` and `done[part]`, when neither half
+/// ([`moved_onto`]), the second beside the first where a spare thread is free. Kept, the halves becoming `done[k]` and `done[part]`, when neither half
 /// is under `small` in area and each is flip-free, without overlap, within the tolerance and
 /// with its seams matched; false, leaving both as they were, otherwise.
 fn rebalance(
@@ -168,10 +168,12 @@ fn rebalance(
         };
         keeps(ctx, &laid, opts, eps).then_some(laid)
     };
-    let Some(ha) = lay(a) else {
+    // The second half is laid beside the first where a spare thread is free.
+    let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
+    let Some(ha) = ha else {
         return false;
     };
-    let Some(hb) = lay(b) else {
+    let Some(hb) = hb.unwrap_or_else(|| lay(b)) else {
         return false;
     };
     done[k] = ha;

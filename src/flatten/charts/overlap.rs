@@ -387,8 +387,7 @@ pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> 
 
 /// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
 /// the union, as trying them in order finds it; two are tried at a time where a spare thread
-/// is free ([`crate::geom::par::speculate`]), the second's result used only when the first
-/// fails.
+/// is free ([`crate::geom::par::first`]).
 pub(super) fn first_merge(
     ctx: &Charts,
     done: &[Laid],
@@ -397,23 +396,8 @@ pub(super) fn first_merge(
     opts: &FlattenOptions,
     eps: f64,
 ) -> Option<(usize, Laid)> {
-    let mut i = 0;
-    while let Some(&k) = near.get(i) {
-        let next = near.get(i + 1).copied();
-        let (first, second) = crate::geom::par::speculate(
-            || merged(ctx, done, k, part, opts, eps),
-            || next.and_then(|j| merged(ctx, done, j, part, opts, eps)),
-        );
-        if let Some(l) = first {
-            return Some((k, l));
-        }
-        match (next, second) {
-            (Some(j), Some(Some(l))) => return Some((j, l)),
-            (_, Some(None)) => i += 2,
-            _ => i += 1,
-        }
-    }
-    None
+    crate::geom::par::first(near, |&k| merged(ctx, done, k, part, opts, eps))
+        .map(|(i, l)| (near[i], l))
 }
 
 /// `done[k]` and `done[part]` laid out as one chart (the cuts of both, more where the union
