@@ -200,7 +200,10 @@ fn relax(
                     cc += ck * du.y * dx.x;
                     d += ck * du.y * dx.y;
                 }
-                let r = DVec2::from_angle((cc - b).atan2(a + d));
+                // Its angle's cosine and sine, without the angle.
+                let r = DVec2::new(a + d, cc - b);
+                let len = r.length();
+                let r = if len > 0.0 { r / len } else { DVec2::X };
                 for (k, &ck) in c.iter().enumerate() {
                     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                     let t = ck * r.rotate(s[i] - s[j]);
