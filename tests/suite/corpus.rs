@@ -276,10 +276,10 @@ fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
 /// Issue 20, items 2 and 3: cow in metal (L2 1.001) at 300 mm on A4. Charts still over the
 /// tolerance once split three times are laid out exactly, and small pieces that cannot be
 /// laid out again with a neighbour are grafted onto their neighbours as they lie
-/// (`flatten::charts::exact`), else hinged onto one by an edge (`flatten::charts::hinge`).
-/// Before the first two, 11 pieces were over the tolerance (the worst at L2 1.347) and 37
-/// were under 1 % of the area; then none was over and 16 were small (42 pieces); hinged, 11
-/// are small (37 pieces).
+/// (`flatten::charts::exact`), else hinged onto one by an edge (`flatten::charts::hinge`),
+/// whole or in halves. Before the first two, 11 pieces were over the tolerance (the worst at
+/// L2 1.347) and 37 were under 1 % of the area; then none was over and 16 were small (42
+/// pieces); hinged whole, 11 were small (37 pieces); in halves too, 9 are (35 pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     require_shared!();
@@ -287,8 +287,8 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 12, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 39, "{} pieces", r.pieces);
+    assert!(r.small <= 10, "{} pieces under 1 % of the area", r.small);
+    assert!(r.pieces <= 37, "{} pieces", r.pieces);
 }
 
 /// Issue 20: a piece split to fit the sheet keeps its layout, and a part of it can stretch

@@ -13,6 +13,12 @@
 //! [`HINGE_REACH`] of a mean common edge's length joined, and the union relaxed as a merged
 //! piece is ([`Charts::lay_from`]: started from the two as they lie) and checked as one is.
 //!
+//! A piece that hinges whole onto no neighbour is halved ([`bisect`]) and each half, as it lies
+//! in the piece's layout, hinged on its own: the first onto a neighbour, the second onto a piece
+//! next to it then (the one that took the first too). Where the whole would wrap round a
+//! saddle vertex past a full turn, each half may still fit beside the piece on its side. Both
+//! halves or neither.
+//!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
 //!   also puts other common edges in place where the two boundaries run alike (a fold of a
@@ -33,6 +39,7 @@ use super::merge::small_pieces;
 use super::overlap::{keeps, self_overlap, Owners};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
+use crate::geom::cut::bisect;
 use crate::geom::polygon;
 use glam::DVec2;
 use std::collections::HashMap;
@@ -65,11 +72,16 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 continue;
             }
             let near = owners.neighbours(ctx, done, si);
-            if let Some(k) = near
+            if let Some((k, l)) = near
                 .into_iter()
-                .find(|&k| hinge(ctx, done, k, si, opts, eps))
+                .find_map(|k| hinge(ctx, done, k, si, opts, eps).map(|l| (k, l)))
             {
+                done[k] = l;
                 owners.absorb(done, k, si);
+                any = true;
+            } else if done[si].faces.len() > 1
+                && hinge_halves(ctx, done, &mut owners, si, opts, eps)
+            {
                 any = true;
             }
         }
@@ -94,16 +106,15 @@ fn motion(c: &Common) -> Option<Motion> {
     Some((turn, shift))
 }
 
-/// Try to hinge `done[part]` onto `done[k]` (see the module doc); true when it was, the
-/// union then being `done[k]`.
+/// `done[part]` hinged onto `done[k]` (see the module doc): the union, when it is kept.
 fn hinge(
     ctx: &Charts,
-    done: &mut [Laid],
+    done: &[Laid],
     k: usize,
     part: usize,
     opts: &FlattenOptions,
     eps: f64,
-) -> bool {
+) -> Option<Laid> {
     let commons = common(ctx, done, k, part);
     let place = |(turn, shift): Motion, p: DVec2| turn.rotate(p) + shift;
     let in_place = |m: Motion, c: &Common| {
@@ -146,10 +157,82 @@ fn hinge(
         } else {
             motions.iter().find_map(try_one)
         };
-        if let Some(l) = found {
-            done[k] = l;
-            return true;
+        if found.is_some() {
+            return found;
         }
+    }
+    None
+}
+
+/// Hinge a small piece that does not hinge whole in two halves (see the module doc): the
+/// first onto a neighbour, the second onto a piece next to it then (the one that took the
+/// first too). Both or neither: true when both hinged, the unions then in `done` and the
+/// halves (pushed onto `done`) and `done[si]` marked gone in `owners`; else `done` and
+/// `owners` are as they were.
+fn hinge_halves(
+    ctx: &Charts,
+    done: &mut Vec<Laid>,
+    owners: &mut Owners,
+    si: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> bool {
+    let (a, b) = bisect(ctx.graph, &done[si].faces);
+    let whole = Whole::new(&done[si].faces, &done[si].uv);
+    // Each half as it lies in the piece's layout.
+    let half = |faces: Vec<usize>| -> Option<Laid> {
+        let uv = whole.restrict(&faces)?;
+        Some(Laid {
+            cuts: ctx.cuts_within(&faces, &done[si].cuts),
+            stretch: distortion::stretch(ctx.mesh, &faces, &uv),
+            faces,
+            uv,
+            gusset: false,
+        })
+    };
+    if a.is_empty() || b.is_empty() {
+        return false;
+    }
+    let (Some(la), Some(lb)) = (half(a), half(b)) else {
+        return false;
+    };
+    // The halves as pieces of their own: the first where the piece was, the second last.
+    let (ia, ib) = (done.len(), done.len() + 1);
+    owners.gone[si] = true;
+    for (i, l) in [(ia, la), (ib, lb)] {
+        for &f in &l.faces {
+            owners.owner[f] = i;
+        }
+        done.push(l);
+        owners.gone.push(false);
+    }
+    let onto = |done: &[Laid], owners: &Owners, part: usize, not: usize| {
+        owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .filter(|&k| k != not)
+            .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
+    };
+    let mut was = Vec::new();
+    for (part, not) in [(ia, ib), (ib, usize::MAX)] {
+        let Some((k, l)) = onto(done, owners, part, not) else {
+            break;
+        };
+        was.push((k, std::mem::replace(&mut done[k], l)));
+        owners.absorb(done, k, part);
+    }
+    if was.len() == 2 {
+        return true;
+    }
+    // Undone: the unions back to the neighbours, the faces to the piece.
+    for (k, l) in was {
+        done[k] = l;
+    }
+    done.truncate(ia);
+    owners.gone.truncate(ia);
+    owners.gone[si] = false;
+    for &f in &done[si].faces {
+        owners.owner[f] = si;
     }
     false
 }
@@ -336,18 +419,16 @@ mod tests {
             match_below: opts.tolerance,
             laid: &LayCache::default(),
         };
-        let mut done = laid(mesh);
+        let done = laid(mesh);
         for l in &done {
             assert!((l.stretch.l2 - 1.0).abs() < 1e-12, "laid exactly");
         }
         let eps = 1e-6;
-        hinge(&ctx, &mut done, 0, 1, &opts, eps).then(|| {
-            let l = done.swap_remove(0);
+        hinge(&ctx, &done, 0, 1, &opts, eps).inspect(|l| {
             // Exactly one of the two common spokes is a slit.
             let spokes = [0usize, 5].map(|f| topo.face_edges[f][0]);
             assert_eq!(l.cuts.len(), 1, "{:?}", l.cuts);
             assert!(spokes.contains(&l.cuts[0]));
-            l
         })
     }
 
@@ -400,5 +481,126 @@ mod tests {
             .sum();
         assert!(total > 2.0 * std::f64::consts::PI + 0.1, "{total}");
         assert!(try_hinge(&mesh).is_none());
+    }
+
+    /// `n` triangles round an apex at the origin over a saddle (rim vertices at `n` even
+    /// steps round the unit circle, times 10, alternately above and below), each with the
+    /// angle `alpha` at the apex.
+    fn saddle(n: usize, alpha: f64) -> Mesh {
+        let step = std::f64::consts::TAU / n as f64;
+        let h = ((step.cos() - alpha.cos()) / (1.0 + alpha.cos())).sqrt();
+        let mut vertices = vec![DVec3::ZERO];
+        for i in 0..n {
+            let a = step * i as f64;
+            let z = if i % 2 == 0 { h } else { -h };
+            vertices.push(DVec3::new(a.cos(), a.sin(), z) * 10.0);
+        }
+        let faces = (0..n)
+            .map(|i| Face {
+                verts: vec![0, i + 1, (i + 1) % n + 1],
+                line: None,
+            })
+            .collect();
+        Mesh { vertices, faces }
+    }
+
+    /// Faces `faces` (consecutive round the apex) of [`saddle`] laid out exactly as one fan.
+    fn fan_piece(mesh: &Mesh, faces: std::ops::Range<usize>) -> Laid {
+        let n = mesh.faces.len();
+        let p = |i: usize| mesh.vertices[i % n + 1];
+        let mut dir = 0.0;
+        let mut uv = Vec::new();
+        for i in faces.clone() {
+            let turn = p(i).angle_between(p(i + 1));
+            uv.push(vec![
+                DVec2::ZERO,
+                DVec2::from_angle(dir) * p(i).length(),
+                DVec2::from_angle(dir + turn) * p(i + 1).length(),
+            ]);
+            dir += turn;
+        }
+        let faces: Vec<usize> = faces.collect();
+        Laid {
+            stretch: distortion::stretch(mesh, &faces, &uv),
+            faces,
+            cuts: Vec::new(),
+            uv,
+            gusset: false,
+        }
+    }
+
+    /// Hinge the second of `pieces` (face ranges of a [`saddle`] of `n` faces, `alpha` each
+    /// at the apex, each laid exactly) in halves: the pieces' face counts after, or `None`
+    /// when it did not hinge.
+    fn hinge_middle(n: usize, alpha: f64, pieces: &[std::ops::Range<usize>]) -> Option<Vec<usize>> {
+        let mesh = saddle(n, alpha);
+        let topo = mesh.topology();
+        let graph = Graph::new(&mesh, &topo);
+        let opts = FlattenOptions::default();
+        let ctx = Charts {
+            mesh: &mesh,
+            topo: &topo,
+            graph: &graph,
+            method: opts.method,
+            match_below: opts.tolerance,
+            laid: &LayCache::default(),
+        };
+        let eps = 1e-6;
+        let mut done: Vec<Laid> = pieces.iter().map(|r| fan_piece(&mesh, r.clone())).collect();
+        for l in &done {
+            assert!((l.stretch.l2 - 1.0).abs() < 1e-12, "laid exactly");
+            assert!(self_overlap(&l.uv, eps).is_none());
+        }
+        // Whole, it overlaps the neighbour on either side.
+        for k in [0, 2] {
+            assert!(hinge(&ctx, &done, k, 1, &opts, eps).is_none());
+        }
+        let before: Vec<(Vec<usize>, Vec<Vec<DVec2>>)> = done
+            .iter()
+            .map(|l| (l.faces.clone(), l.uv.clone()))
+            .collect();
+        let mut owners = Owners::new(n, &done);
+        let owner_before = owners.owner.clone();
+        if !hinge_halves(&ctx, &mut done, &mut owners, 1, &opts, eps) {
+            // Left as it was.
+            let after: Vec<(Vec<usize>, Vec<Vec<DVec2>>)> = done
+                .iter()
+                .map(|l| (l.faces.clone(), l.uv.clone()))
+                .collect();
+            assert_eq!(after, before);
+            assert_eq!(owners.owner, owner_before);
+            assert!(owners.gone.iter().all(|&g| !g));
+            return None;
+        }
+        owners.drop_gone(&mut done);
+        assert_eq!(done.len(), pieces.len() - 1);
+        for l in &done {
+            assert!(self_overlap(&l.uv, eps).is_none());
+            assert!((l.stretch.l2 - 1.0).abs() < 1e-9, "{}", l.stretch.l2);
+        }
+        let mut faces: Vec<usize> = done.iter().flat_map(|l| l.faces.clone()).collect();
+        faces.sort_unstable();
+        assert_eq!(faces, (0..n).collect::<Vec<_>>());
+        Some(done.iter().map(|l| l.faces.len()).collect())
+    }
+
+    /// Eight faces of 75° round a saddle's apex (600° in all), in pieces of 3, 2 and 3 faces:
+    /// the middle piece hinged whole on either side would make 375° round the apex and
+    /// overlap, but each of its faces hinged onto the piece beside it makes 300°.
+    #[test]
+    fn a_small_piece_that_overlaps_whole_hinges_in_halves() {
+        let sizes = hinge_middle(8, 75f64.to_radians(), &[0..3, 3..5, 5..8]);
+        assert_eq!(sizes, Some(vec![4, 4]));
+    }
+
+    /// Ten faces of 75°, in pieces of 4, 2, 3 and 1: the second piece's half next to the
+    /// third hinges (300°), its other half then overlaps on both sides (375°), so neither
+    /// hinges and everything is as it was.
+    #[test]
+    fn a_piece_is_hinged_in_halves_both_or_neither() {
+        assert_eq!(
+            hinge_middle(10, 75f64.to_radians(), &[0..4, 4..6, 6..9, 9..10]),
+            None
+        );
     }
 }
