@@ -178,6 +178,9 @@ fn hinge_halves(
     eps: f64,
 ) -> bool {
     let (a, b) = bisect(ctx.graph, &done[si].faces);
+    if a.is_empty() || b.is_empty() {
+        return false;
+    }
     let whole = Whole::new(&done[si].faces, &done[si].uv);
     // Each half as it lies in the piece's layout.
     let half = |faces: Vec<usize>| -> Option<Laid> {
@@ -190,13 +193,10 @@ fn hinge_halves(
             gusset: false,
         })
     };
-    if a.is_empty() || b.is_empty() {
-        return false;
-    }
     let (Some(la), Some(lb)) = (half(a), half(b)) else {
         return false;
     };
-    // The halves as pieces of their own: the first where the piece was, the second last.
+    // The halves as pieces of their own, after the others; the piece is gone meanwhile.
     let (ia, ib) = (done.len(), done.len() + 1);
     owners.gone[si] = true;
     for (i, l) in [(ia, la), (ib, lb)] {

@@ -134,9 +134,10 @@ const REBALANCE_TRIES: usize = 2;
 /// Share the faces of a small piece `done[part]` and its neighbour `done[k]` out anew: the
 /// two as one chart are halved along the bisector of their two faces farthest apart
 /// ([`bisect`]), and each half laid out, starting from the two layouts joined
-/// ([`moved_onto`]), the second beside the first where a spare thread is free. Kept, the halves becoming `done[k]` and `done[part]`, when neither half
-/// is under `small` in area and each is flip-free, without overlap, within the tolerance and
-/// with its seams matched; false, leaving both as they were, otherwise.
+/// ([`moved_onto`]), the second beside the first where a spare thread is free. Kept, the
+/// halves becoming `done[k]` and `done[part]`, when neither half is under `small` in area and
+/// each is flip-free, without overlap, within the tolerance and with its seams matched;
+/// false, leaving both as they were, otherwise.
 fn rebalance(
     ctx: &Charts,
     done: &mut [Laid],
@@ -168,7 +169,6 @@ fn rebalance(
         };
         keeps(ctx, &laid, opts, eps).then_some(laid)
     };
-    // The second half is laid beside the first where a spare thread is free.
     let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
     let Some(ha) = ha else {
         return false;
