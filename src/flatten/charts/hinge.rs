@@ -15,9 +15,9 @@
 //!
 //! A piece that hinges whole onto no neighbour is halved ([`bisect`]) and each half, as it lies
 //! in the piece's layout, hinged on its own: the first onto a neighbour, the second onto a piece
-//! next to it then (the one that took the first too). Where the whole would wrap round a
-//! saddle vertex past a full turn, each half may still fit beside the piece on its side. Both
-//! halves or neither.
+//! next to it then (the one that took the first too); else it is quartered (each half halved
+//! again) and the quarters hinged so in turn. Where the whole would wrap round a saddle vertex
+//! past a full turn, each part may still fit beside the piece on its side. All parts or none.
 //!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
@@ -164,11 +164,82 @@ fn hinge(
     None
 }
 
-/// Hinge a small piece that does not hinge whole in two halves (see the module doc): the
-/// first onto a neighbour, the second onto a piece next to it then (the one that took the
-/// first too). Both or neither: true when both hinged, the unions then in `done` and the
-/// halves (pushed onto `done`) and `done[si]` marked gone in `owners`; else `done` and
-/// `owners` are as they were.
+/// Hinge a small piece that does not hinge whole in `parts` (see the module doc), each as it
+/// lies in the piece's layout, in turn onto a piece next to it then (not onto a part still to
+/// come). All or none: true when all hinged, the unions then in `done` and the parts (pushed
+/// onto `done`) and `done[si]` marked gone in `owners`; else `done` and `owners` are as they
+/// were.
+fn hinge_parts(
+    ctx: &Charts,
+    done: &mut Vec<Laid>,
+    owners: &mut Owners,
+    si: usize,
+    parts: Vec<Vec<usize>>,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> bool {
+    if parts.len() < 2 || parts.iter().any(|p| p.is_empty()) {
+        return false;
+    }
+    let whole = Whole::new(&done[si].faces, &done[si].uv);
+    let laid: Option<Vec<Laid>> = parts
+        .into_iter()
+        .map(|faces| {
+            let uv = whole.restrict(&faces)?;
+            Some(Laid {
+                cuts: ctx.cuts_within(&faces, &done[si].cuts),
+                stretch: distortion::stretch(ctx.mesh, &faces, &uv),
+                faces,
+                uv,
+                gusset: false,
+            })
+        })
+        .collect();
+    let Some(laid) = laid else {
+        return false;
+    };
+    // The parts as pieces of their own, after the others; the piece is gone meanwhile.
+    let first = done.len();
+    owners.gone[si] = true;
+    for l in laid {
+        for &f in &l.faces {
+            owners.owner[f] = done.len();
+        }
+        done.push(l);
+        owners.gone.push(false);
+    }
+    let last = done.len();
+    let mut was = Vec::new();
+    for part in first..last {
+        let Some((k, l)) = owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .filter(|&k| !(part < k && k < last))
+            .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
+        else {
+            break;
+        };
+        was.push((k, std::mem::replace(&mut done[k], l)));
+        owners.absorb(done, k, part);
+    }
+    if was.len() == last - first {
+        return true;
+    }
+    // Undone, last first: the unions back to the neighbours, the faces to the piece.
+    for (k, l) in was.into_iter().rev() {
+        done[k] = l;
+    }
+    done.truncate(first);
+    owners.gone.truncate(first);
+    owners.gone[si] = false;
+    for &f in &done[si].faces {
+        owners.owner[f] = si;
+    }
+    false
+}
+
+/// Hinge a small piece that does not hinge whole in halves ([`bisect`]), else in quarters
+/// (each half halved again where it has two faces or more): see [`hinge_parts`].
 fn hinge_halves(
     ctx: &Charts,
     done: &mut Vec<Laid>,
@@ -181,60 +252,17 @@ fn hinge_halves(
     if a.is_empty() || b.is_empty() {
         return false;
     }
-    let whole = Whole::new(&done[si].faces, &done[si].uv);
-    // Each half as it lies in the piece's layout.
-    let half = |faces: Vec<usize>| -> Option<Laid> {
-        let uv = whole.restrict(&faces)?;
-        Some(Laid {
-            cuts: ctx.cuts_within(&faces, &done[si].cuts),
-            stretch: distortion::stretch(ctx.mesh, &faces, &uv),
-            faces,
-            uv,
-            gusset: false,
-        })
-    };
-    let (Some(la), Some(lb)) = (half(a), half(b)) else {
-        return false;
-    };
-    // The halves as pieces of their own, after the others; the piece is gone meanwhile.
-    let (ia, ib) = (done.len(), done.len() + 1);
-    owners.gone[si] = true;
-    for (i, l) in [(ia, la), (ib, lb)] {
-        for &f in &l.faces {
-            owners.owner[f] = i;
-        }
-        done.push(l);
-        owners.gone.push(false);
-    }
-    let onto = |done: &[Laid], owners: &Owners, part: usize, not: usize| {
-        owners
-            .neighbours(ctx, done, part)
-            .into_iter()
-            .filter(|&k| k != not)
-            .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
-    };
-    let mut was = Vec::new();
-    for (part, not) in [(ia, ib), (ib, usize::MAX)] {
-        let Some((k, l)) = onto(done, owners, part, not) else {
-            break;
-        };
-        was.push((k, std::mem::replace(&mut done[k], l)));
-        owners.absorb(done, k, part);
-    }
-    if was.len() == 2 {
+    if hinge_parts(ctx, done, owners, si, vec![a.clone(), b.clone()], opts, eps) {
         return true;
     }
-    // Undone: the unions back to the neighbours, the faces to the piece.
-    for (k, l) in was {
-        done[k] = l;
+    let mut quarters = Vec::new();
+    for h in [a, b] {
+        match bisect(ctx.graph, &h) {
+            (x, y) if !x.is_empty() && !y.is_empty() => quarters.extend([x, y]),
+            _ => quarters.push(h),
+        }
     }
-    done.truncate(ia);
-    owners.gone.truncate(ia);
-    owners.gone[si] = false;
-    for &f in &done[si].faces {
-        owners.owner[f] = si;
-    }
-    false
+    quarters.len() > 2 && hinge_parts(ctx, done, owners, si, quarters, opts, eps)
 }
 
 /// `done[part]` moved by `m` beside `done[k]`, the common edges it `joins` joined (their ends
