@@ -2,9 +2,10 @@
 //! two closures, the second on a scoped thread when one of the process's spare threads is
 //! free (one fewer than the machine's cores, shared by every caller, nested calls included),
 //! else after the first on this one; [`speculate`] runs the second only when a spare thread
-//! is free, and [`first`] tries candidates two at a time with it; [`map`] splits a list of independent jobs into halves
-//! of about equal weight and joins them, so a job may itself fork (a chart whose halves are
-//! laid in parallel). Results always come back in the jobs' order.
+//! is free, and [`first`] tries candidates two at a time with it; [`map`] splits a list of
+//! independent jobs into halves of about equal weight and joins them, so a job may itself
+//! fork (a chart whose halves are laid in parallel). Results always come back in the jobs'
+//! order.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;

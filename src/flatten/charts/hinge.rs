@@ -71,17 +71,11 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
             if owners.gone[si] || ctx.area(&done[si].faces) >= small {
                 continue;
             }
-            let near = owners.neighbours(ctx, done, si);
-            if let Some((k, l)) = near
-                .into_iter()
-                .find_map(|k| hinge(ctx, done, k, si, opts, eps).map(|l| (k, l)))
-            {
+            if let Some((k, l)) = hinge_onto(ctx, done, &owners, si, &|_| true, opts, eps) {
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
-            } else if done[si].faces.len() > 1
-                && hinge_halves(ctx, done, &mut owners, si, opts, eps)
-            {
+            } else if hinge_halves(ctx, done, &mut owners, si, opts, eps) {
                 any = true;
             }
         }
@@ -90,6 +84,24 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
             break;
         }
     }
+}
+
+/// The first neighbour of `done[part]` (those sharing the longest boundary first) that
+/// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union.
+fn hinge_onto(
+    ctx: &Charts,
+    done: &[Laid],
+    owners: &Owners,
+    part: usize,
+    allowed: &dyn Fn(usize) -> bool,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<(usize, Laid)> {
+    owners
+        .neighbours(ctx, done, part)
+        .into_iter()
+        .filter(|&k| allowed(k))
+        .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
 }
 
 /// The rigid motion (unit complex turn, shift) that puts `c`'s ends as the small piece lays
@@ -211,12 +223,9 @@ fn hinge_parts(
     let last = done.len();
     let mut was = Vec::new();
     for part in first..last {
-        let Some((k, l)) = owners
-            .neighbours(ctx, done, part)
-            .into_iter()
-            .filter(|&k| !(part < k && k < last))
-            .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
-        else {
+        // Not onto a part still to come.
+        let to_come = |k: usize| part < k && k < last;
+        let Some((k, l)) = hinge_onto(ctx, done, owners, part, &|k| !to_come(k), opts, eps) else {
             break;
         };
         was.push((k, std::mem::replace(&mut done[k], l)));

@@ -297,12 +297,6 @@ pub(super) fn partition(
     let greedy = crate::geom::par::map(orders.iter().collect(), &[], &|order: &Vec<usize>| {
         greedy(&isl, order)
     });
-    let mut best: Best = None;
-    for (_, parts) in &greedy {
-        if let Some(parts) = parts {
-            consider(&isl, parts.clone(), total, &mut best);
-        }
-    }
     let k_min = greedy.iter().map(|g| g.0).min().unwrap_or(1);
     let mut jobs = Vec::new();
     for (order, &(k_own, _)) in orders.iter().zip(&greedy) {
@@ -310,6 +304,10 @@ pub(super) fn partition(
         if k_own != k_min {
             jobs.push((order, k_own));
         }
+    }
+    let mut best: Best = None;
+    for parts in greedy.into_iter().filter_map(|g| g.1) {
+        consider(&isl, parts, total, &mut best);
     }
     let balanced = crate::geom::par::map(jobs, &[], &|(order, k): (&Vec<usize>, usize)| {
         let cuts = balanced(&isl, order, k, total);
