@@ -9,7 +9,7 @@
 //! points (at most 400 × 400) refined by pattern search; a shape thinner than the grid gets
 //! one tiny pole at a material point.
 
-use super::shape::{in_material, POLE_LANES};
+use super::shape::{boundary_dist, in_material, POLE_LANES};
 use crate::geom::polygon;
 use crate::geom::segment::point_segment_dist2;
 use glam::DVec2;
@@ -48,6 +48,8 @@ pub(crate) fn poles(rings: &[Vec<DVec2>]) -> Vec<(DVec2, f64)> {
     let near = Nearest::new(&segs, lo, hi, 6.0 * h);
     let at = |i: usize, j: usize| lo + DVec2::new((i as f64 + 0.5) * h, (j as f64 + 0.5) * h);
     let material = material_on_grid(rings, nx, ny, &at);
+    // Each material grid point with its clearance: the distance to the boundary, lowered to
+    // the distance to each pole's circle as the poles are found.
     let mut pts: Vec<(DVec2, f64)> = Vec::new();
     for i in 0..nx {
         for j in 0..ny {
@@ -65,11 +67,15 @@ pub(crate) fn poles(rings: &[Vec<DVec2>]) -> Vec<(DVec2, f64)> {
     };
     let mut out: Vec<(DVec2, f64)> = Vec::new();
     while out.len() < MAX_POLES {
+        if let Some(&(c, r)) = out.last() {
+            for (p, v) in &mut pts {
+                *v = v.min(c.distance(*p) - r);
+            }
+        }
         let mut best = (DVec2::ZERO, f64::NEG_INFINITY);
-        for (p, d0) in &pts {
-            let v = value(*p, *d0, &out);
+        for &(p, v) in &pts {
             if v > best.1 {
-                best = (*p, v);
+                best = (p, v);
             }
         }
         if best.1 <= 0.0 {
@@ -145,6 +151,9 @@ fn material_on_grid(
     out
 }
 
+/// Up to this many segments, measuring every one is quicker than searching the cells.
+const FEW_SEGMENTS: usize = 24;
+
 /// The segments of a shape by the cells of a uniform grid over its box, for the distance from
 /// a point to the nearest ([`super::shape::boundary_dist`]) without measuring every segment:
 /// the cells are searched in square rings around the point's until the nearest found is
@@ -196,6 +205,9 @@ impl Nearest {
 
     /// [`super::shape::boundary_dist`] of `p`.
     fn dist(&self, segs: &[[DVec2; 2]], p: DVec2) -> f64 {
+        if segs.len() <= FEW_SEGMENTS {
+            return boundary_dist(segs, p);
+        }
         let (ci, cj) = self.at(p);
         let mut best = f64::INFINITY;
         let reach = self.nx.max(self.ny);
@@ -226,7 +238,6 @@ impl Nearest {
 
 #[cfg(test)]
 mod tests {
-    use super::super::shape::boundary_dist;
     use super::*;
     use crate::geom::rng::Rng;
 
