@@ -25,7 +25,9 @@
 //!   developable), and those are joined too. Candidates are tried by the common length they
 //!   join, longest first (ties: longer hinge edge, then lower edge id), at most
 //!   [`HINGE_TRIES`] per neighbour, and relaxed the first [`RELAX_TRIES`].
-//! - **Which neighbour.** Those sharing the longest boundary first, as for merges.
+//! - **Which neighbour.** Those sharing the longest boundary first, as for merges; a
+//!   neighbour the piece failed to hinge onto in an earlier round is not tried again while
+//!   neither has changed ([`super::overlap::Failed`]).
 //! - **Kept when** the union is flip-free, within the tolerance, its seams matched, without
 //!   overlap (the moved piece against the neighbour's faces near it; a relaxed union as a
 //!   whole) and, when pieces are split to fit the sheet, fitting it (else the split would cut
@@ -36,7 +38,7 @@
 
 use super::join::{common, fits_room, Common};
 use super::merge::small_pieces;
-use super::overlap::{keeps, self_overlap, Owners};
+use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -63,6 +65,13 @@ type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
 /// Hinge every small piece of `done` that has a neighbour it fits beside (see the module
 /// doc), smallest first, in rounds while one hinges.
 pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    let failed = Failed::default();
+    let try_onto = Onto {
+        ctx,
+        opts,
+        eps,
+        failed: &failed,
+    };
     for _ in 0..HINGE_ROUNDS {
         let (small, order) = small_pieces(ctx, done);
         let mut owners = Owners::new(ctx.mesh.faces.len(), done);
@@ -71,11 +80,11 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
             if owners.gone[si] || ctx.area(&done[si].faces) >= small {
                 continue;
             }
-            if let Some((k, l)) = hinge_onto(ctx, done, &owners, si, &|_| true, opts, eps) {
+            if let Some((k, l)) = try_onto.hinge(done, &owners, si, &|_| true) {
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
-            } else if hinge_halves(ctx, done, &mut owners, si, opts, eps) {
+            } else if hinge_halves(&try_onto, done, &mut owners, si) {
                 any = true;
             }
         }
@@ -86,22 +95,39 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
     }
 }
 
-/// The first neighbour of `done[part]` (those sharing the longest boundary first) that
-/// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union.
-fn hinge_onto(
-    ctx: &Charts,
-    done: &[Laid],
-    owners: &Owners,
-    part: usize,
-    allowed: &dyn Fn(usize) -> bool,
-    opts: &FlattenOptions,
+/// What hinging a piece onto a neighbour needs besides the pieces: the charts, the options
+/// and the pairs that failed already (a pair of pieces as they are hinges the same way in
+/// every round).
+struct Onto<'a> {
+    ctx: &'a Charts<'a>,
+    opts: &'a FlattenOptions,
     eps: f64,
-) -> Option<(usize, Laid)> {
-    owners
-        .neighbours(ctx, done, part)
-        .into_iter()
-        .filter(|&k| allowed(k))
-        .find_map(|k| hinge(ctx, done, k, part, opts, eps).map(|l| (k, l)))
+    failed: &'a Failed,
+}
+
+impl Onto<'_> {
+    /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
+    /// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union.
+    fn hinge(
+        &self,
+        done: &[Laid],
+        owners: &Owners,
+        part: usize,
+        allowed: &dyn Fn(usize) -> bool,
+    ) -> Option<(usize, Laid)> {
+        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
+        owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .filter(|&k| allowed(k) && !self.failed.known(Trial::Hinge, &done[k], &done[part]))
+            .find_map(|k| match hinge(ctx, done, k, part, opts, eps) {
+                Some(l) => Some((k, l)),
+                None => {
+                    self.failed.note(Trial::Hinge, &done[k], &done[part]);
+                    None
+                }
+            })
+    }
 }
 
 /// The rigid motion (unit complex turn, shift) that puts `c`'s ends as the small piece lays
@@ -182,14 +208,13 @@ fn hinge(
 /// onto `done`) and `done[si]` marked gone in `owners`; else `done` and `owners` are as they
 /// were.
 fn hinge_parts(
-    ctx: &Charts,
+    onto: &Onto,
     done: &mut Vec<Laid>,
     owners: &mut Owners,
     si: usize,
     parts: Vec<Vec<usize>>,
-    opts: &FlattenOptions,
-    eps: f64,
 ) -> bool {
+    let ctx = onto.ctx;
     if parts.len() < 2 || parts.iter().any(|p| p.is_empty()) {
         return false;
     }
@@ -225,7 +250,7 @@ fn hinge_parts(
     for part in first..last {
         // Not onto a part still to come.
         let to_come = |k: usize| part < k && k < last;
-        let Some((k, l)) = hinge_onto(ctx, done, owners, part, &|k| !to_come(k), opts, eps) else {
+        let Some((k, l)) = onto.hinge(done, owners, part, &|k| !to_come(k)) else {
             break;
         };
         was.push((k, std::mem::replace(&mut done[k], l)));
@@ -249,19 +274,13 @@ fn hinge_parts(
 
 /// Hinge a small piece that does not hinge whole in halves ([`bisect`]), else in quarters
 /// (each half halved again where it has two faces or more): see [`hinge_parts`].
-fn hinge_halves(
-    ctx: &Charts,
-    done: &mut Vec<Laid>,
-    owners: &mut Owners,
-    si: usize,
-    opts: &FlattenOptions,
-    eps: f64,
-) -> bool {
+fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usize) -> bool {
+    let ctx = onto.ctx;
     let (a, b) = bisect(ctx.graph, &done[si].faces);
     if a.is_empty() || b.is_empty() {
         return false;
     }
-    if hinge_parts(ctx, done, owners, si, vec![a.clone(), b.clone()], opts, eps) {
+    if hinge_parts(onto, done, owners, si, vec![a.clone(), b.clone()]) {
         return true;
     }
     let mut quarters = Vec::new();
@@ -271,7 +290,7 @@ fn hinge_halves(
             _ => quarters.push(h),
         }
     }
-    quarters.len() > 2 && hinge_parts(ctx, done, owners, si, quarters, opts, eps)
+    quarters.len() > 2 && hinge_parts(onto, done, owners, si, quarters)
 }
 
 /// `done[part]` moved by `m` beside `done[k]`, the common edges it `joins` joined (their ends
@@ -520,6 +539,42 @@ mod tests {
         assert!(try_hinge(&mesh).is_none());
     }
 
+    /// A failed hinge is remembered for the two pieces exactly as they are: the same pair is
+    /// not tried again, the pair with either piece changed (one coordinate by one ulp) or in
+    /// another trial is.
+    #[test]
+    fn a_failed_hinge_is_known_only_for_the_same_two_pieces() {
+        let mesh = fan(|i| if i % 2 == 0 { 5.0 } else { -5.0 });
+        let topo = mesh.topology();
+        let graph = Graph::new(&mesh, &topo);
+        let opts = FlattenOptions::default();
+        let ctx = Charts {
+            mesh: &mesh,
+            topo: &topo,
+            graph: &graph,
+            method: opts.method,
+            match_below: opts.tolerance,
+            laid: &LayCache::default(),
+        };
+        let mut done = laid(&mesh);
+        let owners = Owners::new(mesh.faces.len(), &done);
+        let failed = Failed::default();
+        let onto = Onto {
+            ctx: &ctx,
+            opts: &opts,
+            eps: 1e-6,
+            failed: &failed,
+        };
+        assert!(!failed.known(Trial::Hinge, &done[0], &done[1]));
+        assert!(onto.hinge(&done, &owners, 1, &|_| true).is_none());
+        assert!(failed.known(Trial::Hinge, &done[0], &done[1]));
+        assert!(!failed.known(Trial::Hinge, &done[1], &done[0]));
+        assert!(!failed.known(Trial::Merge, &done[0], &done[1]));
+        let q = &mut done[1].uv[0][2].y;
+        *q = f64::from_bits(q.to_bits() + 1);
+        assert!(!failed.known(Trial::Hinge, &done[0], &done[1]));
+    }
+
     /// `n` triangles round an apex at the origin over a saddle (rim vertices at `n` even
     /// steps round the unit circle, times 10, alternately above and below), each with the
     /// angle `alpha` at the apex.
@@ -598,7 +653,14 @@ mod tests {
             .collect();
         let mut owners = Owners::new(n, &done);
         let owner_before = owners.owner.clone();
-        if !hinge_halves(&ctx, &mut done, &mut owners, 1, &opts, eps) {
+        let failed = Failed::default();
+        let onto = Onto {
+            ctx: &ctx,
+            opts: &opts,
+            eps,
+            failed: &failed,
+        };
+        if !hinge_halves(&onto, &mut done, &mut owners, 1) {
             // Left as it was.
             let after: Vec<(Vec<usize>, Vec<Vec<DVec2>>)> = done
                 .iter()

@@ -7,7 +7,8 @@
 //! in order of the boundary length they share with it (longest first, ties by index), at most
 //! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too;
 //! then another round, while the last one merged any (a piece that failed early may fit a
-//! neighbour a later merge has changed). The merged chart keeps the cuts of both (and more
+//! neighbour a later merge has changed; a pair that failed is not tried again while neither
+//! piece has changed: [`super::overlap::Failed`]). The merged chart keeps the cuts of both (and more
 //! where it is not a disk). A small piece that no neighbour takes is shared out with one of
 //! its [`REBALANCE_TRIES`] nearest: the two are halved anew and kept as the halves when
 //! neither half is small and both keep the tolerance (`rebalance`; the count of pieces stays);
@@ -45,7 +46,9 @@
 
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
-use super::overlap::{both_cuts, first_merge, keeps, laid_as_one, self_overlap, Owners};
+use super::overlap::{
+    both_cuts, first_merge, keeps, laid_as_one, self_overlap, Failed, Owners, Trial,
+};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -63,9 +66,10 @@ pub(crate) const NEAR_SHARE: f64 = 1.0 / 3.0;
 /// Merge the small pieces of `done` into neighbours (see the module doc), in rounds until
 /// none merges (at most [`MERGE_ROUNDS`]).
 pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+    let failed = Failed::default();
     for _ in 0..MERGE_ROUNDS {
         let before = done.len();
-        merge_small_once(ctx, done, opts, eps);
+        merge_small_once(ctx, done, opts, eps, &failed);
         if done.len() == before {
             break;
         }
@@ -73,7 +77,13 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
 }
 
 /// One round of [`merge_small`]: each small piece, smallest first, tried with its neighbours.
-fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
+fn merge_small_once(
+    ctx: &Charts,
+    done: &mut Vec<Laid>,
+    opts: &FlattenOptions,
+    eps: f64,
+    failed: &Failed,
+) {
     let (small, order) = small_pieces(ctx, done);
     let mut owners = Owners::new(ctx.mesh.faces.len(), done);
     for si in order {
@@ -87,15 +97,16 @@ fn merge_small_once(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, e
             .collect();
         // Laid out again as one, else shared out with a neighbour, else grafted onto the
         // neighbours as they lie.
-        if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps) {
+        if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
             done[k] = union;
             owners.absorb(done, k, si);
-        } else if let Some(k) = near
-            .iter()
-            .take(REBALANCE_TRIES)
-            .copied()
-            .find(|&k| rebalance(ctx, done, k, si, small, opts, eps))
-        {
+        } else if let Some(k) = near.iter().take(REBALANCE_TRIES).copied().find(|&k| {
+            !failed.known(Trial::Share, &done[k], &done[si])
+                && (rebalance(ctx, done, k, si, small, opts, eps) || {
+                    failed.note(Trial::Share, &done[k], &done[si]);
+                    false
+                })
+        }) {
             for (p, l) in [(k, &done[k]), (si, &done[si])] {
                 for &f in &l.faces {
                     owners.owner[f] = p;

@@ -387,7 +387,8 @@ pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> 
 
 /// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
 /// the union, as trying them in order finds it; two are tried at a time where a spare thread
-/// is free ([`crate::geom::par::first`]).
+/// is free ([`crate::geom::par::first`]). A pair `failed` already is skipped; one that fails
+/// now is noted there.
 pub(super) fn first_merge(
     ctx: &Charts,
     done: &[Laid],
@@ -395,9 +396,71 @@ pub(super) fn first_merge(
     part: usize,
     opts: &FlattenOptions,
     eps: f64,
+    failed: &Failed,
 ) -> Option<(usize, Laid)> {
-    crate::geom::par::first(near, |&k| merged(ctx, done, k, part, opts, eps))
-        .map(|(i, l)| (near[i], l))
+    let near: Vec<usize> = near
+        .iter()
+        .copied()
+        .filter(|&k| !failed.known(Trial::Merge, &done[k], &done[part]))
+        .collect();
+    crate::geom::par::first(&near, |&k| {
+        let l = merged(ctx, done, k, part, opts, eps);
+        if l.is_none() {
+            failed.note(Trial::Merge, &done[k], &done[part]);
+        }
+        l
+    })
+    .map(|(i, l)| (near[i], l))
+}
+
+/// The trials on a pair of pieces that [`Failed`] remembers.
+#[derive(Debug, Clone, Copy, Hash)]
+pub(super) enum Trial {
+    /// Laid out as one ([`first_merge`]).
+    Merge,
+    /// Shared out ([`super::merge`]'s `rebalance`).
+    Share,
+    /// Hinged ([`super::hinge`]).
+    Hinge,
+}
+
+/// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A
+/// trial is a function of the two pieces alone (and of options that stay the same while the
+/// pieces are merged), so it fails again while neither has changed: the rounds of merging
+/// and hinging skip it. A pair is known by a 128-bit digest of both pieces.
+#[derive(Default)]
+pub(super) struct Failed(std::sync::Mutex<std::collections::HashSet<u128>>);
+
+impl Failed {
+    fn key(trial: Trial, a: &Laid, b: &Laid) -> u128 {
+        use std::hash::{Hash, Hasher};
+        let half = |salt: u8| {
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (salt, trial).hash(&mut h);
+            for l in [a, b] {
+                (&l.faces, &l.cuts, l.gusset).hash(&mut h);
+                for q in l.uv.iter().flatten() {
+                    (q.x.to_bits(), q.y.to_bits()).hash(&mut h);
+                }
+            }
+            h.finish() as u128
+        };
+        half(0) << 64 | half(1)
+    }
+
+    /// Whether `trial` failed on `a` and `b` as they are.
+    pub(super) fn known(&self, trial: Trial, a: &Laid, b: &Laid) -> bool {
+        let key = Self::key(trial, a, b);
+        self.0.lock().is_ok_and(|s| s.contains(&key))
+    }
+
+    /// `trial` failed on `a` and `b` as they are.
+    pub(super) fn note(&self, trial: Trial, a: &Laid, b: &Laid) {
+        let key = Self::key(trial, a, b);
+        if let Ok(mut s) = self.0.lock() {
+            s.insert(key);
+        }
+    }
 }
 
 /// `done[k]` and `done[part]` laid out as one chart (the cuts of both, more where the union
