@@ -144,6 +144,56 @@ pub fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
     faces.iter().partition(|&&f| da[f] <= db[f])
 }
 
+/// Split faces in two of about equal area across the two faces farthest apart (as
+/// [`bisect`] finds them): the faces in order of how much nearer they are to the first
+/// (distance to the first less distance to the second, ties by face), the first part taking
+/// them until it has half the area. `None` when `faces` is not connected or a part would be
+/// empty or not connected.
+pub fn bisect_area(g: &Graph, faces: &[usize]) -> Option<(Vec<usize>, Vec<usize>)> {
+    let nf = g.area.len();
+    let mut inside = vec![false; nf];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let &start = faces.first()?;
+    let far = |d: &[f64]| {
+        faces
+            .iter()
+            .copied()
+            .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
+    };
+    let d0 = g.distances(&[start], &|f| inside[f]);
+    if faces.iter().any(|&f| !d0[f].is_finite()) {
+        return None;
+    }
+    let a = far(&d0)?;
+    let da = g.distances(&[a], &|f| inside[f]);
+    let b = far(&da)?;
+    let db = g.distances(&[b], &|f| inside[f]);
+    let mut order = faces.to_vec();
+    order.sort_by(|&x, &y| (da[x] - db[x]).total_cmp(&(da[y] - db[y])).then(x.cmp(&y)));
+    let half = 0.5 * faces.iter().map(|&f| g.area[f]).sum::<f64>();
+    let mut taken = 0.0;
+    let n = order
+        .iter()
+        .position(|&f| {
+            taken += g.area[f];
+            taken >= half
+        })
+        .map_or(order.len(), |i| i + 1);
+    let second = order.split_off(n);
+    let connected = |part: &[usize]| {
+        let mut within = vec![false; nf];
+        for &f in part {
+            within[f] = true;
+        }
+        let d = g.distances(&part[..1], &|f| within[f]);
+        part.iter().all(|&f| d[f].is_finite())
+    };
+    (!order.is_empty() && !second.is_empty() && connected(&order) && connected(&second))
+        .then_some((order, second))
+}
+
 /// Split faces in two by which of faces `a` and `b` is nearer through the face graph restricted
 /// to `faces` (used to separate two faces whose layouts overlap). Each part is connected when
 /// `faces` is.
@@ -614,4 +664,65 @@ fn handle_cuts(
     out.sort_unstable();
     out.dedup();
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::mesh::Face;
+
+    /// Unit squares (two triangles each): a strip 10 long and 1 wide, then a 10 × 10 block
+    /// at its end.
+    fn strip_and_block() -> Mesh {
+        let mut at = std::collections::HashMap::new();
+        let mut vertices = Vec::new();
+        let mut v = |i: usize, j: usize| {
+            *at.entry((i, j)).or_insert_with(|| {
+                vertices.push(DVec3::new(i as f64, j as f64, 0.0));
+                vertices.len() - 1
+            })
+        };
+        let mut faces = Vec::new();
+        for i in 0..20 {
+            for j in 0..(if i < 10 { 1 } else { 10 }) {
+                let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+                for verts in [vec![a, b, c], vec![a, c, d]] {
+                    faces.push(Face { verts, line: None });
+                }
+            }
+        }
+        Mesh { vertices, faces }
+    }
+
+    fn connected(g: &Graph, part: &[usize]) -> bool {
+        let d = g.distances(&part[..1], &|f| part.contains(&f));
+        part.iter().all(|&f| d[f].is_finite())
+    }
+
+    #[test]
+    fn halves_of_equal_area_where_the_bisector_gives_unequal_ones() {
+        let mesh = strip_and_block();
+        let topo = mesh.topology();
+        let g = Graph::new(&mesh, &topo);
+        let faces: Vec<usize> = (0..mesh.faces.len()).collect();
+        let area = |p: &[usize]| p.iter().map(|&f| g.area[f]).sum::<f64>();
+        let total = area(&faces);
+        assert!((total - 110.0).abs() < 1e-9, "{total}");
+        // The bisector halves the way from the strip's end to the block's far corner, not
+        // the area.
+        let (a, b) = bisect(&g, &faces);
+        let narrow = area(&a).min(area(&b));
+        assert!(narrow < 0.4 * total, "{narrow}");
+        let (a, b) = bisect_area(&g, &faces).expect("halves");
+        let largest = faces.iter().map(|&f| g.area[f]).fold(0.0, f64::max);
+        assert!((area(&a) - 0.5 * total).abs() <= largest, "{}", area(&a));
+        assert!(area(&a) >= 0.5 * total - 1e-9);
+        assert!(connected(&g, &a) && connected(&g, &b));
+        let mut all = [a, b].concat();
+        all.sort_unstable();
+        assert_eq!(all, faces);
+        // Two pieces of the strip that do not touch: no halves.
+        let apart: Vec<usize> = (0..6).chain(10..16).collect();
+        assert_eq!(bisect_area(&g, &apart), None);
+    }
 }

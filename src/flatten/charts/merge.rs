@@ -51,7 +51,7 @@ use super::overlap::{
 };
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
-use crate::geom::cut::bisect;
+use crate::geom::cut::{bisect, bisect_area};
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
@@ -144,7 +144,8 @@ const REBALANCE_TRIES: usize = 2;
 
 /// Share the faces of a small piece `done[part]` and its neighbour `done[k]` out anew: the
 /// two as one chart are halved along the bisector of their two faces farthest apart
-/// ([`bisect`]), and each half laid out, starting from the two layouts joined
+/// ([`bisect`]), or, where a half would be under `small`, across them into halves of equal
+/// area ([`bisect_area`]), and each half laid out, starting from the two layouts joined
 /// ([`moved_onto`]), the second beside the first where a spare thread is free. Kept, the
 /// halves becoming `done[k]` and `done[part]`, when neither half is under `small` in area and
 /// each is flip-free, without overlap, within the tolerance and with its seams matched;
@@ -160,10 +161,6 @@ fn rebalance(
 ) -> bool {
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
-    let (a, b) = bisect(ctx.graph, &faces);
-    if ctx.area(&a) < small || ctx.area(&b) < small {
-        return false;
-    }
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
     let cuts = both_cuts(&done[k], &done[part]);
     let lay = |half: Vec<usize>| -> Option<Laid> {
@@ -180,11 +177,16 @@ fn rebalance(
         };
         keeps(ctx, &laid, opts, eps).then_some(laid)
     };
-    let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
-    let Some(ha) = ha else {
+    // Along the bisector; where a half would be small, into halves of equal area.
+    let is_small = |(a, b): &(Vec<usize>, Vec<usize>)| ctx.area(a) < small || ctx.area(b) < small;
+    let halves = Some(bisect(ctx.graph, &faces))
+        .filter(|h| !is_small(h))
+        .or_else(|| bisect_area(ctx.graph, &faces).filter(|h| !is_small(h)));
+    let Some((a, b)) = halves else {
         return false;
     };
-    let Some(hb) = hb.unwrap_or_else(|| lay(b)) else {
+    let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
+    let (Some(ha), Some(hb)) = (ha, hb.unwrap_or_else(|| lay(b))) else {
         return false;
     };
     done[k] = ha;
