@@ -19,6 +19,10 @@
 //! again) and the quarters hinged so in turn. Where the whole would wrap round a saddle vertex
 //! past a full turn, each part may still fit beside the piece on its side. All parts or none.
 //!
+//! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
+//! share is hinged in parts so too (after the small pieces): the pattern stage would split it
+//! to fit the sheet, and one of its parts would be small.
+//!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
 //!   also puts other common edges in place where the two boundaries run alike (a fold of a
@@ -63,7 +67,8 @@ type Motion = (DVec2, DVec2);
 type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
 
 /// Hinge every small piece of `done` that has a neighbour it fits beside (see the module
-/// doc), smallest first, in rounds while one hinges.
+/// doc), smallest first, then in parts those too large for the sheet that would split into
+/// a small part, in rounds while one hinges.
 pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
     let failed = Failed::default();
     let try_onto = Onto {
@@ -73,11 +78,26 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
         failed: &failed,
     };
     for _ in 0..HINGE_ROUNDS {
-        let (small, order) = small_pieces(ctx, done);
+        let (small, mut order) = small_pieces(ctx, done);
+        // Then those too large for the sheet that it would split into a small part.
+        let fits = |l: &Laid| fits_room(opts.room, &l.uv);
+        let mut large: Vec<(f64, usize)> = (0..done.len())
+            .map(|k| (ctx.area(&done[k].faces), k))
+            .filter(|&(a, k)| small <= a && a < 2.0 * small && !fits(&done[k]))
+            .collect();
+        large.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        order.extend(large.into_iter().map(|(_, k)| k));
         let mut owners = Owners::new(ctx.mesh.faces.len(), done);
         let mut any = false;
         for si in order {
-            if owners.gone[si] || ctx.area(&done[si].faces) >= small {
+            if owners.gone[si] {
+                continue;
+            }
+            if ctx.area(&done[si].faces) >= small {
+                // Too large for the sheet: in parts only.
+                if !fits(&done[si]) && hinge_halves(&try_onto, done, &mut owners, si) {
+                    any = true;
+                }
                 continue;
             }
             if let Some((k, l)) = try_onto.hinge(done, &owners, si, &|_| true) {
@@ -701,5 +721,102 @@ mod tests {
             hinge_middle(10, 75f64.to_radians(), &[0..4, 4..6, 6..9, 9..10]),
             None
         );
+    }
+
+    /// Two 100 mm squares side by side on the plane and a strip 200 mm long and 1.5 mm wide
+    /// along their bottom (1.48 % of the area), the sheet's room 150 mm square: the strip does
+    /// not fit it, so the pattern stage would split it into two pieces under 1 %. Hinged in
+    /// halves instead, each half goes onto the square above it, both fitting the room.
+    #[test]
+    fn a_strip_too_long_for_the_sheet_is_hinged_in_halves_onto_its_neighbours() {
+        let xs: Vec<f64> = (0..=20).map(|i| 10.0 * i as f64).collect();
+        let ys: Vec<f64> = [-1.5]
+            .into_iter()
+            .chain((0..=10).map(|j| 10.0 * j as f64))
+            .collect();
+        let vertices: Vec<DVec3> = ys
+            .iter()
+            .flat_map(|&y| xs.iter().map(move |&x| DVec3::new(x, y, 0.0)))
+            .collect();
+        let v = |i: usize, j: usize| j * xs.len() + i;
+        // Faces of the cells in columns `cols` and rows `rows` (row 0: the strip).
+        let cells = |cols: std::ops::Range<usize>, rows: std::ops::Range<usize>| {
+            let mut faces = Vec::new();
+            for j in rows {
+                for i in cols.clone() {
+                    let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+                    faces.push(vec![a, b, c]);
+                    faces.push(vec![a, c, d]);
+                }
+            }
+            faces
+        };
+        let pieces = [
+            cells(0..10, 1..11),
+            cells(10..20, 1..11),
+            cells(0..20, 0..1),
+        ];
+        let mut faces = Vec::new();
+        let mut ranges = Vec::new();
+        for p in &pieces {
+            ranges.push(faces.len()..faces.len() + p.len());
+            faces.extend(p.iter().map(|verts| Face {
+                verts: verts.clone(),
+                line: None,
+            }));
+        }
+        let mesh = Mesh { vertices, faces };
+        let topo = mesh.topology();
+        let graph = Graph::new(&mesh, &topo);
+        let opts = FlattenOptions {
+            room: Some([150.0, 150.0]),
+            ..FlattenOptions::default()
+        };
+        let ctx = Charts {
+            mesh: &mesh,
+            topo: &topo,
+            graph: &graph,
+            method: opts.method,
+            match_below: opts.tolerance,
+            laid: &LayCache::default(),
+        };
+        // Laid as they lie on the plane.
+        let mut done: Vec<Laid> = ranges
+            .into_iter()
+            .map(|r| {
+                let faces: Vec<usize> = r.collect();
+                let uv: Vec<Vec<DVec2>> = faces
+                    .iter()
+                    .map(|&f| {
+                        let p = mesh.face_points(f);
+                        p.iter().map(|q| q.truncate()).collect()
+                    })
+                    .collect();
+                Laid {
+                    stretch: distortion::stretch(&mesh, &faces, &uv),
+                    faces,
+                    cuts: Vec::new(),
+                    uv,
+                    gusset: false,
+                }
+            })
+            .collect();
+        let total: f64 = (0..mesh.faces.len()).map(|f| graph.area[f]).sum();
+        let strip = ctx.area(&done[2].faces) / total;
+        assert!(0.01 < strip && strip < 0.02, "{strip}");
+        assert!(!fits_room(opts.room, &done[2].uv));
+        hinge_small(&ctx, &mut done, &opts, 1e-6);
+        assert_eq!(done.len(), 2);
+        let mut owned = vec![0; mesh.faces.len()];
+        for (k, l) in done.iter().enumerate() {
+            assert_eq!(l.faces.len(), 200 + 20, "piece {k}");
+            assert!(fits_room(opts.room, &l.uv), "piece {k}");
+            assert!((l.stretch.l2 - 1.0).abs() < 1e-9, "{}", l.stretch.l2);
+            assert!(self_overlap(&l.uv, 1e-6).is_none());
+            for &f in &l.faces {
+                owned[f] += 1;
+            }
+        }
+        assert!(owned.iter().all(|&n| n == 1));
     }
 }
