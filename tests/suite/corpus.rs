@@ -294,7 +294,8 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
 /// (`flatten::charts::exact`), else hinged onto one by an edge (`flatten::charts::hinge`),
 /// whole or in parts. Before the first two, 11 pieces were over the tolerance (the worst at
 /// L2 1.347) and 37 were under 1 % of the area; then none was over and 16 were small (42
-/// pieces); hinged whole, 11 were small (37 pieces); in halves and quarters too, 8 are (34
+/// pieces); hinged whole, 11 were small (37 pieces); in halves and quarters too, 8 (34
+/// pieces); merged with a slit where no hinge fits (`flatten::charts::slit`), 7 are (33
 /// pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
@@ -303,8 +304,8 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 9, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 36, "{} pieces", r.pieces);
+    assert!(r.small <= 7, "{} pieces under 1 % of the area", r.small);
+    assert!(r.pieces <= 33, "{} pieces", r.pieces);
 }
 
 /// Issue 20: a piece split to fit the sheet keeps its layout, and a part of it can stretch

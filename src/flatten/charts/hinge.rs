@@ -19,6 +19,9 @@
 //! again) and the quarters hinged so in turn. Where the whole would wrap round a saddle vertex
 //! past a full turn, each part may still fit beside the piece on its side. All parts or none.
 //!
+//! A small piece that hinges in no way is last laid out anew with a neighbour as one, with a
+//! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]).
+//!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
 //! to fit the sheet, and one of its parts would be small.
@@ -43,6 +46,7 @@
 use super::join::{common, fits_room, Common};
 use super::merge::small_pieces;
 use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
+use super::slit::{slit_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -106,6 +110,10 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 any = true;
             } else if hinge_halves(&try_onto, done, &mut owners, si) {
                 any = true;
+            } else if let Some((k, l)) = try_onto.slit(done, &owners, si) {
+                done[k] = l;
+                owners.absorb(done, k, si);
+                any = true;
             }
         }
         owners.drop_gone(done);
@@ -126,6 +134,24 @@ struct Onto<'a> {
 }
 
 impl Onto<'_> {
+    /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
+    /// boundary that it merges with by a slit ([`slit_merge`]), and the union.
+    fn slit(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
+        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
+        owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .take(SLIT_TRIES)
+            .filter(|&k| !self.failed.known(Trial::Slit, &done[k], &done[part]))
+            .find_map(|k| match slit_merge(ctx, done, k, part, opts, eps) {
+                Some(l) => Some((k, l)),
+                None => {
+                    self.failed.note(Trial::Slit, &done[k], &done[part]);
+                    None
+                }
+            })
+    }
+
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
     /// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union.
     fn hinge(

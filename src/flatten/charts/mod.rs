@@ -112,6 +112,7 @@ mod hinge;
 mod join;
 mod merge;
 mod overlap;
+mod slit;
 
 use assemble::{assemble, edge_ids};
 use darts::{darts, gussets, DART_MIN_FACES};

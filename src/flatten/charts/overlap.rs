@@ -422,6 +422,8 @@ pub(super) enum Trial {
     Share,
     /// Hinged ([`super::hinge`]).
     Hinge,
+    /// Laid out as one with a slit ([`super::slit`]).
+    Slit,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A
