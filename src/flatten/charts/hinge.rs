@@ -135,21 +135,24 @@ struct Onto<'a> {
 
 impl Onto<'_> {
     /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
-    /// boundary that it merges with by a slit ([`slit_merge`]), and the union.
+    /// boundary that it merges with by a slit ([`slit_merge`]), and the union; two are tried
+    /// at a time where a spare thread is free ([`crate::geom::par::first`]).
     fn slit(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
-        owners
+        let near: Vec<usize> = owners
             .neighbours(ctx, done, part)
             .into_iter()
             .take(SLIT_TRIES)
             .filter(|&k| !self.failed.known(Trial::Slit, &done[k], &done[part]))
-            .find_map(|k| match slit_merge(ctx, done, k, part, opts, eps) {
-                Some(l) => Some((k, l)),
-                None => {
-                    self.failed.note(Trial::Slit, &done[k], &done[part]);
-                    None
-                }
-            })
+            .collect();
+        crate::geom::par::first(&near, |&k| {
+            let l = slit_merge(ctx, done, k, part, opts, eps);
+            if l.is_none() {
+                self.failed.note(Trial::Slit, &done[k], &done[part]);
+            }
+            l
+        })
+        .map(|(i, l)| (near[i], l))
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
