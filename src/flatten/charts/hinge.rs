@@ -457,8 +457,7 @@ fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::LayCache;
-    use crate::geom::cut::Graph;
+    use crate::flatten::charts::Fixture;
     use crate::geom::mesh::{Face, Mesh};
     use glam::DVec3;
 
@@ -513,17 +512,10 @@ mod tests {
     }
 
     fn try_hinge(mesh: &Mesh) -> Option<Laid> {
-        let topo = mesh.topology();
-        let graph = Graph::new(mesh, &topo);
         let opts = FlattenOptions::default();
-        let ctx = Charts {
-            mesh,
-            topo: &topo,
-            graph: &graph,
-            method: opts.method,
-            match_below: opts.tolerance,
-            laid: &LayCache::default(),
-        };
+        let fx = Fixture::new(mesh.clone());
+        let topo = &fx.topo;
+        let ctx = fx.charts(&opts);
         let done = laid(mesh);
         for l in &done {
             assert!((l.stretch.l2 - 1.0).abs() < 1e-12, "laid exactly");
@@ -594,18 +586,11 @@ mod tests {
     #[test]
     fn a_failed_hinge_is_known_only_for_the_same_two_pieces() {
         let mesh = fan(|i| if i % 2 == 0 { 5.0 } else { -5.0 });
-        let topo = mesh.topology();
-        let graph = Graph::new(&mesh, &topo);
         let opts = FlattenOptions::default();
-        let ctx = Charts {
-            mesh: &mesh,
-            topo: &topo,
-            graph: &graph,
-            method: opts.method,
-            match_below: opts.tolerance,
-            laid: &LayCache::default(),
-        };
-        let mut done = laid(&mesh);
+        let fx = Fixture::new(mesh);
+        let mesh = &fx.mesh;
+        let ctx = fx.charts(&opts);
+        let mut done = laid(mesh);
         let owners = Owners::new(mesh.faces.len(), &done);
         let failed = Failed::default();
         let onto = Onto {
@@ -675,19 +660,12 @@ mod tests {
     /// when it did not hinge.
     fn hinge_middle(n: usize, alpha: f64, pieces: &[std::ops::Range<usize>]) -> Option<Vec<usize>> {
         let mesh = saddle(n, alpha);
-        let topo = mesh.topology();
-        let graph = Graph::new(&mesh, &topo);
         let opts = FlattenOptions::default();
-        let ctx = Charts {
-            mesh: &mesh,
-            topo: &topo,
-            graph: &graph,
-            method: opts.method,
-            match_below: opts.tolerance,
-            laid: &LayCache::default(),
-        };
+        let fx = Fixture::new(mesh);
+        let mesh = &fx.mesh;
+        let ctx = fx.charts(&opts);
         let eps = 1e-6;
-        let mut done: Vec<Laid> = pieces.iter().map(|r| fan_piece(&mesh, r.clone())).collect();
+        let mut done: Vec<Laid> = pieces.iter().map(|r| fan_piece(mesh, r.clone())).collect();
         for l in &done {
             assert!((l.stretch.l2 - 1.0).abs() < 1e-12, "laid exactly");
             assert!(self_overlap(&l.uv, eps).is_none());
@@ -795,20 +773,13 @@ mod tests {
             }));
         }
         let mesh = Mesh { vertices, faces };
-        let topo = mesh.topology();
-        let graph = Graph::new(&mesh, &topo);
         let opts = FlattenOptions {
             room: Some([150.0, 150.0]),
             ..FlattenOptions::default()
         };
-        let ctx = Charts {
-            mesh: &mesh,
-            topo: &topo,
-            graph: &graph,
-            method: opts.method,
-            match_below: opts.tolerance,
-            laid: &LayCache::default(),
-        };
+        let fx = Fixture::new(mesh);
+        let (mesh, graph) = (&fx.mesh, &fx.graph);
+        let ctx = fx.charts(&opts);
         // Laid as they lie on the plane.
         let mut done: Vec<Laid> = ranges
             .into_iter()
@@ -822,7 +793,7 @@ mod tests {
                     })
                     .collect();
                 Laid {
-                    stretch: distortion::stretch(&mesh, &faces, &uv),
+                    stretch: distortion::stretch(mesh, &faces, &uv),
                     faces,
                     cuts: Vec::new(),
                     uv,

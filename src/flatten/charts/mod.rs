@@ -339,6 +339,41 @@ struct Charts<'a> {
     laid: &'a LayCache,
 }
 
+/// A mesh with what [`Charts`] borrows, for tests: `Fixture::new(mesh).charts(&opts)`.
+#[cfg(test)]
+pub(super) struct Fixture {
+    pub(super) mesh: Mesh,
+    pub(super) topo: Topology,
+    pub(super) graph: Graph,
+    laid: LayCache,
+}
+
+#[cfg(test)]
+impl Fixture {
+    pub(super) fn new(mesh: Mesh) -> Fixture {
+        let topo = mesh.topology();
+        let graph = Graph::new(&mesh, &topo);
+        Fixture {
+            mesh,
+            topo,
+            graph,
+            laid: LayCache::default(),
+        }
+    }
+
+    /// The charts of the mesh as `opts` lays them.
+    fn charts(&self, opts: &FlattenOptions) -> Charts<'_> {
+        Charts {
+            mesh: &self.mesh,
+            topo: &self.topo,
+            graph: &self.graph,
+            method: opts.method,
+            match_below: opts.tolerance,
+            laid: &self.laid,
+        }
+    }
+}
+
 /// The layouts of [`Charts::laid`] by key, and the faces they hold in all.
 type LayCache = std::sync::Mutex<(HashMap<(Vec<usize>, Vec<usize>, bool), Layout>, usize)>;
 

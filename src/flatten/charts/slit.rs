@@ -204,8 +204,7 @@ impl<'a> Fans<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::LayCache;
-    use crate::geom::cut::Graph;
+    use crate::flatten::charts::Fixture;
     use crate::geom::mesh::{Face, Mesh};
     use glam::DVec3;
 
@@ -246,17 +245,10 @@ mod tests {
     #[test]
     fn a_border_vertex_past_a_full_turn_is_slit_into_two_wedges() {
         let mesh = zigzag_cone();
-        let topo = mesh.topology();
-        let graph = Graph::new(&mesh, &topo);
         let opts = FlattenOptions::default();
-        let ctx = Charts {
-            mesh: &mesh,
-            topo: &topo,
-            graph: &graph,
-            method: opts.method,
-            match_below: opts.tolerance,
-            laid: &LayCache::default(),
-        };
+        let fx = Fixture::new(mesh);
+        let (mesh, topo) = (&fx.mesh, &fx.topo);
+        let ctx = fx.charts(&opts);
         let five: Vec<usize> = (0..15).collect();
         let fans = Fans::new(&ctx, &five, &[]);
         let apex = (0..fans.turn.len())
