@@ -8,10 +8,11 @@
 //! [`MERGE_TRIES`] of them; a neighbour grown by a merge may take the next small piece too;
 //! then another round, while the last one merged any (a piece that failed early may fit a
 //! neighbour a later merge has changed; a pair that failed is not tried again while neither
-//! piece has changed: [`super::overlap::Failed`]). The merged chart keeps the cuts of both (and more
-//! where it is not a disk). A small piece that no neighbour takes is shared out with one of
-//! its [`REBALANCE_TRIES`] nearest: the two are halved anew and kept as the halves when
-//! neither half is small and both keep the tolerance (`rebalance`; the count of pieces stays);
+//! piece has changed: [`super::overlap::Failed`]). The merged chart keeps the cuts of both
+//! (and more where it is not a disk). A small piece that no neighbour takes is shared out
+//! with one of its [`REBALANCE_TRIES`] nearest: the two are halved anew (into halves of equal
+//! area where the bisector would leave one small) and kept as the halves when neither half
+//! is small and both keep the tolerance (`rebalance`; the count of pieces stays);
 //! else it is grafted onto its neighbours as they lie ([`graft`]). The neighbours are tried
 //! two at a time where a spare thread is free, the first that takes it winning as in order
 //! (`first_merge`). What is still small once every merge below is done is hinged onto a
