@@ -124,24 +124,34 @@ pub fn bisect(g: &Graph, faces: &[usize]) -> (Vec<usize>, Vec<usize>) {
     let Some(&start) = faces.first() else {
         return (Vec::new(), Vec::new());
     };
-    let far = |d: &[f64]| -> usize {
-        faces
-            .iter()
-            .copied()
-            .filter(|&f| d[f].is_finite())
-            .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
-            .unwrap_or(start)
-    };
     let d0 = g.distances(&[start], &within);
     // Faces not reached from the start (another component) go to the second part.
     if faces.iter().any(|&f| !d0[f].is_finite()) {
         return faces.iter().partition(|&&f| d0[f].is_finite());
     }
-    let a = far(&d0);
-    let da = g.distances(&[a], &within);
-    let b = far(&da);
-    let db = g.distances(&[b], &within);
+    let (da, db) = far_pair(g, faces, &within, &d0);
     faces.iter().partition(|&&f| da[f] <= db[f])
+}
+
+/// The distances (within `faces`, connected) from each of their two faces farthest apart:
+/// the face farthest from where `d0` was measured, then the face farthest from it (ties:
+/// lower face).
+fn far_pair(
+    g: &Graph,
+    faces: &[usize],
+    within: &dyn Fn(usize) -> bool,
+    d0: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let far = |d: &[f64]| -> usize {
+        faces
+            .iter()
+            .copied()
+            .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
+            .unwrap_or(0)
+    };
+    let da = g.distances(&[far(d0)], within);
+    let db = g.distances(&[far(&da)], within);
+    (da, db)
 }
 
 /// Split faces in two of about equal area across the two faces farthest apart (as
@@ -156,20 +166,11 @@ pub fn bisect_area(g: &Graph, faces: &[usize]) -> Option<(Vec<usize>, Vec<usize>
         inside[f] = true;
     }
     let &start = faces.first()?;
-    let far = |d: &[f64]| {
-        faces
-            .iter()
-            .copied()
-            .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
-    };
     let d0 = g.distances(&[start], &|f| inside[f]);
     if faces.iter().any(|&f| !d0[f].is_finite()) {
         return None;
     }
-    let a = far(&d0)?;
-    let da = g.distances(&[a], &|f| inside[f]);
-    let b = far(&da)?;
-    let db = g.distances(&[b], &|f| inside[f]);
+    let (da, db) = far_pair(g, faces, &|f| inside[f], &d0);
     let mut order = faces.to_vec();
     order.sort_by(|&x, &y| (da[x] - db[x]).total_cmp(&(da[y] - db[y])).then(x.cmp(&y)));
     let half = 0.5 * faces.iter().map(|&f| g.area[f]).sum::<f64>();

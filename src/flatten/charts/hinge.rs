@@ -143,14 +143,11 @@ impl Onto<'_> {
             .neighbours(ctx, done, part)
             .into_iter()
             .take(SLIT_TRIES)
-            .filter(|&k| !self.failed.known(Trial::Slit, &done[k], &done[part]))
             .collect();
         crate::geom::par::first(&near, |&k| {
-            let l = slit_merge(ctx, done, k, part, opts, eps);
-            if l.is_none() {
-                self.failed.note(Trial::Slit, &done[k], &done[part]);
-            }
-            l
+            self.failed.attempt(Trial::Slit, &done[k], &done[part], || {
+                slit_merge(ctx, done, k, part, opts, eps)
+            })
         })
         .map(|(i, l)| (near[i], l))
     }
@@ -168,13 +165,13 @@ impl Onto<'_> {
         owners
             .neighbours(ctx, done, part)
             .into_iter()
-            .filter(|&k| allowed(k) && !self.failed.known(Trial::Hinge, &done[k], &done[part]))
-            .find_map(|k| match hinge(ctx, done, k, part, opts, eps) {
-                Some(l) => Some((k, l)),
-                None => {
-                    self.failed.note(Trial::Hinge, &done[k], &done[part]);
-                    None
-                }
+            .filter(|&k| allowed(k))
+            .find_map(|k| {
+                self.failed
+                    .attempt(Trial::Hinge, &done[k], &done[part], || {
+                        hinge(ctx, done, k, part, opts, eps)
+                    })
+                    .map(|l| (k, l))
             })
     }
 }
@@ -501,14 +498,21 @@ mod tests {
             at + DVec2::X * p(6).length(),
             at + DVec2::from_angle(angle(5)) * p(1).length(),
         ]];
-        let piece = |faces: Vec<usize>, uv: Vec<Vec<DVec2>>| Laid {
+        vec![
+            piece(mesh, (0..5).collect(), uv_n),
+            piece(mesh, vec![5], uv_s),
+        ]
+    }
+
+    /// `faces` of `mesh` laid out as `uv`, without cuts.
+    fn piece(mesh: &Mesh, faces: Vec<usize>, uv: Vec<Vec<DVec2>>) -> Laid {
+        Laid {
             stretch: distortion::stretch(mesh, &faces, &uv),
             faces,
             cuts: Vec::new(),
             uv,
             gusset: false,
-        };
-        vec![piece((0..5).collect(), uv_n), piece(vec![5], uv_s)]
+        }
     }
 
     fn try_hinge(mesh: &Mesh) -> Option<Laid> {
@@ -645,14 +649,7 @@ mod tests {
             ]);
             dir += turn;
         }
-        let faces: Vec<usize> = faces.collect();
-        Laid {
-            stretch: distortion::stretch(mesh, &faces, &uv),
-            faces,
-            cuts: Vec::new(),
-            uv,
-            gusset: false,
-        }
+        piece(mesh, faces.collect(), uv)
     }
 
     /// Hinge the second of `pieces` (face ranges of a [`saddle`] of `n` faces, `alpha` each
@@ -784,21 +781,11 @@ mod tests {
         let mut done: Vec<Laid> = ranges
             .into_iter()
             .map(|r| {
-                let faces: Vec<usize> = r.collect();
-                let uv: Vec<Vec<DVec2>> = faces
-                    .iter()
-                    .map(|&f| {
-                        let p = mesh.face_points(f);
-                        p.iter().map(|q| q.truncate()).collect()
-                    })
+                let uv = r
+                    .clone()
+                    .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
                     .collect();
-                Laid {
-                    stretch: distortion::stretch(mesh, &faces, &uv),
-                    faces,
-                    cuts: Vec::new(),
-                    uv,
-                    gusset: false,
-                }
+                piece(mesh, r.collect(), uv)
             })
             .collect();
         let total: f64 = (0..mesh.faces.len()).map(|f| graph.area[f]).sum();

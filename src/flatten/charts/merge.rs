@@ -101,13 +101,15 @@ fn merge_small_once(
         if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
             done[k] = union;
             owners.absorb(done, k, si);
-        } else if let Some(k) = near.iter().take(REBALANCE_TRIES).copied().find(|&k| {
-            !failed.known(Trial::Share, &done[k], &done[si])
-                && (rebalance(ctx, done, k, si, small, opts, eps) || {
-                    failed.note(Trial::Share, &done[k], &done[si]);
-                    false
+        } else if let Some((k, (ha, hb))) = near.iter().take(REBALANCE_TRIES).find_map(|&k| {
+            failed
+                .attempt(Trial::Share, &done[k], &done[si], || {
+                    rebalance(ctx, done, k, si, small, opts, eps)
                 })
+                .map(|halves| (k, halves))
         }) {
+            done[k] = ha;
+            done[si] = hb;
             for (p, l) in [(k, &done[k]), (si, &done[si])] {
                 for &f in &l.faces {
                     owners.owner[f] = p;
@@ -147,21 +149,25 @@ const REBALANCE_TRIES: usize = 2;
 /// two as one chart are halved along the bisector of their two faces farthest apart
 /// ([`bisect`]), or, where a half would be under `small`, across them into halves of equal
 /// area ([`bisect_area`]), and each half laid out, starting from the two layouts joined
-/// ([`moved_onto`]), the second beside the first where a spare thread is free. Kept, the
-/// halves becoming `done[k]` and `done[part]`, when neither half is under `small` in area and
-/// each is flip-free, without overlap, within the tolerance and with its seams matched;
-/// false, leaving both as they were, otherwise.
+/// ([`moved_onto`]), the second beside the first where a spare thread is free. The halves
+/// (to become `done[k]` and `done[part]`) when neither is under `small` in area and each is
+/// flip-free, without overlap, within the tolerance and with its seams matched; else `None`.
 fn rebalance(
     ctx: &Charts,
-    done: &mut [Laid],
+    done: &[Laid],
     k: usize,
     part: usize,
     small: f64,
     opts: &FlattenOptions,
     eps: f64,
-) -> bool {
+) -> Option<(Laid, Laid)> {
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
+    // Along the bisector; where a half would be small, into halves of equal area.
+    let is_small = |(a, b): &(Vec<usize>, Vec<usize>)| ctx.area(a) < small || ctx.area(b) < small;
+    let (a, b) = Some(bisect(ctx.graph, &faces))
+        .filter(|h| !is_small(h))
+        .or_else(|| bisect_area(ctx.graph, &faces).filter(|h| !is_small(h)))?;
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
     let cuts = both_cuts(&done[k], &done[part]);
     let lay = |half: Vec<usize>| -> Option<Laid> {
@@ -178,21 +184,8 @@ fn rebalance(
         };
         keeps(ctx, &laid, opts, eps).then_some(laid)
     };
-    // Along the bisector; where a half would be small, into halves of equal area.
-    let is_small = |(a, b): &(Vec<usize>, Vec<usize>)| ctx.area(a) < small || ctx.area(b) < small;
-    let halves = Some(bisect(ctx.graph, &faces))
-        .filter(|h| !is_small(h))
-        .or_else(|| bisect_area(ctx.graph, &faces).filter(|h| !is_small(h)));
-    let Some((a, b)) = halves else {
-        return false;
-    };
     let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
-    let (Some(ha), Some(hb)) = (ha, hb.unwrap_or_else(|| lay(b))) else {
-        return false;
-    };
-    done[k] = ha;
-    done[part] = hb;
-    true
+    Some((ha?, hb.unwrap_or_else(|| lay(b))?))
 }
 
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).

@@ -398,17 +398,10 @@ pub(super) fn first_merge(
     eps: f64,
     failed: &Failed,
 ) -> Option<(usize, Laid)> {
-    let near: Vec<usize> = near
-        .iter()
-        .copied()
-        .filter(|&k| !failed.known(Trial::Merge, &done[k], &done[part]))
-        .collect();
-    crate::geom::par::first(&near, |&k| {
-        let l = merged(ctx, done, k, part, opts, eps);
-        if l.is_none() {
-            failed.note(Trial::Merge, &done[k], &done[part]);
-        }
-        l
+    crate::geom::par::first(near, |&k| {
+        failed.attempt(Trial::Merge, &done[k], &done[part], || {
+            merged(ctx, done, k, part, opts, eps)
+        })
     })
     .map(|(i, l)| (near[i], l))
 }
@@ -451,17 +444,32 @@ impl Failed {
     }
 
     /// Whether `trial` failed on `a` and `b` as they are.
+    #[cfg(test)]
     pub(super) fn known(&self, trial: Trial, a: &Laid, b: &Laid) -> bool {
         let key = Self::key(trial, a, b);
         self.0.lock().is_ok_and(|s| s.contains(&key))
     }
 
-    /// `trial` failed on `a` and `b` as they are.
-    pub(super) fn note(&self, trial: Trial, a: &Laid, b: &Laid) {
+    /// `run` (`trial` on `a` and `b`), unless it failed on them as they are already; a
+    /// failure (`None`) is noted.
+    pub(super) fn attempt<T>(
+        &self,
+        trial: Trial,
+        a: &Laid,
+        b: &Laid,
+        run: impl FnOnce() -> Option<T>,
+    ) -> Option<T> {
         let key = Self::key(trial, a, b);
-        if let Ok(mut s) = self.0.lock() {
-            s.insert(key);
+        if self.0.lock().is_ok_and(|s| s.contains(&key)) {
+            return None;
         }
+        let out = run();
+        if out.is_none() {
+            if let Ok(mut s) = self.0.lock() {
+                s.insert(key);
+            }
+        }
+        out
     }
 }
 
@@ -469,9 +477,7 @@ impl Failed {
 /// is not a disk), started from the two layouts as they lie, one moved onto the other
 /// ([`super::join::moved_onto`]); `None` when it cannot be laid out. Not checked.
 pub(super) fn laid_as_one(ctx: &Charts, done: &[Laid], k: usize, part: usize) -> Option<Laid> {
-    let mut faces = done[k].faces.clone();
-    faces.extend(&done[part].faces);
-    let cuts = ctx.disk(&faces, &both_cuts(&done[k], &done[part]))?;
+    let (faces, cuts) = as_one(ctx, &done[k], &done[part])?;
     let joined = super::join::moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
     let Ok(Layout::Laid(uv, stretch)) = ctx.lay_from(&faces, &cuts, joined.as_deref()) else {
         return None;
@@ -483,6 +489,15 @@ pub(super) fn laid_as_one(ctx: &Charts, done: &[Laid], k: usize, part: usize) ->
         stretch,
         gusset: false,
     })
+}
+
+/// The faces of `a` and `b` as one chart (those of `a` first) and its cuts: those of both, more
+/// where the two as one are not a disk; `None` when they cannot be cut into one.
+pub(super) fn as_one(ctx: &Charts, a: &Laid, b: &Laid) -> Option<(Vec<usize>, Vec<usize>)> {
+    let mut faces = a.faces.clone();
+    faces.extend(&b.faces);
+    let cuts = ctx.disk(&faces, &both_cuts(a, b))?;
+    Some((faces, cuts))
 }
 
 /// The cuts of two charts merged into one (sorted).

@@ -21,7 +21,7 @@
 //! - Neighbours tried: those sharing the longest boundary first, at most [`SLIT_TRIES`].
 
 use super::join::fits_room;
-use super::overlap::{both_cuts, keeps};
+use super::overlap::{as_one, keeps};
 use super::{Charts, FlattenOptions, Laid, Layout};
 use crate::geom::cut::{open, Opened};
 use std::collections::HashMap;
@@ -43,9 +43,7 @@ pub(super) fn slit_merge(
     opts: &FlattenOptions,
     eps: f64,
 ) -> Option<Laid> {
-    let mut faces = done[k].faces.clone();
-    faces.extend(&done[part].faces);
-    let cuts = ctx.disk(&faces, &both_cuts(&done[k], &done[part]))?;
+    let (faces, cuts) = as_one(ctx, &done[k], &done[part])?;
     let cuts = slit_saddles(ctx, &faces, &cuts)?;
     let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &cuts) else {
         return None;
