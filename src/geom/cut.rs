@@ -171,18 +171,74 @@ pub fn bisect_area(g: &Graph, faces: &[usize]) -> Option<(Vec<usize>, Vec<usize>
         return None;
     }
     let (da, db) = far_pair(g, faces, &|f| inside[f], &d0);
+    let half = 0.5 * faces.iter().map(|&f| g.area[f]).sum::<f64>();
+    split_ordered(g, faces, &da, &db, &|order| {
+        let mut taken = 0.0;
+        Some(
+            order
+                .iter()
+                .position(|&f| {
+                    taken += g.area[f];
+                    taken >= half
+                })
+                .map_or(order.len(), |i| i + 1),
+        )
+    })
+}
+
+/// Split faces in two between faces `a` and `b`, each part of at least `least` area: as
+/// [`split_between`] where both its parts have that, else with the faces in order of how much
+/// nearer they are to `a` than to `b` (as [`bisect_area`] orders them), the first part taking
+/// them until it has `least`, or leaving the second that. `None` when no such split keeps `a`
+/// and `b` apart, or a part would not be connected.
+pub fn split_between_area(
+    g: &Graph,
+    faces: &[usize],
+    a: usize,
+    b: usize,
+    least: f64,
+) -> Option<(Vec<usize>, Vec<usize>)> {
+    let nf = g.area.len();
+    let mut inside = vec![false; nf];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let da = g.distances(&[a], &|f| inside[f]);
+    let db = g.distances(&[b], &|f| inside[f]);
+    if faces.iter().any(|&f| !da[f].is_finite()) {
+        return None;
+    }
+    let (first, second) = split_ordered(g, faces, &da, &db, &|order| {
+        // Areas of the first k faces, k = 0..=n.
+        let mut before = vec![0.0];
+        for &f in order {
+            before.push(before.last().copied().unwrap_or(0.0) + g.area[f]);
+        }
+        let total = before[order.len()];
+        let nearer = order.iter().take_while(|&&f| da[f] < db[f]).count();
+        let ok = |k: usize| before[k] >= least && total - before[k] >= least;
+        // The feasible count nearest the natural split.
+        (0..=order.len())
+            .filter(|&k| ok(k))
+            .min_by_key(|&k| (k.abs_diff(nearer), k))
+    })?;
+    (first.contains(&a) && second.contains(&b)).then_some((first, second))
+}
+
+/// `faces` in order of `da − db` (ties by face), split after the count `at` picks from that
+/// order; `None` when it picks none, or a part would be empty or not connected.
+fn split_ordered(
+    g: &Graph,
+    faces: &[usize],
+    da: &[f64],
+    db: &[f64],
+    at: &dyn Fn(&[usize]) -> Option<usize>,
+) -> Option<(Vec<usize>, Vec<usize>)> {
+    let nf = g.area.len();
     let mut order = faces.to_vec();
     order.sort_by(|&x, &y| (da[x] - db[x]).total_cmp(&(da[y] - db[y])).then(x.cmp(&y)));
-    let half = 0.5 * faces.iter().map(|&f| g.area[f]).sum::<f64>();
-    let mut taken = 0.0;
-    let n = order
-        .iter()
-        .position(|&f| {
-            taken += g.area[f];
-            taken >= half
-        })
-        .map_or(order.len(), |i| i + 1);
-    let second = order.split_off(n);
+    let n = at(&order)?;
+    let second = order.split_off(n.min(order.len()));
     let connected = |part: &[usize]| {
         let mut within = vec![false; nf];
         for &f in part {
@@ -725,5 +781,51 @@ mod tests {
         // Two pieces of the strip that do not touch: no halves.
         let apart: Vec<usize> = (0..6).chain(10..16).collect();
         assert_eq!(bisect_area(&g, &apart), None);
+    }
+
+    #[test]
+    fn a_split_between_two_faces_moves_across_to_leave_each_part_its_least_area() {
+        let mesh = strip_and_block();
+        let topo = mesh.topology();
+        let g = Graph::new(&mesh, &topo);
+        let faces: Vec<usize> = (0..mesh.faces.len()).collect();
+        let area = |p: &[usize]| p.iter().map(|&f| g.area[f]).sum::<f64>();
+        let sorted = |p: &[usize]| {
+            let mut p = p.to_vec();
+            p.sort_unstable();
+            p
+        };
+        let largest = faces.iter().map(|&f| g.area[f]).fold(0.0, f64::max);
+        // The strip's end against the block's far corner: the nearer of the two gives the
+        // strip's end the strip and some of the block.
+        let (a, b) = (0, faces.len() - 1);
+        let (na, nb) = split_between(&g, &faces, a, b);
+        let natural = area(&na);
+        assert!(natural > 10.0 && area(&nb) > natural + 20.0, "{natural}");
+        // Where both parts of that have the least area, it is that split.
+        let (x, y) = split_between_area(&g, &faces, a, b, natural).expect("split");
+        assert_eq!((sorted(&x), sorted(&y)), (sorted(&na), sorted(&nb)));
+        // Else the first part takes faces across until it has the least area, the second
+        // keeping as much.
+        for least in [natural + 10.0, 0.5 * area(&faces)] {
+            let (x, y) = split_between_area(&g, &faces, a, b, least).expect("split");
+            assert!(
+                area(&x) >= least && area(&x) < least + largest,
+                "{}",
+                area(&x)
+            );
+            assert!(area(&y) >= least, "{}", area(&y));
+            assert!(x.contains(&a) && y.contains(&b));
+            assert!(connected(&g, &x) && connected(&g, &y));
+            assert_eq!(sorted(&[x, y].concat()), faces);
+        }
+        // Or leaves the second part that much: the two the other way round.
+        let (x, y) = split_between_area(&g, &faces, b, a, natural + 10.0).expect("split");
+        assert!(area(&y) >= natural + 10.0 && area(&y) < natural + 10.0 + largest);
+        assert!(x.contains(&b) && y.contains(&a));
+        // No split leaves both parts 60 of the 110, nor keeps apart faces not connected.
+        assert_eq!(split_between_area(&g, &faces, a, b, 60.0), None);
+        let apart: Vec<usize> = (0..6).chain(10..16).collect();
+        assert_eq!(split_between_area(&g, &apart, 0, 12, 1.0), None);
     }
 }

@@ -19,8 +19,10 @@
 //! again) and the quarters hinged so in turn. Where the whole would wrap round a saddle vertex
 //! past a full turn, each part may still fit beside the piece on its side. All parts or none.
 //!
-//! A small piece that hinges in no way is last laid out anew with a neighbour as one, with a
-//! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]).
+//! A small piece that hinges in no way is then laid out anew with a neighbour as one, with a
+//! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]);
+//! last, it is shared out with a neighbour where the two overlap ([`share_apart`]): the two
+//! as one split between faces that fold over each other into two parts, neither small.
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
@@ -44,7 +46,7 @@
 //!   tolerance, so the hinge edge itself always is.
 
 use super::join::{common, fits_room, Common};
-use super::merge::small_pieces;
+use super::merge::{share_apart, small_pieces};
 use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
 use super::slit::{slit_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
@@ -58,6 +60,9 @@ use std::collections::HashMap;
 const HINGE_TRIES: usize = 64;
 /// Rounds at most (a hinged union still small may hinge again).
 const HINGE_ROUNDS: usize = 4;
+/// Neighbours a small piece that hinges in no way is shared out with at most
+/// ([`share_apart`]).
+const APART_NEIGHBOURS: usize = 3;
 /// Candidates tried with the union relaxed, per neighbour.
 const RELAX_TRIES: usize = 2;
 /// How near (in mean common edge lengths) a common edge's ends must land to be joined when
@@ -114,6 +119,12 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
+            } else if let Some((k, (ha, hb))) = try_onto.apart(done, &owners, si, small) {
+                done[k] = ha;
+                done[si] = hb;
+                owners.claim(done, k);
+                owners.claim(done, si);
+                any = true;
             }
         }
         owners.drop_gone(done);
@@ -150,6 +161,30 @@ impl Onto<'_> {
             })
         })
         .map(|(i, l)| (near[i], l))
+    }
+
+    /// The first of the [`APART_NEIGHBOURS`] neighbours of `done[part]` sharing the longest
+    /// boundary that it is shared out with where the two overlap ([`share_apart`]), and the
+    /// halves (to become the neighbour and `done[part]`).
+    fn apart(
+        &self,
+        done: &[Laid],
+        owners: &Owners,
+        part: usize,
+        small: f64,
+    ) -> Option<(usize, (Laid, Laid))> {
+        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
+        owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .take(APART_NEIGHBOURS)
+            .find_map(|k| {
+                self.failed
+                    .attempt(Trial::Apart, &done[k], &done[part], || {
+                        share_apart(ctx, done, k, part, small, opts, eps)
+                    })
+                    .map(|h| (k, h))
+            })
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that

@@ -16,7 +16,9 @@
 //! else it is grafted onto its neighbours as they lie ([`graft`]). The neighbours are tried
 //! two at a time where a spare thread is free, the first that takes it winning as in order
 //! (`first_merge`). What is still small once every merge below is done is hinged onto a
-//! neighbour by one edge ([`super::hinge`]).
+//! neighbour by one edge ([`super::hinge`]), and what hinges in no way is last shared out with
+//! a neighbour where the two overlap (`share_apart`): split between two faces that fold over
+//! each other, moved across where a part would be small.
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
@@ -48,11 +50,11 @@
 use super::exact::graft;
 use super::join::{fits_room, moved_onto};
 use super::overlap::{
-    both_cuts, first_merge, keeps, laid_as_one, self_overlap, Failed, Owners, Trial,
+    both_cuts, first_merge, keeps, laid_as_one, overlaps, self_overlap, Failed, Owners, Trial,
 };
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
-use crate::geom::cut::{bisect, bisect_area};
+use crate::geom::cut::{bisect, bisect_area, split_between_area};
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
@@ -110,11 +112,8 @@ fn merge_small_once(
         }) {
             done[k] = ha;
             done[si] = hb;
-            for (p, l) in [(k, &done[k]), (si, &done[si])] {
-                for &f in &l.faces {
-                    owners.owner[f] = p;
-                }
-            }
+            owners.claim(done, k);
+            owners.claim(done, si);
         } else if let Some(took) = graft(ctx, done, &near, si, opts.tolerance, eps) {
             for (k, faces) in took {
                 for f in faces {
@@ -169,10 +168,33 @@ fn rebalance(
         .filter(|h| !is_small(h))
         .or_else(|| bisect_area(ctx.graph, &faces).filter(|h| !is_small(h)))?;
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
-    let cuts = both_cuts(&done[k], &done[part]);
+    lay_halves(
+        ctx,
+        joined.as_deref(),
+        &both_cuts(&done[k], &done[part]),
+        a,
+        b,
+        opts,
+        eps,
+    )
+}
+
+/// The halves `a` and `b` of two pieces (their cuts `cuts`) each laid out, starting from the
+/// two layouts `joined` where there are, the second beside the first where a spare thread is
+/// free; both, when each is flip-free, without overlap, within the tolerance and with its
+/// seams matched ([`keeps`]).
+fn lay_halves(
+    ctx: &Charts,
+    joined: Option<&Whole>,
+    cuts: &[usize],
+    a: Vec<usize>,
+    b: Vec<usize>,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<(Laid, Laid)> {
     let lay = |half: Vec<usize>| -> Option<Laid> {
-        let hc = ctx.disk(&half, &ctx.cuts_within(&half, &cuts))?;
-        let Ok(Layout::Laid(uv, s)) = ctx.lay_from(&half, &hc, joined.as_deref()) else {
+        let hc = ctx.disk(&half, &ctx.cuts_within(&half, cuts))?;
+        let Ok(Layout::Laid(uv, s)) = ctx.lay_from(&half, &hc, joined) else {
             return None;
         };
         let laid = Laid {
@@ -186,6 +208,70 @@ fn rebalance(
     };
     let (ha, hb) = crate::geom::par::speculate(|| lay(a), || lay(b.clone()));
     Some((ha?, hb.unwrap_or_else(|| lay(b))?))
+}
+
+/// Partitions [`share_apart`] lays out at most per layout of the two pieces.
+const APART_TRIES: usize = 3;
+/// Overlapping pairs of faces [`share_apart`] splits between at most per layout.
+const APART_PAIRS: usize = 16;
+
+/// Share a small piece `done[part]` and its neighbour `done[k]` out anew where the two
+/// overlap when joined: as they lie ([`moved_onto`]), then laid out as one
+/// ([`laid_as_one`]). The two as one are split between two faces that overlap, each face
+/// going with the nearer, moved across so that each part has at least `small` area
+/// ([`split_between_area`]): what folds over the other goes to the other part, as a chart
+/// that overlaps itself is split. The parts (to become `done[k]` and `done[part]`) are laid
+/// out from that layout and kept as [`rebalance`] keeps its halves, and when each fits the
+/// sheet; at most [`APART_TRIES`] partitions of the first [`APART_PAIRS`] overlapping pairs
+/// of each layout are laid out.
+pub(super) fn share_apart(
+    ctx: &Charts,
+    done: &[Laid],
+    k: usize,
+    part: usize,
+    small: f64,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<(Laid, Laid)> {
+    if ctx.area(&done[k].faces) + ctx.area(&done[part].faces) < 2.0 * small {
+        return None;
+    }
+    let cuts = both_cuts(&done[k], &done[part]);
+    let mut tried: Vec<Vec<usize>> = Vec::new();
+    // As they lie; where no split of that is kept, laid out as one.
+    let layouts = [false, true].into_iter().filter_map(|relaxed| {
+        if relaxed {
+            laid_as_one(ctx, done, k, part).map(|l| (l.faces, l.uv))
+        } else {
+            moved_onto(ctx, done, k, part).map(|j| (j.faces, j.uv))
+        }
+    });
+    for (faces, uv) in layouts {
+        let whole = Whole::new(&faces, &uv);
+        let mut laid = 0;
+        for (x, y) in overlaps(&uv, eps, APART_PAIRS) {
+            if laid == APART_TRIES {
+                break;
+            }
+            let Some((a, b)) = split_between_area(ctx.graph, &faces, faces[x], faces[y], small)
+            else {
+                continue;
+            };
+            let mut key = a.clone();
+            key.sort_unstable();
+            if tried.contains(&key) {
+                continue;
+            }
+            tried.push(key);
+            laid += 1;
+            let halves = lay_halves(ctx, Some(&whole), &cuts, a, b, opts, eps)
+                .filter(|(ha, hb)| fits_room(opts.room, &ha.uv) && fits_room(opts.room, &hb.uv));
+            if halves.is_some() {
+                return halves;
+            }
+        }
+    }
+    None
 }
 
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).
@@ -349,4 +435,56 @@ fn merged_defect(ctx: &Charts, defect: &[f64], around: &[usize], a: &Laid, b: &L
     // Summed in one order, for the same figure on every run.
     common.sort_unstable();
     common.iter().map(|&v| defect[v]).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flatten::charts::{zigzag_cone, Fixture};
+
+    /// One sector of the zigzag cone beside the next four turns 400° round the apex: joined
+    /// as they lie, or laid out as one, it folds over the fourth. Shared out where they
+    /// overlap, the five sectors become two parts that each turn less than a full turn and
+    /// have the least area asked for; where the five have less than twice that, there is no
+    /// such split.
+    #[test]
+    fn a_small_piece_folding_over_its_neighbour_is_shared_out_where_they_overlap() {
+        let opts = FlattenOptions::default();
+        let fx = Fixture::new(zigzag_cone());
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        let piece = |faces: Vec<usize>| {
+            let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &[]) else {
+                panic!("laid");
+            };
+            Laid {
+                faces,
+                cuts: Vec::new(),
+                uv,
+                stretch,
+                gusset: false,
+            }
+        };
+        let done = vec![piece((3..15).collect()), piece((0..3).collect())];
+        assert!(done.iter().all(|l| keeps(&ctx, l, &opts, eps)));
+        let sector = ctx.area(&done[1].faces);
+        let j = moved_onto(&ctx, &done, 0, 1).expect("joined");
+        assert!(self_overlap(&j.uv, eps).is_some());
+        assert!(laid_as_one(&ctx, &done, 0, 1).is_none_or(|l| !keeps(&ctx, &l, &opts, eps)));
+        let small = 1.5 * sector;
+        let (ha, hb) = share_apart(&ctx, &done, 0, 1, small, &opts, eps).expect("shared out");
+        for h in [&ha, &hb] {
+            assert!(
+                ctx.area(&h.faces) >= small,
+                "{}",
+                ctx.area(&h.faces) / sector
+            );
+            assert!(keeps(&ctx, h, &opts, eps));
+            assert!((h.stretch.l2 - 1.0).abs() < 1e-6, "{}", h.stretch.l2);
+        }
+        let mut all = [ha.faces, hb.faces].concat();
+        all.sort_unstable();
+        assert_eq!(all, (0..15).collect::<Vec<_>>());
+        assert!(share_apart(&ctx, &done, 0, 1, 2.6 * sector, &opts, eps).is_none());
+    }
 }

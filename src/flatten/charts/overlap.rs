@@ -379,6 +379,16 @@ fn merged(
 /// Whether a layout made by merging pieces is kept: flip-free, within the tolerance, its seams
 /// matched and without overlap (deeper than `eps`).
 pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> bool {
+    if std::env::var_os("FC_K").is_some() {
+        eprintln!(
+            "  keeps {} f: flipped {} l2 {:.6} seam {:.6} overlap {}",
+            l.faces.len(),
+            l.stretch.flipped,
+            l.stretch.l2,
+            ctx.seam_error(l),
+            self_overlap(&l.uv, eps).is_some()
+        );
+    }
     l.stretch.flipped == 0
         && l.stretch.l2 <= opts.tolerance
         && ctx.seam_error(l) <= opts.seam_tolerance
@@ -417,6 +427,8 @@ pub(super) enum Trial {
     Hinge,
     /// Laid out as one with a slit ([`super::slit`]).
     Slit,
+    /// Shared out where the two overlap ([`super::merge::share_apart`]).
+    Apart,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A
@@ -605,6 +617,13 @@ impl Owners {
             self.owner[f] = k;
         }
         self.gone[part] = true;
+    }
+
+    /// `done[k]`'s faces are its own (its faces shared out anew).
+    pub(super) fn claim(&mut self, done: &[Laid], k: usize) {
+        for &f in &done[k].faces {
+            self.owner[f] = k;
+        }
     }
 
     /// Drop the charts merged into others.

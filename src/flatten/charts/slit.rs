@@ -202,40 +202,7 @@ impl<'a> Fans<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::Fixture;
-    use crate::geom::mesh::{Face, Mesh};
-    use glam::DVec3;
-
-    /// A cone over a zigzag: ten flat sectors round an apex (vertex 0), each of 80° there
-    /// (800° in all), each an inner triangle (apex, ring 1) and two outer ones (ring 1 to
-    /// ring 2, twice as far out); faces `3 i .. 3 i + 3` are sector `i`.
-    fn zigzag_cone() -> Mesh {
-        let step = std::f64::consts::TAU / 10.0;
-        // Unit spokes alternately h above and below, 80° apart.
-        let c = 80f64.to_radians().cos();
-        let h = ((step.cos() - c) / (1.0 + c)).sqrt();
-        let spoke = |i: usize| {
-            let a = step * i as f64;
-            DVec3::new(a.cos(), a.sin(), if i % 2 == 0 { h } else { -h })
-        };
-        let mut vertices = vec![DVec3::ZERO];
-        for i in 0..10 {
-            vertices.push(10.0 * spoke(i));
-            vertices.push(20.0 * spoke(i));
-        }
-        let (r1, r2) = (|i: usize| 1 + 2 * (i % 10), |i: usize| 2 + 2 * (i % 10));
-        let mut faces = Vec::new();
-        for i in 0..10 {
-            for verts in [
-                vec![0, r1(i), r1(i + 1)],
-                vec![r1(i), r2(i), r2(i + 1)],
-                vec![r1(i), r2(i + 1), r1(i + 1)],
-            ] {
-                faces.push(Face { verts, line: None });
-            }
-        }
-        Mesh { vertices, faces }
-    }
+    use crate::flatten::charts::{zigzag_cone, Fixture};
 
     /// Five sectors of the cone as one chart turn 400° round the apex on its border: one
     /// slit from the apex into the chart splits them into two wedges under a full turn, and
