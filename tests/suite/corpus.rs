@@ -297,7 +297,8 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
 /// L2 1.347) and 37 were under 1 % of the area; then none was over and 16 were small (42
 /// pieces); hinged whole, 11 were small (37 pieces); in halves and quarters too, 8 (34
 /// pieces); merged with a slit where no hinge fits (`flatten::charts::slit`), 7 (33
-/// pieces); shared out where a small piece and a neighbour overlap, 6 are (33 pieces).
+/// pieces); shared out where a small piece and a neighbour overlap, 6 (33 pieces); merged
+/// with darts where the two as one stretch past the tolerance, 5 are (32 pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     require_shared!();
@@ -305,8 +306,8 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 6, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 33, "{} pieces", r.pieces);
+    assert!(r.small <= 5, "{} pieces under 1 % of the area", r.small);
+    assert!(r.pieces <= 32, "{} pieces", r.pieces);
 }
 
 /// Issue 20: a piece split to fit the sheet keeps its layout, and a part of it can stretch

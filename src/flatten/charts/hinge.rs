@@ -21,8 +21,10 @@
 //!
 //! A small piece that hinges in no way is then laid out anew with a neighbour as one, with a
 //! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]);
-//! last, it is shared out with a neighbour where the two overlap ([`share_apart`]): the two
-//! as one split between faces that fold over each other into two parts, neither small.
+//! then it is shared out with a neighbour where the two overlap ([`share_apart`]): the two
+//! as one split between faces that fold over each other into two parts, neither small; last,
+//! it is laid out with a neighbour as one with darts where the two stretch past the tolerance
+//! ([`dart_merge`]).
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
@@ -48,7 +50,7 @@
 use super::join::{common, fits_room, Common};
 use super::merge::{share_apart, small_pieces};
 use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
-use super::slit::{slit_merge, SLIT_TRIES};
+use super::slit::{dart_merge, slit_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -125,6 +127,10 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 owners.claim(done, k);
                 owners.claim(done, si);
                 any = true;
+            } else if let Some((k, l)) = try_onto.dart(done, &owners, si) {
+                done[k] = l;
+                owners.absorb(done, k, si);
+                any = true;
             }
         }
         owners.drop_gone(done);
@@ -185,6 +191,24 @@ impl Onto<'_> {
                     })
                     .map(|h| (k, h))
             })
+    }
+
+    /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
+    /// boundary that it merges with by darts ([`dart_merge`]), and the union; two are tried
+    /// at a time where a spare thread is free.
+    fn dart(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
+        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
+        let near: Vec<usize> = owners
+            .neighbours(ctx, done, part)
+            .into_iter()
+            .take(SLIT_TRIES)
+            .collect();
+        crate::geom::par::first(&near, |&k| {
+            self.failed.attempt(Trial::Dart, &done[k], &done[part], || {
+                dart_merge(ctx, done, k, part, opts, eps)
+            })
+        })
+        .map(|(i, l)| (near[i], l))
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that

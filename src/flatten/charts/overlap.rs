@@ -429,6 +429,8 @@ pub(super) enum Trial {
     Slit,
     /// Shared out where the two overlap ([`super::merge::share_apart`]).
     Apart,
+    /// Laid out as one with darts ([`super::slit::dart_merge`]).
+    Dart,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A

@@ -1,4 +1,4 @@
-//! Small pieces merged with a slit (issue 20, item 3: no piece under 1 % of the area): a
+//! Small pieces merged with a slit or a dart (issue 20, item 3: no piece under 1 % of the area): a
 //! small piece that no neighbour takes in any other way ([`super::merge`], [`super::hinge`])
 //! often sits at a saddle vertex of the surface, where its faces and the neighbour's turn past
 //! a full turn round a vertex on the border of the two as one. Laid flat, such a vertex's
@@ -19,9 +19,14 @@
 //! - **Kept** as a merge is ([`keeps`]: flip-free, within the tolerance, seams matched, no
 //!   overlap) and when it fits the sheet.
 //! - Neighbours tried: those sharing the longest boundary first, at most [`SLIT_TRIES`].
+//!
+//! A small piece on a bump of the surface (positive curvature) stretches the two as one past
+//! the tolerance instead: they are laid out as one and relieved by darts as a chart over the
+//! tolerance is ([`dart_merge`]; [`super::darts`]).
 
+use super::darts::{darts, DART_MIN_FACES};
 use super::join::fits_room;
-use super::overlap::{as_one, keeps};
+use super::overlap::{as_one, keeps, laid_as_one};
 use super::{Charts, FlattenOptions, Laid, Layout};
 use crate::geom::cut::{open, Opened};
 use std::collections::HashMap;
@@ -55,6 +60,27 @@ pub(super) fn slit_merge(
         stretch,
         gusset: false,
     };
+    (keeps(ctx, &l, opts, eps) && fits_room(opts.room, &l.uv)).then_some(l)
+}
+
+/// `done[part]` and `done[k]` laid out as one ([`laid_as_one`]) and, where that is over the
+/// tolerance, relieved by darts as a chart over it is ([`darts`]): a small piece on a bump
+/// of the surface stretches the two as one past the tolerance, and a dart from their border
+/// toward the bump opens it. `None` unless the union is then kept as a merge is and fits the
+/// sheet.
+pub(super) fn dart_merge(
+    ctx: &Charts,
+    done: &[Laid],
+    k: usize,
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<Laid> {
+    let mut l = laid_as_one(ctx, done, k, part)?;
+    if l.stretch.l2 <= opts.tolerance || l.faces.len() < DART_MIN_FACES || opts.darts == 0 {
+        return None;
+    }
+    darts(ctx, &mut l, opts, eps).ok()?;
     (keeps(ctx, &l, opts, eps) && fits_room(opts.room, &l.uv)).then_some(l)
 }
 
@@ -202,7 +228,10 @@ impl<'a> Fans<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::{zigzag_cone, Fixture};
+    use crate::flatten::charts::{zigzag_cone, Fixture, Layout};
+    use crate::geom::mesh::{Face, Mesh};
+    use crate::surface::MaterialKind;
+    use glam::DVec3;
 
     /// Five sectors of the cone as one chart turn 400° round the apex on its border: one
     /// slit from the apex into the chart splits them into two wedges under a full turn, and
@@ -240,5 +269,81 @@ mod tests {
         assert!((0..after.turn.len()).all(|v| !after.border[v] || after.turn[v] <= TAU));
         let four: Vec<usize> = (0..12).collect();
         assert_eq!(slit_saddles(&ctx, &four, &[]), None);
+    }
+
+    /// A cone of 12 facets round an apex that lacks 60° of a full turn, in three rings of
+    /// slant 10 mm each: faces `0..12` round the apex, then 24 per ring.
+    fn bump() -> Mesh {
+        let half = (1.0 - 60.0 / 360.0f64).asin();
+        let mut vertices = vec![DVec3::ZERO];
+        for ring in 1..=3 {
+            let s = 10.0 * ring as f64;
+            for i in 0..12 {
+                let a = TAU * i as f64 / 12.0;
+                let r = s * half.sin();
+                vertices.push(DVec3::new(r * a.cos(), r * a.sin(), -s * half.cos()));
+            }
+        }
+        let at = |ring: usize, i: usize| 1 + 12 * (ring - 1) + i % 12;
+        let mut faces: Vec<Face> = (0..12)
+            .map(|i| Face {
+                verts: vec![0, at(1, i), at(1, i + 1)],
+                line: None,
+            })
+            .collect();
+        for ring in 1..3 {
+            for i in 0..12 {
+                let (a, b) = (at(ring, i), at(ring, i + 1));
+                let (c, d) = (at(ring + 1, i), at(ring + 1, i + 1));
+                for verts in [vec![a, c, d], vec![a, d, b]] {
+                    faces.push(Face { verts, line: None });
+                }
+            }
+        }
+        Mesh { vertices, faces }
+    }
+
+    /// A small piece from the bump's top to its border and the rest of it each lie flat, but
+    /// laid out as one they stretch past metal's tolerance (the cone lacks 60° round its
+    /// apex, now inside); with a dart from the border to the apex they lie flat within it, one
+    /// piece.
+    #[test]
+    fn a_small_piece_on_a_bump_merges_with_its_neighbour_by_a_dart() {
+        let opts = FlattenOptions::for_material(MaterialKind::Metal);
+        let fx = Fixture::new(bump());
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        let piece = |faces: Vec<usize>| {
+            let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &[]) else {
+                panic!("laid");
+            };
+            Laid {
+                faces,
+                cuts: Vec::new(),
+                uv,
+                stretch,
+                gusset: false,
+            }
+        };
+        // The small piece: a strip of one facet from the apex to the border.
+        let strip = vec![0, 12, 13, 36, 37];
+        let rest: Vec<usize> = (0..60).filter(|f| !strip.contains(f)).collect();
+        let done = vec![piece(rest), piece(strip)];
+        assert!(done.iter().all(|l| l.stretch.l2 <= opts.tolerance));
+        let one = laid_as_one(&ctx, &done, 0, 1).expect("laid as one");
+        assert!(one.stretch.l2 > opts.tolerance, "{}", one.stretch.l2);
+        let l = dart_merge(&ctx, &done, 0, 1, &opts, eps).expect("merged by a dart");
+        assert!(l.stretch.l2 <= opts.tolerance, "{}", l.stretch.l2);
+        assert!(keeps(&ctx, &l, &opts, eps));
+        assert!(!l.cuts.is_empty());
+        let mut faces = l.faces.clone();
+        faces.sort_unstable();
+        assert_eq!(faces, (0..60).collect::<Vec<_>>());
+        // Within the tolerance as one already: nothing to relieve.
+        let paper = FlattenOptions {
+            tolerance: 1.5,
+            ..opts
+        };
+        assert!(dart_merge(&ctx, &done, 0, 1, &paper, eps).is_none());
     }
 }
