@@ -74,6 +74,10 @@ const HINGE_REACH: f64 = 0.5;
 /// A rigid motion of the plane: a unit complex number (the turn) and a shift.
 type Motion = (DVec2, DVec2);
 
+/// A merge of `done[part]` into `done[k]` that lays the two out anew as one: (ctx, done, k,
+/// part, opts, eps) to the union when it is kept.
+type Merge = fn(&Charts, &[Laid], usize, usize, &FlattenOptions, f64) -> Option<Laid>;
+
 /// Which common edges a motion joins.
 type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
 
@@ -117,7 +121,9 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 any = true;
             } else if hinge_halves(&try_onto, done, &mut owners, si) {
                 any = true;
-            } else if let Some((k, l)) = try_onto.slit(done, &owners, si) {
+            } else if let Some((k, l)) =
+                try_onto.merge(done, &owners, si, (Trial::Slit, slit_merge))
+            {
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
@@ -127,7 +133,9 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 owners.claim(done, k);
                 owners.claim(done, si);
                 any = true;
-            } else if let Some((k, l)) = try_onto.dart(done, &owners, si) {
+            } else if let Some((k, l)) =
+                try_onto.merge(done, &owners, si, (Trial::Dart, dart_merge))
+            {
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
@@ -152,9 +160,16 @@ struct Onto<'a> {
 
 impl Onto<'_> {
     /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
-    /// boundary that it merges with by a slit ([`slit_merge`]), and the union; two are tried
-    /// at a time where a spare thread is free ([`crate::geom::par::first`]).
-    fn slit(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
+    /// boundary that it merges with by `merge` ([`slit_merge`], [`dart_merge`]), and the
+    /// union; two are tried at a time where a spare thread is free
+    /// ([`crate::geom::par::first`]).
+    fn merge(
+        &self,
+        done: &[Laid],
+        owners: &Owners,
+        part: usize,
+        (trial, merge): (Trial, Merge),
+    ) -> Option<(usize, Laid)> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
         let near: Vec<usize> = owners
             .neighbours(ctx, done, part)
@@ -162,8 +177,8 @@ impl Onto<'_> {
             .take(SLIT_TRIES)
             .collect();
         crate::geom::par::first(&near, |&k| {
-            self.failed.attempt(Trial::Slit, &done[k], &done[part], || {
-                slit_merge(ctx, done, k, part, opts, eps)
+            self.failed.attempt(trial, &done[k], &done[part], || {
+                merge(ctx, done, k, part, opts, eps)
             })
         })
         .map(|(i, l)| (near[i], l))
@@ -191,24 +206,6 @@ impl Onto<'_> {
                     })
                     .map(|h| (k, h))
             })
-    }
-
-    /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
-    /// boundary that it merges with by darts ([`dart_merge`]), and the union; two are tried
-    /// at a time where a spare thread is free.
-    fn dart(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
-        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
-        let near: Vec<usize> = owners
-            .neighbours(ctx, done, part)
-            .into_iter()
-            .take(SLIT_TRIES)
-            .collect();
-        crate::geom::par::first(&near, |&k| {
-            self.failed.attempt(Trial::Dart, &done[k], &done[part], || {
-                dart_merge(ctx, done, k, part, opts, eps)
-            })
-        })
-        .map(|(i, l)| (near[i], l))
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that

@@ -453,19 +453,7 @@ mod tests {
         let fx = Fixture::new(zigzag_cone());
         let ctx = fx.charts(&opts);
         let eps = 1e-6;
-        let piece = |faces: Vec<usize>| {
-            let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &[]) else {
-                panic!("laid");
-            };
-            Laid {
-                faces,
-                cuts: Vec::new(),
-                uv,
-                stretch,
-                gusset: false,
-            }
-        };
-        let done = vec![piece((3..15).collect()), piece((0..3).collect())];
+        let done = vec![ctx.piece((3..15).collect()), ctx.piece((0..3).collect())];
         assert!(done.iter().all(|l| keeps(&ctx, l, &opts, eps)));
         let sector = ctx.area(&done[1].faces);
         let j = moved_onto(&ctx, &done, 0, 1).expect("joined");

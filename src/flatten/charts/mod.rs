@@ -374,6 +374,23 @@ impl Fixture {
     }
 }
 
+#[cfg(test)]
+impl Charts<'_> {
+    /// `faces` laid out as one piece without cuts, for tests (panics where it cannot be).
+    pub(super) fn piece(&self, faces: Vec<usize>) -> Laid {
+        let Ok(Layout::Laid(uv, stretch)) = self.lay(&faces, &[]) else {
+            panic!("faces {faces:?} not laid out");
+        };
+        Laid {
+            faces,
+            cuts: Vec::new(),
+            uv,
+            stretch,
+            gusset: false,
+        }
+    }
+}
+
 /// A cone over a zigzag, for tests: ten flat sectors round an apex (vertex 0), each of 80°
 /// there (800° in all), each an inner triangle (apex, ring 1) and two outer ones (ring 1 to
 /// ring 2, twice as far out); faces `3 i .. 3 i + 3` are sector `i`.

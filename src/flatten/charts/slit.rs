@@ -228,7 +228,7 @@ impl<'a> Fans<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::{zigzag_cone, Fixture, Layout};
+    use crate::flatten::charts::{zigzag_cone, Fixture};
     use crate::geom::mesh::{Face, Mesh};
     use crate::surface::MaterialKind;
     use glam::DVec3;
@@ -313,22 +313,10 @@ mod tests {
         let fx = Fixture::new(bump());
         let ctx = fx.charts(&opts);
         let eps = 1e-6;
-        let piece = |faces: Vec<usize>| {
-            let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &[]) else {
-                panic!("laid");
-            };
-            Laid {
-                faces,
-                cuts: Vec::new(),
-                uv,
-                stretch,
-                gusset: false,
-            }
-        };
         // The small piece: a strip of one facet from the apex to the border.
         let strip = vec![0, 12, 13, 36, 37];
         let rest: Vec<usize> = (0..60).filter(|f| !strip.contains(f)).collect();
-        let done = vec![piece(rest), piece(strip)];
+        let done = vec![ctx.piece(rest), ctx.piece(strip)];
         assert!(done.iter().all(|l| l.stretch.l2 <= opts.tolerance));
         let one = laid_as_one(&ctx, &done, 0, 1).expect("laid as one");
         assert!(one.stretch.l2 > opts.tolerance, "{}", one.stretch.l2);
