@@ -142,16 +142,43 @@ fn far_pair(
     within: &dyn Fn(usize) -> bool,
     d0: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    let far = |d: &[f64]| -> usize {
-        faces
-            .iter()
-            .copied()
-            .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
-            .unwrap_or(0)
-    };
-    let da = g.distances(&[far(d0)], within);
-    let db = g.distances(&[far(&da)], within);
+    let da = g.distances(&[farthest(faces, d0)], within);
+    let db = g.distances(&[farthest(faces, &da)], within);
     (da, db)
+}
+
+/// The face of `faces` farthest by `d` (ties: lower face).
+fn farthest(faces: &[usize], d: &[f64]) -> usize {
+    faces
+        .iter()
+        .copied()
+        .max_by(|&a, &b| d[a].total_cmp(&d[b]).then(b.cmp(&a)))
+        .unwrap_or(0)
+}
+
+/// The two faces farthest apart through the face graph restricted to `faces`, as [`bisect`]
+/// finds them (the face farthest from the first face, then the face farthest from that);
+/// `None` when `faces` is empty or not connected.
+pub fn farthest_apart(g: &Graph, faces: &[usize]) -> Option<(usize, usize)> {
+    let (inside, d0) = from_first(g, faces)?;
+    let a = farthest(faces, &d0);
+    let da = g.distances(&[a], &|f| inside[f]);
+    Some((a, farthest(faces, &da)))
+}
+
+/// Which faces are among `faces`, and the distances from the first of them; `None` when
+/// `faces` is empty or not connected.
+fn from_first(g: &Graph, faces: &[usize]) -> Option<(Vec<bool>, Vec<f64>)> {
+    let mut inside = vec![false; g.area.len()];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let &start = faces.first()?;
+    let d0 = g.distances(&[start], &|f| inside[f]);
+    faces
+        .iter()
+        .all(|&f| d0[f].is_finite())
+        .then_some((inside, d0))
 }
 
 /// Split faces in two of about equal area across the two faces farthest apart (as
@@ -160,16 +187,7 @@ fn far_pair(
 /// them until it has half the area. `None` when `faces` is not connected or a part would be
 /// empty or not connected.
 pub fn bisect_area(g: &Graph, faces: &[usize]) -> Option<(Vec<usize>, Vec<usize>)> {
-    let nf = g.area.len();
-    let mut inside = vec![false; nf];
-    for &f in faces {
-        inside[f] = true;
-    }
-    let &start = faces.first()?;
-    let d0 = g.distances(&[start], &|f| inside[f]);
-    if faces.iter().any(|&f| !d0[f].is_finite()) {
-        return None;
-    }
+    let (inside, d0) = from_first(g, faces)?;
     let (da, db) = far_pair(g, faces, &|f| inside[f], &d0);
     let half = 0.5 * faces.iter().map(|&f| g.area[f]).sum::<f64>();
     split_ordered(g, faces, &da, &db, &|order| {

@@ -28,7 +28,9 @@
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
-//! to fit the sheet, and one of its parts would be small.
+//! to fit the sheet, and one of its parts would be small. Where its parts hinge onto no
+//! neighbour, it is shared out with one across its length ([`share_across`]): two pieces,
+//! each with one end of it and some of the neighbour, neither small, both fitting the sheet.
 //!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
@@ -48,7 +50,7 @@
 //!   tolerance, so the hinge edge itself always is.
 
 use super::join::{common, fits_room, Common};
-use super::merge::{share_apart, small_pieces};
+use super::merge::{share_across, share_apart, small_pieces};
 use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
 use super::slit::{dart_merge, slit_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
@@ -77,6 +79,10 @@ type Motion = (DVec2, DVec2);
 /// A merge of `done[part]` into `done[k]` that lays the two out anew as one: (ctx, done, k,
 /// part, opts, eps) to the union when it is kept.
 type Merge = fn(&Charts, &[Laid], usize, usize, &FlattenOptions, f64) -> Option<Laid>;
+
+/// A share-out of `done[part]` with `done[k]`: (ctx, done, k, part, small, opts, eps) to
+/// the two parts when they are kept.
+type Share = fn(&Charts, &[Laid], usize, usize, f64, &FlattenOptions, f64) -> Option<(Laid, Laid)>;
 
 /// Which common edges a motion joins.
 type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
@@ -109,8 +115,16 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 continue;
             }
             if ctx.area(&done[si].faces) >= small {
-                // Too large for the sheet: in parts only.
-                if !fits(&done[si]) && hinge_halves(&try_onto, done, &mut owners, si) {
+                // Too large for the sheet: in parts, else shared out across it.
+                if fits(&done[si]) {
+                    continue;
+                }
+                if hinge_halves(&try_onto, done, &mut owners, si) {
+                    any = true;
+                } else if let Some((k, (ha, hb))) =
+                    try_onto.share(done, &owners, si, (Trial::Across, share_across), small)
+                {
+                    owners.shared(done, (k, si), (ha, hb));
                     any = true;
                 }
                 continue;
@@ -127,11 +141,10 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
-            } else if let Some((k, (ha, hb))) = try_onto.apart(done, &owners, si, small) {
-                done[k] = ha;
-                done[si] = hb;
-                owners.claim(done, k);
-                owners.claim(done, si);
+            } else if let Some((k, (ha, hb))) =
+                try_onto.share(done, &owners, si, (Trial::Apart, share_apart), small)
+            {
+                owners.shared(done, (k, si), (ha, hb));
                 any = true;
             } else if let Some((k, l)) =
                 try_onto.merge(done, &owners, si, (Trial::Dart, dart_merge))
@@ -185,13 +198,14 @@ impl Onto<'_> {
     }
 
     /// The first of the [`APART_NEIGHBOURS`] neighbours of `done[part]` sharing the longest
-    /// boundary that it is shared out with where the two overlap ([`share_apart`]), and the
-    /// halves (to become the neighbour and `done[part]`).
-    fn apart(
+    /// boundary that it is shared out with by `share` ([`share_apart`], [`share_across`]), and
+    /// the two parts (to become the neighbour and `done[part]`).
+    fn share(
         &self,
         done: &[Laid],
         owners: &Owners,
         part: usize,
+        (trial, share): (Trial, Share),
         small: f64,
     ) -> Option<(usize, (Laid, Laid))> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
@@ -201,8 +215,8 @@ impl Onto<'_> {
             .take(APART_NEIGHBOURS)
             .find_map(|k| {
                 self.failed
-                    .attempt(Trial::Apart, &done[k], &done[part], || {
-                        share_apart(ctx, done, k, part, small, opts, eps)
+                    .attempt(trial, &done[k], &done[part], || {
+                        share(ctx, done, k, part, small, opts, eps)
                     })
                     .map(|h| (k, h))
             })
@@ -510,7 +524,7 @@ fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::Fixture;
+    use crate::flatten::charts::{strip_and_squares, Fixture};
     use crate::geom::mesh::{Face, Mesh};
     use glam::DVec3;
 
@@ -789,43 +803,7 @@ mod tests {
     /// halves instead, each half goes onto the square above it, both fitting the room.
     #[test]
     fn a_strip_too_long_for_the_sheet_is_hinged_in_halves_onto_its_neighbours() {
-        let xs: Vec<f64> = (0..=20).map(|i| 10.0 * i as f64).collect();
-        let ys: Vec<f64> = [-1.5]
-            .into_iter()
-            .chain((0..=10).map(|j| 10.0 * j as f64))
-            .collect();
-        let vertices: Vec<DVec3> = ys
-            .iter()
-            .flat_map(|&y| xs.iter().map(move |&x| DVec3::new(x, y, 0.0)))
-            .collect();
-        let v = |i: usize, j: usize| j * xs.len() + i;
-        // Faces of the cells in columns `cols` and rows `rows` (row 0: the strip).
-        let cells = |cols: std::ops::Range<usize>, rows: std::ops::Range<usize>| {
-            let mut faces = Vec::new();
-            for j in rows {
-                for i in cols.clone() {
-                    let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
-                    faces.push(vec![a, b, c]);
-                    faces.push(vec![a, c, d]);
-                }
-            }
-            faces
-        };
-        let pieces = [
-            cells(0..10, 1..11),
-            cells(10..20, 1..11),
-            cells(0..20, 0..1),
-        ];
-        let mut faces = Vec::new();
-        let mut ranges = Vec::new();
-        for p in &pieces {
-            ranges.push(faces.len()..faces.len() + p.len());
-            faces.extend(p.iter().map(|verts| Face {
-                verts: verts.clone(),
-                line: None,
-            }));
-        }
-        let mesh = Mesh { vertices, faces };
+        let (mesh, ranges) = strip_and_squares(&[(0..10, 1..11), (10..20, 1..11), (0..20, 0..1)]);
         let opts = FlattenOptions {
             room: Some([150.0, 150.0]),
             ..FlattenOptions::default()

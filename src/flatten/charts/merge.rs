@@ -18,7 +18,8 @@
 //! (`first_merge`). What is still small once every merge below is done is hinged onto a
 //! neighbour by one edge ([`super::hinge`]), and what hinges in no way is last shared out with
 //! a neighbour where the two overlap (`share_apart`): split between two faces that fold over
-//! each other, moved across where a part would be small.
+//! each other, moved across where a part would be small. A piece too long for the sheet that
+//! hinges in no parts is shared out with a neighbour across its length (`share_across`).
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
@@ -54,7 +55,8 @@ use super::overlap::{
 };
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
-use crate::geom::cut::{bisect, bisect_area, split_between_area};
+use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between_area};
+use glam::DVec2;
 
 /// Pieces under this share of the surface's area are merged where they can be.
 pub(crate) const SMALL_SHARE: f64 = 0.01;
@@ -110,10 +112,7 @@ fn merge_small_once(
                 })
                 .map(|halves| (k, halves))
         }) {
-            done[k] = ha;
-            done[si] = hb;
-            owners.claim(done, k);
-            owners.claim(done, si);
+            owners.shared(done, (k, si), (ha, hb));
         } else if let Some(took) = graft(ctx, done, &near, si, opts.tolerance, eps) {
             for (k, faces) in took {
                 for f in faces {
@@ -233,10 +232,7 @@ pub(super) fn share_apart(
     opts: &FlattenOptions,
     eps: f64,
 ) -> Option<(Laid, Laid)> {
-    if ctx.area(&done[k].faces) + ctx.area(&done[part].faces) < 2.0 * small {
-        return None;
-    }
-    let cuts = both_cuts(&done[k], &done[part]);
+    let shares = Shares::new(ctx, done, k, part, small, opts, eps)?;
     let mut tried: Vec<Vec<usize>> = Vec::new();
     // As they lie; where no split of that is kept, laid out as one.
     let layouts = [false, true].into_iter().filter_map(|relaxed| {
@@ -247,14 +243,89 @@ pub(super) fn share_apart(
         }
     });
     for (faces, uv) in layouts {
-        let whole = Whole::new(&faces, &uv);
+        let pairs: Vec<(usize, usize)> = overlaps(&uv, eps, APART_PAIRS)
+            .into_iter()
+            .map(|(x, y)| (faces[x], faces[y]))
+            .collect();
+        let shared = shares.between(&faces, &uv, &pairs, &mut tried);
+        if shared.is_some() {
+            return shared;
+        }
+    }
+    None
+}
+
+/// Share a piece `done[part]` too long for the sheet (and under twice `small` in area) and
+/// its neighbour `done[k]` out anew across the piece: the two, joined as they lie
+/// ([`moved_onto`]), are split between the piece's two faces farthest apart (moved across
+/// where a part would be under `small`: [`split_between_area`]), so that each part takes
+/// one end of the piece and some of the neighbour. Kept as [`share_apart`] keeps its parts
+/// (each fitting the sheet): where the pattern stage would split the piece into two small
+/// parts, there are two pieces of at least `small`.
+pub(super) fn share_across(
+    ctx: &Charts,
+    done: &[Laid],
+    k: usize,
+    part: usize,
+    small: f64,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<(Laid, Laid)> {
+    let shares = Shares::new(ctx, done, k, part, small, opts, eps)?;
+    let ends = farthest_apart(ctx.graph, &done[part].faces)?;
+    let j = moved_onto(ctx, done, k, part)?;
+    shares.between(&j.faces, &j.uv, &[ends], &mut Vec::new())
+}
+
+/// What a share-out of two pieces laid as one needs besides the layout: the two pieces'
+/// cuts, the small area, the options.
+struct Shares<'a> {
+    ctx: &'a Charts<'a>,
+    cuts: Vec<usize>,
+    small: f64,
+    opts: &'a FlattenOptions,
+    eps: f64,
+}
+
+impl<'a> Shares<'a> {
+    /// The share-out of `done[part]` and `done[k]`; `None` when the two have less than twice
+    /// `small` in area (no split leaves both parts that).
+    fn new(
+        ctx: &'a Charts<'a>,
+        done: &[Laid],
+        k: usize,
+        part: usize,
+        small: f64,
+        opts: &'a FlattenOptions,
+        eps: f64,
+    ) -> Option<Self> {
+        (ctx.area(&done[k].faces) + ctx.area(&done[part].faces) >= 2.0 * small).then(|| Shares {
+            ctx,
+            cuts: both_cuts(&done[k], &done[part]),
+            small,
+            opts,
+            eps,
+        })
+    }
+
+    /// The first partition of `faces` (laid out as `uv`) between a pair of faces of `pairs`
+    /// ([`split_between_area`]) not in `tried` whose parts are laid out from `uv` and kept
+    /// (see [`share_apart`]); at most [`APART_TRIES`] are laid out, each noted in `tried`.
+    fn between(
+        &self,
+        faces: &[usize],
+        uv: &[Vec<DVec2>],
+        pairs: &[(usize, usize)],
+        tried: &mut Vec<Vec<usize>>,
+    ) -> Option<(Laid, Laid)> {
+        let (ctx, opts) = (self.ctx, self.opts);
+        let whole = Whole::new(faces, uv);
         let mut laid = 0;
-        for (x, y) in overlaps(&uv, eps, APART_PAIRS) {
+        for &(x, y) in pairs {
             if laid == APART_TRIES {
                 break;
             }
-            let Some((a, b)) = split_between_area(ctx.graph, &faces, faces[x], faces[y], small)
-            else {
+            let Some((a, b)) = split_between_area(ctx.graph, faces, x, y, self.small) else {
                 continue;
             };
             let mut key = a.clone();
@@ -264,14 +335,14 @@ pub(super) fn share_apart(
             }
             tried.push(key);
             laid += 1;
-            let halves = lay_halves(ctx, Some(&whole), &cuts, a, b, opts, eps)
+            let halves = lay_halves(ctx, Some(&whole), &self.cuts, a, b, opts, self.eps)
                 .filter(|(ha, hb)| fits_room(opts.room, &ha.uv) && fits_room(opts.room, &hb.uv));
             if halves.is_some() {
                 return halves;
             }
         }
+        None
     }
-    None
 }
 
 /// Join neighbouring pieces of any size whose layouts fit together (see the module doc).
@@ -440,7 +511,7 @@ fn merged_defect(ctx: &Charts, defect: &[f64], around: &[usize], a: &Laid, b: &L
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::{zigzag_cone, Fixture};
+    use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
 
     /// One sector of the zigzag cone beside the next four turns 400° round the apex: joined
     /// as they lie, or laid out as one, it folds over the fourth. Shared out where they
@@ -474,5 +545,45 @@ mod tests {
         all.sort_unstable();
         assert_eq!(all, (0..15).collect::<Vec<_>>());
         assert!(share_apart(&ctx, &done, 0, 1, 2.6 * sector, &opts, eps).is_none());
+    }
+
+    /// A square of 100 mm and a strip 200 mm long and 1.5 mm wide along its bottom, from its
+    /// left side on past its right (so the strip is too long for a room of 150 mm, and only
+    /// its left half touches the square): shared out across the strip, each part has one end
+    /// of the strip, the right one with a corner of the square, both at least the least area
+    /// asked for and fitting the room. Where the two have less than twice that, there is no
+    /// such split.
+    #[test]
+    fn a_strip_too_long_for_the_sheet_is_shared_out_across_with_its_neighbour() {
+        // The square's cells, then the strip's.
+        let (mesh, _) = strip_and_squares(&[(0..10, 1..11), (0..20, 0..1)]);
+        let opts = FlattenOptions {
+            room: Some([150.0, 150.0]),
+            ..FlattenOptions::default()
+        };
+        let fx = Fixture::new(mesh);
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        let done = vec![
+            ctx.piece((0..200).collect()),
+            ctx.piece((200..240).collect()),
+        ];
+        assert!(!fits_room(opts.room, &done[1].uv) && fits_room(opts.room, &done[0].uv));
+        let least = 2000.0;
+        let (ha, hb) = share_across(&ctx, &done, 0, 1, least, &opts, eps).expect("shared");
+        for h in [&ha, &hb] {
+            assert!(ctx.area(&h.faces) >= least, "{}", ctx.area(&h.faces));
+            assert!(fits_room(opts.room, &h.uv));
+            assert!(keeps(&ctx, h, &opts, eps));
+            assert!((h.stretch.l2 - 1.0).abs() < 1e-9, "{}", h.stretch.l2);
+        }
+        // The strip's end cells: one in each part.
+        let (left, right) = (200, 238);
+        assert!(ha.faces.contains(&left) != hb.faces.contains(&left));
+        assert!(ha.faces.contains(&left) != ha.faces.contains(&right));
+        let mut all = [ha.faces, hb.faces].concat();
+        all.sort_unstable();
+        assert_eq!(all, (0..240).collect::<Vec<_>>());
+        assert!(share_across(&ctx, &done, 0, 1, 5500.0, &opts, eps).is_none());
     }
 }

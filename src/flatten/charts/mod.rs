@@ -391,6 +391,41 @@ impl Charts<'_> {
     }
 }
 
+/// A grid of cells on the plane in pieces, for tests: columns `0..20` of 10 mm (x from 0 to
+/// 200 mm), row 0 a strip 1.5 mm high under the x axis, rows `1..11` of 10 mm above it; each
+/// block (columns, rows) is a piece of two faces per cell, the pieces' faces numbered in turn
+/// (their ranges returned).
+#[cfg(test)]
+pub(super) fn strip_and_squares(
+    blocks: &[(std::ops::Range<usize>, std::ops::Range<usize>)],
+) -> (Mesh, Vec<std::ops::Range<usize>>) {
+    use glam::DVec3;
+    let xs: Vec<f64> = (0..=20).map(|i| 10.0 * i as f64).collect();
+    let ys: Vec<f64> = [-1.5]
+        .into_iter()
+        .chain((0..=10).map(|j| 10.0 * j as f64))
+        .collect();
+    let vertices: Vec<DVec3> = ys
+        .iter()
+        .flat_map(|&y| xs.iter().map(move |&x| DVec3::new(x, y, 0.0)))
+        .collect();
+    let v = |i: usize, j: usize| j * xs.len() + i;
+    let (mut faces, mut ranges) = (Vec::new(), Vec::new());
+    for (cols, rows) in blocks {
+        let first = faces.len();
+        for j in rows.clone() {
+            for i in cols.clone() {
+                let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+                for verts in [vec![a, b, c], vec![a, c, d]] {
+                    faces.push(Face { verts, line: None });
+                }
+            }
+        }
+        ranges.push(first..faces.len());
+    }
+    (Mesh { vertices, faces }, ranges)
+}
+
 /// A cone over a zigzag, for tests: ten flat sectors round an apex (vertex 0), each of 80°
 /// there (800° in all), each an inner triangle (apex, ring 1) and two outer ones (ring 1 to
 /// ring 2, twice as far out); faces `3 i .. 3 i + 3` are sector `i`.

@@ -429,6 +429,8 @@ pub(super) enum Trial {
     Slit,
     /// Shared out where the two overlap ([`super::merge::share_apart`]).
     Apart,
+    /// Shared out across a piece too long for the sheet ([`super::merge::share_across`]).
+    Across,
     /// Laid out as one with darts ([`super::slit::dart_merge`]).
     Dart,
 }
@@ -621,10 +623,20 @@ impl Owners {
         self.gone[part] = true;
     }
 
-    /// `done[k]`'s faces are its own (its faces shared out anew).
-    pub(super) fn claim(&mut self, done: &[Laid], k: usize) {
-        for &f in &done[k].faces {
-            self.owner[f] = k;
+    /// The two parts of a share-out in place of the two pieces: `done[k]` becomes `ha`,
+    /// `done[si]` becomes `hb`, each owning its faces.
+    pub(super) fn shared(
+        &mut self,
+        done: &mut [Laid],
+        (k, si): (usize, usize),
+        (ha, hb): (Laid, Laid),
+    ) {
+        done[k] = ha;
+        done[si] = hb;
+        for p in [k, si] {
+            for &f in &done[p].faces {
+                self.owner[f] = p;
+            }
         }
     }
 
