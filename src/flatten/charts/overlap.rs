@@ -379,16 +379,6 @@ fn merged(
 /// Whether a layout made by merging pieces is kept: flip-free, within the tolerance, its seams
 /// matched and without overlap (deeper than `eps`).
 pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> bool {
-    if std::env::var_os("FC_K").is_some() {
-        eprintln!(
-            "  keeps {} f: flipped {} l2 {:.6} seam {:.6} overlap {}",
-            l.faces.len(),
-            l.stretch.flipped,
-            l.stretch.l2,
-            ctx.seam_error(l),
-            self_overlap(&l.uv, eps).is_some()
-        );
-    }
     l.stretch.flipped == 0
         && l.stretch.l2 <= opts.tolerance
         && ctx.seam_error(l) <= opts.seam_tolerance
