@@ -680,14 +680,29 @@ fn compare_with_the_simulator(mut fw: Firmware) {
     fw.slave.write_all(b"M0\n").unwrap();
     sim.write_all(b"M0\n").unwrap();
     std::thread::sleep(Duration::from_millis(500));
-    fw.slave.write_all(b"?").unwrap();
-    let want = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
-    sim.write_all(b"?").unwrap();
-    let got = read_answer(&mut sim, &mut partial, |l| l.starts_with('<'));
     let state = |a: &[String]| {
         a.last()
             .map(|l| l[1..].split('|').next().unwrap_or("").to_string())
     };
+    // The firmware's simulator now and then garbles a byte of a report (CI once read
+    // `<Ho9d:0|…>`): a report whose state is none GRBL has is asked for again.
+    let known = |s: &str| {
+        let name = s.split(':').next().unwrap_or("");
+        [
+            "Idle", "Run", "Hold", "Jog", "Alarm", "Door", "Check", "Home", "Sleep",
+        ]
+        .contains(&name)
+    };
+    let mut want = Vec::new();
+    for _ in 0..3 {
+        fw.slave.write_all(b"?").unwrap();
+        want = fw.read_until(|l| l.starts_with('<'), Duration::from_secs(5));
+        if state(&want).is_some_and(|s| known(&s)) {
+            break;
+        }
+    }
+    sim.write_all(b"?").unwrap();
+    let got = read_answer(&mut sim, &mut partial, |l| l.starts_with('<'));
     assert_eq!(want.len(), 1, "no ok before cycle start: {want:?}");
     assert_eq!(state(&want), Some("Hold:0".into()), "{want:?}");
     assert_eq!(got.len(), 1, "{got:?}");
