@@ -24,7 +24,11 @@
 //! then it is shared out with a neighbour where the two overlap ([`share_apart`]): the two
 //! as one split between faces that fold over each other into two parts, neither small; last,
 //! it is laid out with a neighbour as one with darts where the two stretch past the tolerance
-//! ([`dart_merge`]).
+//! ([`dart_merge`]). Last, it is passed on through a neighbour ([`pass_on`]): where the two
+//! overlap, they are split between the overlapping faces into one part of at least the small
+//! share and one under it (a narrow arm of the neighbour that the piece folds over, say),
+//! and that one joined to a piece next to it in any of the ways above; the three pieces
+//! become two.
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
@@ -50,8 +54,8 @@
 //!   tolerance, so the hinge edge itself always is.
 
 use super::join::{common, fits_room, Common};
-use super::merge::{share_across, share_apart, small_pieces};
-use super::overlap::{keeps, self_overlap, Failed, Owners, Trial};
+use super::merge::{pass_apart, share_across, share_apart, small_pieces, MERGE_TRIES};
+use super::overlap::{first_merge, keeps, self_overlap, Failed, Owners, Trial};
 use super::slit::{dart_merge, slit_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
@@ -152,6 +156,8 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 done[k] = l;
                 owners.absorb(done, k, si);
                 any = true;
+            } else if pass_on(&try_onto, done, &mut owners, si, small) {
+                any = true;
             }
         }
         owners.drop_gone(done);
@@ -220,6 +226,25 @@ impl Onto<'_> {
                     })
                     .map(|h| (k, h))
             })
+    }
+
+    /// The first neighbour of `done[part]` that it joins and the union: hinged onto one
+    /// ([`Onto::hinge`]), else laid out as one with one ([`first_merge`] of the
+    /// [`MERGE_TRIES`] sharing the longest boundary), with a slit ([`slit_merge`]), with
+    /// darts ([`dart_merge`]).
+    fn join(&self, done: &[Laid], owners: &Owners, part: usize) -> Option<(usize, Laid)> {
+        let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
+        self.hinge(done, owners, part, &|_| true)
+            .or_else(|| {
+                let near: Vec<usize> = owners
+                    .neighbours(ctx, done, part)
+                    .into_iter()
+                    .take(MERGE_TRIES)
+                    .collect();
+                first_merge(ctx, done, &near, part, opts, eps, self.failed)
+            })
+            .or_else(|| self.merge(done, owners, part, (Trial::Slit, slit_merge)))
+            .or_else(|| self.merge(done, owners, part, (Trial::Dart, dart_merge)))
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
@@ -409,6 +434,44 @@ fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usiz
     quarters.len() > 2 && hinge_parts(onto, done, owners, si, quarters)
 }
 
+/// Pass a small piece `done[si]` on through a neighbour: shared out with it where the two
+/// overlap into a part of at least `small` and one under it ([`pass_apart`]), and that one
+/// joined to a piece next to it then ([`Onto::join`]: a third piece, or the other part).
+/// Of the [`APART_NEIGHBOURS`] neighbours sharing the longest boundary, the first through
+/// which it passes. All or none: true when it passed, the neighbour then its larger part in
+/// `done`, the piece that took the smaller one their union, and `done[si]` marked gone in
+/// `owners`; else `done` and `owners` are as they were.
+fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small: f64) -> bool {
+    let (ctx, opts, eps) = (onto.ctx, onto.opts, onto.eps);
+    let near: Vec<usize> = owners
+        .neighbours(ctx, done, si)
+        .into_iter()
+        .take(APART_NEIGHBOURS)
+        .collect();
+    near.into_iter().any(|k| {
+        // Not again while neither of the two has changed, though a third piece may have.
+        if onto.failed.known(Trial::Pass, &done[k], &done[si]) {
+            return false;
+        }
+        let pair = [done[k].clone(), done[si].clone()];
+        let mut take = |parts: (Laid, Laid)| -> Option<()> {
+            owners.shared(done, (k, si), parts);
+            if let Some((m, union)) = onto.join(done, owners, si) {
+                done[m] = union;
+                owners.absorb(done, m, si);
+                return Some(());
+            }
+            owners.shared(done, (k, si), (pair[0].clone(), pair[1].clone()));
+            None
+        };
+        let passed = pass_apart(ctx, &pair, small, opts, eps, &mut take).is_some();
+        if !passed {
+            onto.failed.note(Trial::Pass, &pair[0], &pair[1]);
+        }
+        passed
+    })
+}
+
 /// `done[part]` moved by `m` beside `done[k]`, the common edges it `joins` joined (their ends
 /// put where `done[k]` has them) and the others cut, the union `relax`ed or not; `None`
 /// unless it is kept (see the module doc).
@@ -524,7 +587,7 @@ fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::{strip_and_squares, Fixture};
+    use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
     use crate::geom::mesh::{Face, Mesh};
     use glam::DVec3;
 
@@ -839,5 +902,68 @@ mod tests {
             }
         }
         assert!(owned.iter().all(|&n| n == 1));
+    }
+
+    /// The zigzag cone's sector 0 (the small piece) beside sectors 1–4 (its neighbour) turns
+    /// 400° round the apex, so the two fold over each other; sectors 5–6 are a third piece,
+    /// not next to the small one. Passed on, the small piece and its neighbour are split
+    /// where they overlap, the part under the small share joined to the third piece: two
+    /// pieces, each flat (L2 1), without overlap, the first of at least the small share,
+    /// together every face. Without the third piece nothing changes.
+    #[test]
+    fn a_small_piece_folding_over_its_neighbour_is_passed_on_to_a_third_piece() {
+        let opts = FlattenOptions::default();
+        let fx = Fixture::new(zigzag_cone());
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        // Each case its own record of failures: a pass that failed on two pieces is not
+        // tried again while they are the same, whatever the third.
+        let (failed, failed_again) = (Failed::default(), Failed::default());
+        let onto = |failed| Onto {
+            ctx: &ctx,
+            opts: &opts,
+            eps,
+            failed,
+        };
+        let sector = ctx.area(&ctx.piece((0..3).collect()).faces);
+        let small = 2.9 * sector;
+        let nf = ctx.mesh.faces.len();
+        let pieces = |ranges: &[std::ops::Range<usize>]| -> Vec<Laid> {
+            ranges
+                .iter()
+                .map(|r| ctx.piece(r.clone().collect()))
+                .collect()
+        };
+        // Without a third piece, nothing changes.
+        let mut done = pieces(&[3..15, 0..3]);
+        let mut owners = Owners::new(nf, &done);
+        assert!(!pass_on(&onto(&failed), &mut done, &mut owners, 1, small));
+        assert_eq!(done[0].faces, (3..15).collect::<Vec<_>>());
+        assert_eq!(done[1].faces, (0..3).collect::<Vec<_>>());
+        assert!(!owners.gone[1]);
+        assert!((0..15).all(|f| owners.owner[f] == usize::from(f < 3)));
+        let mut done = pieces(&[3..15, 0..3, 15..21]);
+        let mut owners = Owners::new(nf, &done);
+        assert!(!pass_on(&onto(&failed), &mut done, &mut owners, 1, small));
+        assert!(pass_on(
+            &onto(&failed_again),
+            &mut done,
+            &mut owners,
+            1,
+            small
+        ));
+        assert!(owners.gone[1]);
+        owners.drop_gone(&mut done);
+        assert_eq!(done.len(), 2);
+        for l in &done {
+            assert!(keeps(&ctx, l, &opts, eps));
+            assert!((l.stretch.l2 - 1.0).abs() < 1e-6, "{}", l.stretch.l2);
+        }
+        assert!(ctx.area(&done[0].faces) >= small);
+        assert!((15..21).all(|f| done[1].faces.contains(&f)));
+        assert!(done[1].faces.len() > 6);
+        let mut all = [done[0].faces.clone(), done[1].faces.clone()].concat();
+        all.sort_unstable();
+        assert_eq!(all, (0..21).collect::<Vec<_>>());
     }
 }

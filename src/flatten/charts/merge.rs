@@ -55,7 +55,7 @@ use super::overlap::{
 };
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
-use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between_area};
+use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between, split_between_area};
 use glam::DVec2;
 
 /// Pieces under this share of the surface's area are merged where they can be.
@@ -232,27 +232,33 @@ pub(super) fn share_apart(
     opts: &FlattenOptions,
     eps: f64,
 ) -> Option<(Laid, Laid)> {
-    let shares = Shares::new(ctx, done, k, part, small, opts, eps)?;
-    let mut tried: Vec<Vec<usize>> = Vec::new();
-    // As they lie; where no split of that is kept, laid out as one.
-    let layouts = [false, true].into_iter().filter_map(|relaxed| {
-        if relaxed {
-            laid_as_one(ctx, done, k, part).map(|l| (l.faces, l.uv))
-        } else {
-            moved_onto(ctx, done, k, part).map(|j| (j.faces, j.uv))
-        }
-    });
-    for (faces, uv) in layouts {
-        let pairs: Vec<(usize, usize)> = overlaps(&uv, eps, APART_PAIRS)
-            .into_iter()
-            .map(|(x, y)| (faces[x], faces[y]))
-            .collect();
-        let shared = shares.between(&faces, &uv, &pairs, &mut tried);
-        if shared.is_some() {
-            return shared;
-        }
-    }
-    None
+    Shares::new(ctx, done, k, part, small, opts, eps)?.apart(done, k, part, &mut Some)
+}
+
+/// The share-outs of `pair[1]` (a small piece) and `pair[0]` (its neighbour) where the two
+/// overlap, as [`share_apart`] finds them, but split between the two faces as they are
+/// nearer ([`split_between`]) where exactly one part is under `small`: each laid out and
+/// kept as [`share_apart`]'s, larger part first, given to `take` in turn; the first that
+/// `take` makes something of. What folds over the small piece (a narrow arm of the
+/// neighbour) goes with one part, the rest with the other: the small part may fit beside a
+/// third piece where the small piece fitted beside none ([`super::hinge`]'s `pass_on`).
+pub(super) fn pass_apart<T>(
+    ctx: &Charts,
+    pair: &[Laid],
+    small: f64,
+    opts: &FlattenOptions,
+    eps: f64,
+    take: &mut impl FnMut((Laid, Laid)) -> Option<T>,
+) -> Option<T> {
+    let shares = Shares {
+        ctx,
+        cuts: both_cuts(&pair[0], &pair[1]),
+        small,
+        lopsided: true,
+        opts,
+        eps,
+    };
+    shares.apart(pair, 0, 1, take)
 }
 
 /// Share a piece `done[part]` too long for the sheet (and under twice `small` in area) and
@@ -274,15 +280,17 @@ pub(super) fn share_across(
     let shares = Shares::new(ctx, done, k, part, small, opts, eps)?;
     let ends = farthest_apart(ctx.graph, &done[part].faces)?;
     let j = moved_onto(ctx, done, k, part)?;
-    shares.between(&j.faces, &j.uv, &[ends], &mut Vec::new())
+    shares.between(&j.faces, &j.uv, &[ends], &mut Vec::new(), &mut Some)
 }
 
 /// What a share-out of two pieces laid as one needs besides the layout: the two pieces'
-/// cuts, the small area, the options.
+/// cuts, the small area, how the parts are split, the options.
 struct Shares<'a> {
     ctx: &'a Charts<'a>,
     cuts: Vec<usize>,
     small: f64,
+    /// Exactly one part under `small` ([`pass_apart`]); else both at least that.
+    lopsided: bool,
     opts: &'a FlattenOptions,
     eps: f64,
 }
@@ -303,21 +311,76 @@ impl<'a> Shares<'a> {
             ctx,
             cuts: both_cuts(&done[k], &done[part]),
             small,
+            lopsided: false,
             opts,
             eps,
         })
     }
 
-    /// The first partition of `faces` (laid out as `uv`) between a pair of faces of `pairs`
-    /// ([`split_between_area`]) not in `tried` whose parts are laid out from `uv` and kept
-    /// (see [`share_apart`]); at most [`APART_TRIES`] are laid out, each noted in `tried`.
-    fn between(
+    /// The share-outs of `done[part]` and `done[k]` where the two overlap (see
+    /// [`share_apart`]), each given to `take` in turn; the first `take` makes something of.
+    fn apart<T>(
+        &self,
+        done: &[Laid],
+        k: usize,
+        part: usize,
+        take: &mut impl FnMut((Laid, Laid)) -> Option<T>,
+    ) -> Option<T> {
+        let ctx = self.ctx;
+        let mut tried: Vec<Vec<usize>> = Vec::new();
+        // As they lie; where no split of that is kept, laid out as one.
+        let layouts = [false, true].into_iter().filter_map(|relaxed| {
+            if relaxed {
+                laid_as_one(ctx, done, k, part).map(|l| (l.faces, l.uv))
+            } else {
+                moved_onto(ctx, done, k, part).map(|j| (j.faces, j.uv))
+            }
+        });
+        for (faces, uv) in layouts {
+            let pairs: Vec<(usize, usize)> = overlaps(&uv, self.eps, APART_PAIRS)
+                .into_iter()
+                .map(|(x, y)| (faces[x], faces[y]))
+                .collect();
+            let taken = self.between(&faces, &uv, &pairs, &mut tried, take);
+            if taken.is_some() {
+                return taken;
+            }
+        }
+        None
+    }
+
+    /// `faces` split between `x` and `y`: moved across so that both parts have `small`
+    /// ([`split_between_area`]); or, `lopsided`, as they are nearer ([`split_between`]) when
+    /// exactly one part is under `small`, the larger first.
+    fn split(&self, faces: &[usize], x: usize, y: usize) -> Option<(Vec<usize>, Vec<usize>)> {
+        let g = self.ctx.graph;
+        if !self.lopsided {
+            return split_between_area(g, faces, x, y, self.small);
+        }
+        let (a, b) = split_between(g, faces, x, y);
+        match (
+            self.ctx.area(&a) < self.small,
+            self.ctx.area(&b) < self.small,
+        ) {
+            _ if a.is_empty() || b.is_empty() => None,
+            (false, true) => Some((a, b)),
+            (true, false) => Some((b, a)),
+            _ => None,
+        }
+    }
+
+    /// The partitions of `faces` (laid out as `uv`) between a pair of faces of `pairs`
+    /// ([`Shares::split`]) not in `tried` whose parts are laid out from `uv` and kept (see
+    /// [`share_apart`]), each given to `take` in turn; the first `take` makes something of.
+    /// At most [`APART_TRIES`] are laid out, each noted in `tried`.
+    fn between<T>(
         &self,
         faces: &[usize],
         uv: &[Vec<DVec2>],
         pairs: &[(usize, usize)],
         tried: &mut Vec<Vec<usize>>,
-    ) -> Option<(Laid, Laid)> {
+        take: &mut impl FnMut((Laid, Laid)) -> Option<T>,
+    ) -> Option<T> {
         let (ctx, opts) = (self.ctx, self.opts);
         let whole = Whole::new(faces, uv);
         let mut laid = 0;
@@ -325,7 +388,7 @@ impl<'a> Shares<'a> {
             if laid == APART_TRIES {
                 break;
             }
-            let Some((a, b)) = split_between_area(ctx.graph, faces, x, y, self.small) else {
+            let Some((a, b)) = self.split(faces, x, y) else {
                 continue;
             };
             let mut key = a.clone();
@@ -335,10 +398,11 @@ impl<'a> Shares<'a> {
             }
             tried.push(key);
             laid += 1;
-            let halves = lay_halves(ctx, Some(&whole), &self.cuts, a, b, opts, self.eps)
-                .filter(|(ha, hb)| fits_room(opts.room, &ha.uv) && fits_room(opts.room, &hb.uv));
-            if halves.is_some() {
-                return halves;
+            let taken = lay_halves(ctx, Some(&whole), &self.cuts, a, b, opts, self.eps)
+                .filter(|(ha, hb)| fits_room(opts.room, &ha.uv) && fits_room(opts.room, &hb.uv))
+                .and_then(&mut *take);
+            if taken.is_some() {
+                return taken;
             }
         }
         None

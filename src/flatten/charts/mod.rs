@@ -251,6 +251,7 @@ fn refuse_overlap(flat: Flat) -> Result<Flat, FlattenError> {
 }
 
 /// A chart laid flat.
+#[derive(Clone)]
 struct Laid {
     faces: Vec<usize>,
     /// Edges cut open inside the chart (topology ids, sorted).

@@ -423,12 +423,18 @@ pub(super) enum Trial {
     Across,
     /// Laid out as one with darts ([`super::slit::dart_merge`]).
     Dart,
+    /// Shared out where the two overlap, the smaller part hinged onto a piece next to it
+    /// ([`super::hinge`]'s `pass_on`).
+    Pass,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A
 /// trial is a function of the two pieces alone (and of options that stay the same while the
 /// pieces are merged), so it fails again while neither has changed: the rounds of merging
-/// and hinging skip it. A pair is known by a 128-bit digest of both pieces.
+/// and hinging skip it. A pair is known by a 128-bit digest of both pieces. A pass
+/// ([`Trial::Pass`]) also depends on the pieces round the two; it is not tried again while
+/// the two are the same all the same (a bound on the work, the result still a function of
+/// the input).
 #[derive(Default)]
 pub(super) struct Failed(std::sync::Mutex<std::collections::HashSet<u128>>);
 
@@ -450,10 +456,17 @@ impl Failed {
     }
 
     /// Whether `trial` failed on `a` and `b` as they are.
-    #[cfg(test)]
     pub(super) fn known(&self, trial: Trial, a: &Laid, b: &Laid) -> bool {
         let key = Self::key(trial, a, b);
         self.0.lock().is_ok_and(|s| s.contains(&key))
+    }
+
+    /// Note that `trial` failed on `a` and `b` as they are.
+    pub(super) fn note(&self, trial: Trial, a: &Laid, b: &Laid) {
+        let key = Self::key(trial, a, b);
+        if let Ok(mut s) = self.0.lock() {
+            s.insert(key);
+        }
     }
 
     /// `run` (`trial` on `a` and `b`), unless it failed on them as they are already; a
@@ -471,9 +484,7 @@ impl Failed {
         }
         let out = run();
         if out.is_none() {
-            if let Ok(mut s) = self.0.lock() {
-                s.insert(key);
-            }
+            self.note(trial, a, b);
         }
         out
     }
