@@ -25,10 +25,10 @@
 //! as one split between faces that fold over each other into two parts, neither small; last,
 //! it is laid out with a neighbour as one with darts where the two stretch past the tolerance
 //! ([`dart_merge`]). Last, it is passed on through a neighbour ([`pass_on`]): where the two
-//! overlap, they are split between the overlapping faces into one part of at least the small
-//! share and one under it (a narrow arm of the neighbour that the piece folds over, say),
-//! and that one joined to a piece next to it in any of the ways above; the three pieces
-//! become two.
+//! overlap, they are split between the overlapping faces into two parts, one or both under
+//! the small share (a narrow arm of the neighbour that the piece folds over, say), and each
+//! small part joined to a piece next to it in any of the ways above; the small piece is gone,
+//! and the neighbour too where both parts were small.
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
@@ -435,12 +435,13 @@ fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usiz
 }
 
 /// Pass a small piece `done[si]` on through a neighbour: shared out with it where the two
-/// overlap into a part of at least `small` and one under it ([`pass_apart`]), and that one
-/// joined to a piece next to it then ([`Onto::join`]: a third piece, or the other part).
-/// Of the [`APART_NEIGHBOURS`] neighbours sharing the longest boundary, the first through
-/// which it passes. All or none: true when it passed, the neighbour then its larger part in
-/// `done`, the piece that took the smaller one their union, and `done[si]` marked gone in
-/// `owners`; else `done` and `owners` are as they were.
+/// overlap into two parts, one or both under `small` ([`pass_apart`]), and each small part,
+/// the smaller first, joined to a piece next to it then ([`Onto::join`]: a third piece, or
+/// the other part). Of the [`APART_NEIGHBOURS`] neighbours sharing the longest boundary,
+/// the first through which it passes. All or none: true when it passed, the neighbour then
+/// its larger part in `done` (or marked gone in `owners` where that was small too), the
+/// pieces that took the small parts their unions, and `done[si]` marked gone; else `done`
+/// and `owners` are as they were.
 fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small: f64) -> bool {
     let (ctx, opts, eps) = (onto.ctx, onto.opts, onto.eps);
     let near: Vec<usize> = owners
@@ -456,13 +457,26 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
         let pair = [done[k].clone(), done[si].clone()];
         let mut take = |parts: (Laid, Laid)| -> Option<()> {
             owners.shared(done, (k, si), parts);
-            if let Some((m, union)) = onto.join(done, owners, si) {
-                done[m] = union;
-                owners.absorb(done, m, si);
-                return Some(());
+            // Each small part joined in turn, the smaller first.
+            let mut was: Vec<(usize, Laid)> = Vec::new();
+            for p in [si, k] {
+                if ctx.area(&done[p].faces) >= small {
+                    continue;
+                }
+                let Some((m, union)) = onto.join(done, owners, p) else {
+                    // Undone, last first.
+                    for (m, l) in was.into_iter().rev() {
+                        done[m] = l;
+                    }
+                    owners.gone[k] = false;
+                    owners.gone[si] = false;
+                    owners.shared(done, (k, si), (pair[0].clone(), pair[1].clone()));
+                    return None;
+                };
+                was.push((m, std::mem::replace(&mut done[m], union)));
+                owners.absorb(done, m, p);
             }
-            owners.shared(done, (k, si), (pair[0].clone(), pair[1].clone()));
-            None
+            Some(())
         };
         let passed = pass_apart(ctx, &pair, small, opts, eps, &mut take).is_some();
         if !passed {
@@ -965,5 +979,42 @@ mod tests {
         let mut all = [done[0].faces.clone(), done[1].faces.clone()].concat();
         all.sort_unstable();
         assert_eq!(all, (0..21).collect::<Vec<_>>());
+    }
+
+    /// As above with a fourth piece, sector 9 (next to the small piece, not to its
+    /// neighbour), and a small share more than the three sectors on either side of the split:
+    /// both parts are small, and each is joined to the piece next to it, the small piece and
+    /// its neighbour both gone.
+    #[test]
+    fn both_parts_of_a_small_piece_and_its_neighbour_are_passed_on_when_both_are_small() {
+        let opts = FlattenOptions::default();
+        let fx = Fixture::new(zigzag_cone());
+        let ctx = fx.charts(&opts);
+        let (eps, failed) = (1e-6, Failed::default());
+        let onto = Onto {
+            ctx: &ctx,
+            opts: &opts,
+            eps,
+            failed: &failed,
+        };
+        let sector = ctx.area(&ctx.piece((0..3).collect()).faces);
+        let mut done: Vec<Laid> = [3..15, 0..3, 15..21, 27..30]
+            .into_iter()
+            .map(|r| ctx.piece(r.collect()))
+            .collect();
+        let mut owners = Owners::new(ctx.mesh.faces.len(), &done);
+        assert!(pass_on(&onto, &mut done, &mut owners, 1, 3.1 * sector));
+        assert!(owners.gone[0] && owners.gone[1]);
+        owners.drop_gone(&mut done);
+        assert_eq!(done.len(), 2);
+        for l in &done {
+            assert!(keeps(&ctx, l, &opts, eps));
+            assert!((l.stretch.l2 - 1.0).abs() < 1e-6, "{}", l.stretch.l2);
+        }
+        assert!((15..21).all(|f| done[0].faces.contains(&f)));
+        assert!((27..30).all(|f| done[1].faces.contains(&f)));
+        let mut all = [done[0].faces.clone(), done[1].faces.clone()].concat();
+        all.sort_unstable();
+        assert_eq!(all, (0..21).chain(27..30).collect::<Vec<_>>());
     }
 }

@@ -237,10 +237,10 @@ pub(super) fn share_apart(
 
 /// The share-outs of `pair[1]` (a small piece) and `pair[0]` (its neighbour) where the two
 /// overlap, as [`share_apart`] finds them, but split between the two faces as they are
-/// nearer ([`split_between`]) where exactly one part is under `small`: each laid out and
+/// nearer ([`split_between`]) where a part is under `small` (or both are): each laid out and
 /// kept as [`share_apart`]'s, larger part first, given to `take` in turn; the first that
 /// `take` makes something of. What folds over the small piece (a narrow arm of the
-/// neighbour) goes with one part, the rest with the other: the small part may fit beside a
+/// neighbour) goes with one part, the rest with the other: a small part may fit beside a
 /// third piece where the small piece fitted beside none ([`super::hinge`]'s `pass_on`).
 pub(super) fn pass_apart<T>(
     ctx: &Charts,
@@ -289,7 +289,7 @@ struct Shares<'a> {
     ctx: &'a Charts<'a>,
     cuts: Vec<usize>,
     small: f64,
-    /// Exactly one part under `small` ([`pass_apart`]); else both at least that.
+    /// A part under `small`, or both ([`pass_apart`]); else both at least that.
     lopsided: bool,
     opts: &'a FlattenOptions,
     eps: f64,
@@ -351,21 +351,18 @@ impl<'a> Shares<'a> {
 
     /// `faces` split between `x` and `y`: moved across so that both parts have `small`
     /// ([`split_between_area`]); or, `lopsided`, as they are nearer ([`split_between`]) when
-    /// exactly one part is under `small`, the larger first.
+    /// a part is under `small` (or both are), the larger first.
     fn split(&self, faces: &[usize], x: usize, y: usize) -> Option<(Vec<usize>, Vec<usize>)> {
         let g = self.ctx.graph;
         if !self.lopsided {
             return split_between_area(g, faces, x, y, self.small);
         }
         let (a, b) = split_between(g, faces, x, y);
-        match (
-            self.ctx.area(&a) < self.small,
-            self.ctx.area(&b) < self.small,
-        ) {
-            _ if a.is_empty() || b.is_empty() => None,
-            (false, true) => Some((a, b)),
-            (true, false) => Some((b, a)),
-            _ => None,
+        let (sa, sb) = (self.ctx.area(&a), self.ctx.area(&b));
+        match () {
+            _ if a.is_empty() || b.is_empty() || sa.min(sb) >= self.small => None,
+            _ if sa >= sb => Some((a, b)),
+            _ => Some((b, a)),
         }
     }
 
