@@ -300,7 +300,9 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
 /// pieces); hinged whole, 11 were small (37 pieces); in halves and quarters too, 8 (34
 /// pieces); merged with a slit where no hinge fits (`flatten::charts::slit`), 7 (33
 /// pieces); shared out where a small piece and a neighbour overlap, 6 (33 pieces); merged
-/// with darts where the two as one stretch past the tolerance, 5 are (32 pieces).
+/// with darts where the two as one stretch past the tolerance, 5 (32 pieces); passed on
+/// through a neighbour to a third piece (`flatten::charts::hinge`'s `pass_on`), 4 are (31
+/// pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     require_shared!();
@@ -308,8 +310,28 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 5, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 32, "{} pieces", r.pieces);
+    assert!(r.small <= 4, "{} pieces under 1 % of the area", r.small);
+    assert!(r.pieces <= 31, "{} pieces", r.pieces);
+}
+
+/// Issue 20, item 3: elephant at 300 mm on A4 kept one piece under 1 % of the area in paper
+/// (5 faces) and one in metal (0.28 %), each joined to no neighbour in any way. Passed on
+/// through a neighbour (`flatten::charts::hinge`'s `pass_on`: the two split where they
+/// overlap, the small part joined to a piece next to it), none is left in either.
+#[test]
+fn corpus_elephant_passes_its_small_pieces_on_through_a_neighbour() {
+    require_shared!();
+    let mesh = shared_data("meshes/elephant.obj");
+    for (kind, tolerance) in [(MaterialKind::Paper, 1.003), (MaterialKind::Metal, 1.001)] {
+        let r = run(&mesh, kind);
+        print_row(&mesh, kind, &r);
+        assert!(
+            r.worst_piece <= tolerance,
+            "worst piece L2 {}",
+            r.worst_piece
+        );
+        assert_eq!(r.small, 0, "{kind:?}: pieces under 1 % of the area");
+    }
 }
 
 /// Issue 20: a piece split to fit the sheet keeps its layout, and a part of it can stretch
