@@ -22,7 +22,7 @@
 //! A small piece that hinges in no way is then laid out anew with a neighbour as one, with a
 //! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]);
 //! then it is shared out with a neighbour where the two overlap ([`share_apart`]): the two
-//! as one split between faces that fold over each other into two parts, neither small; last,
+//! as one split between faces that fold over each other into two parts, neither small; then
 //! it is laid out with a neighbour as one with darts where the two stretch past the tolerance
 //! ([`dart_merge`]). Last, it is passed on through a neighbour ([`pass_on`]): where the two
 //! overlap, they are split between the overlapping faces into two parts, one or both under
@@ -190,11 +190,7 @@ impl Onto<'_> {
         (trial, merge): (Trial, Merge),
     ) -> Option<(usize, Laid)> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
-        let near: Vec<usize> = owners
-            .neighbours(ctx, done, part)
-            .into_iter()
-            .take(SLIT_TRIES)
-            .collect();
+        let near: Vec<usize> = owners.nearest(ctx, done, part, SLIT_TRIES);
         crate::geom::par::first(&near, |&k| {
             self.failed.attempt(trial, &done[k], &done[part], || {
                 merge(ctx, done, k, part, opts, eps)
@@ -236,11 +232,7 @@ impl Onto<'_> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
         self.hinge(done, owners, part, &|_| true)
             .or_else(|| {
-                let near: Vec<usize> = owners
-                    .neighbours(ctx, done, part)
-                    .into_iter()
-                    .take(MERGE_TRIES)
-                    .collect();
+                let near: Vec<usize> = owners.nearest(ctx, done, part, MERGE_TRIES);
                 first_merge(ctx, done, &near, part, opts, eps, self.failed)
             })
             .or_else(|| self.merge(done, owners, part, (Trial::Slit, slit_merge)))
@@ -444,11 +436,7 @@ fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usiz
 /// and `owners` are as they were.
 fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small: f64) -> bool {
     let (ctx, opts, eps) = (onto.ctx, onto.opts, onto.eps);
-    let near: Vec<usize> = owners
-        .neighbours(ctx, done, si)
-        .into_iter()
-        .take(APART_NEIGHBOURS)
-        .collect();
+    let near: Vec<usize> = owners.nearest(ctx, done, si, APART_NEIGHBOURS);
     near.into_iter().any(|k| {
         // Not again while neither of the two has changed, though a third piece may have.
         if onto.failed.known(Trial::Pass, &done[k], &done[si]) {
@@ -923,7 +911,8 @@ mod tests {
     /// not next to the small one. Passed on, the small piece and its neighbour are split
     /// where they overlap, the part under the small share joined to the third piece: two
     /// pieces, each flat (L2 1), without overlap, the first of at least the small share,
-    /// together every face. Without the third piece nothing changes.
+    /// together every face. Without the third piece nothing changes; and once that failed,
+    /// the pass is not tried again on the same two pieces (the record of failures kept).
     #[test]
     fn a_small_piece_folding_over_its_neighbour_is_passed_on_to_a_third_piece() {
         let opts = FlattenOptions::default();

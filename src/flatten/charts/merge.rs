@@ -95,11 +95,7 @@ fn merge_small_once(
         if owners.gone[si] || ctx.area(&done[si].faces) >= small {
             continue;
         }
-        let near: Vec<usize> = owners
-            .neighbours(ctx, done, si)
-            .into_iter()
-            .take(MERGE_TRIES)
-            .collect();
+        let near: Vec<usize> = owners.nearest(ctx, done, si, MERGE_TRIES);
         // Laid out again as one, else shared out with a neighbour, else grafted onto the
         // neighbours as they lie.
         if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
@@ -359,10 +355,12 @@ impl<'a> Shares<'a> {
         }
         let (a, b) = split_between(g, faces, x, y);
         let (sa, sb) = (self.ctx.area(&a), self.ctx.area(&b));
-        match () {
-            _ if a.is_empty() || b.is_empty() || sa.min(sb) >= self.small => None,
-            _ if sa >= sb => Some((a, b)),
-            _ => Some((b, a)),
+        if a.is_empty() || b.is_empty() || sa.min(sb) >= self.small {
+            None
+        } else if sa >= sb {
+            Some((a, b))
+        } else {
+            Some((b, a))
         }
     }
 

@@ -616,6 +616,13 @@ impl Owners {
         cands.into_iter().map(|(_, k)| k).collect()
     }
 
+    /// The first `n` of [`Owners::neighbours`].
+    pub(super) fn nearest(&self, ctx: &Charts, done: &[Laid], part: usize, n: usize) -> Vec<usize> {
+        let mut near = self.neighbours(ctx, done, part);
+        near.truncate(n);
+        near
+    }
+
     /// `done[part]` was merged into `done[k]`.
     pub(super) fn absorb(&mut self, done: &[Laid], k: usize, part: usize) {
         for &f in &done[part].faces {
