@@ -71,6 +71,8 @@ const HINGE_ROUNDS: usize = 4;
 /// Neighbours a small piece that hinges in no way is shared out with at most
 /// ([`share_apart`]).
 const APART_NEIGHBOURS: usize = 3;
+/// Neighbours a small piece that joins none is passed on through at most ([`pass_on`]).
+const PASS_NEIGHBOURS: usize = 6;
 /// Candidates tried with the union relaxed, per neighbour.
 const RELAX_TRIES: usize = 2;
 /// How near (in mean common edge lengths) a common edge's ends must land to be joined when
@@ -429,14 +431,14 @@ fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usiz
 /// Pass a small piece `done[si]` on through a neighbour: shared out with it where the two
 /// overlap into two parts, one or both under `small` ([`pass_apart`]), and each small part,
 /// the smaller first, joined to a piece next to it then ([`Onto::join`]: a third piece, or
-/// the other part). Of the [`APART_NEIGHBOURS`] neighbours sharing the longest boundary,
+/// the other part). Of the [`PASS_NEIGHBOURS`] neighbours sharing the longest boundary,
 /// the first through which it passes. All or none: true when it passed, the neighbour then
 /// its larger part in `done` (or marked gone in `owners` where that was small too), the
 /// pieces that took the small parts their unions, and `done[si]` marked gone; else `done`
 /// and `owners` are as they were.
 fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small: f64) -> bool {
     let (ctx, opts, eps) = (onto.ctx, onto.opts, onto.eps);
-    let near: Vec<usize> = owners.nearest(ctx, done, si, APART_NEIGHBOURS);
+    let near: Vec<usize> = owners.nearest(ctx, done, si, PASS_NEIGHBOURS);
     near.into_iter().any(|k| {
         // Not again while neither of the two has changed, though a third piece may have.
         if onto.failed.known(Trial::Pass, &done[k], &done[si]) {
