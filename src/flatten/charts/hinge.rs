@@ -440,10 +440,6 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
     let (ctx, opts, eps) = (onto.ctx, onto.opts, onto.eps);
     let near: Vec<usize> = owners.nearest(ctx, done, si, PASS_NEIGHBOURS);
     near.into_iter().any(|k| {
-        // Not again while neither of the two has changed, though a third piece may have.
-        if onto.failed.known(Trial::Pass, &done[k], &done[si]) {
-            return false;
-        }
         let pair = [done[k].clone(), done[si].clone()];
         let mut take = |parts: (Laid, Laid)| -> Option<()> {
             owners.shared(done, (k, si), parts);
@@ -468,11 +464,12 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
             }
             Some(())
         };
-        let passed = pass_apart(ctx, &pair, small, opts, eps, &mut take).is_some();
-        if !passed {
-            onto.failed.note(Trial::Pass, &pair[0], &pair[1]);
-        }
-        passed
+        // Not again while neither of the two has changed, though a third piece may have.
+        onto.failed
+            .attempt(Trial::Pass, &pair[0], &pair[1], || {
+                pass_apart(ctx, &pair, small, opts, eps, &mut take)
+            })
+            .is_some()
     })
 }
 

@@ -456,17 +456,10 @@ impl Failed {
     }
 
     /// Whether `trial` failed on `a` and `b` as they are.
+    #[cfg(test)]
     pub(super) fn known(&self, trial: Trial, a: &Laid, b: &Laid) -> bool {
         let key = Self::key(trial, a, b);
         self.0.lock().is_ok_and(|s| s.contains(&key))
-    }
-
-    /// Note that `trial` failed on `a` and `b` as they are.
-    pub(super) fn note(&self, trial: Trial, a: &Laid, b: &Laid) {
-        let key = Self::key(trial, a, b);
-        if let Ok(mut s) = self.0.lock() {
-            s.insert(key);
-        }
     }
 
     /// `run` (`trial` on `a` and `b`), unless it failed on them as they are already; a
@@ -484,7 +477,9 @@ impl Failed {
         }
         let out = run();
         if out.is_none() {
-            self.note(trial, a, b);
+            if let Ok(mut s) = self.0.lock() {
+                s.insert(key);
+            }
         }
         out
     }
