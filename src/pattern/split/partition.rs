@@ -28,7 +28,7 @@ use crate::flatten::Flat;
 use crate::geom::polygon;
 use crate::pattern::{PatternError, PatternOptions};
 use glam::DVec2;
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// Below this bend (0.01°, as the strips' bend lines) an interior edge is flat: a seam there
 /// would cross a panel rather than follow a line of the surface.
@@ -396,52 +396,127 @@ fn greedy(isl: &Island, order: &[usize]) -> (usize, Option<Vec<Vec<usize>>>) {
 /// Fewer parts: the smallest part that can join a neighbour (through a joined edge) and
 /// still fit does, into the neighbour it shares the longest seam with, until none can. A run
 /// of a sequence can fall apart into pieces, and a small one is better joined to another.
-fn merge(isl: &Island, mut parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
-    let mut part_of = vec![0; isl.faces.len()];
-    loop {
-        for (k, p) in parts.iter().enumerate() {
-            for &u in p {
-                part_of[u] = k;
-            }
+///
+/// A run can fall apart into thousands of pieces (a piece much larger than the sheet), so the
+/// parts keep their places (a joined pair in the first one's), the seams between them are
+/// summed once and again only round a union (over its links in the island's order, so the
+/// sums are those a fresh count gives), and a pair of parts whose union does not fit is not
+/// measured again while neither has changed (whether a set fits depends on its faces only).
+fn merge(isl: &Island, parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    let n = isl.faces.len();
+    let mut links_of: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, &(u, v, _)) in isl.links.iter().enumerate() {
+        links_of[u].push(i);
+        links_of[v].push(i);
+    }
+    let mut slot_of = vec![usize::MAX; n];
+    for (k, p) in parts.iter().enumerate() {
+        for &u in p {
+            slot_of[u] = k;
         }
-        let area = |p: &Vec<usize>| p.iter().map(|&u| isl.area[u]).sum::<f64>();
-        let mut by_size: Vec<usize> = (0..parts.len()).collect();
-        by_size.sort_by(|&a, &b| area(&parts[a]).total_cmp(&area(&parts[b])).then(a.cmp(&b)));
+    }
+    let sum_area = |p: &[usize]| p.iter().map(|&u| isl.area[u]).sum::<f64>();
+    let mut area: Vec<f64> = parts.iter().map(|p| sum_area(p)).collect();
+    let mut by_size: BTreeSet<BySize> = (0..parts.len()).map(|k| BySize(area[k], k)).collect();
+    // Per part: its neighbours and the seam length shared with each.
+    let mut seams: Vec<Vec<(usize, f64)>> = vec![Vec::new(); parts.len()];
+    let add = |seams: &mut Vec<(usize, f64)>, other: usize, c: f64| match seams
+        .iter_mut()
+        .find(|x| x.0 == other)
+    {
+        Some(x) => x.1 += c,
+        None => seams.push((other, c)),
+    };
+    for &(u, v, c) in &isl.links {
+        let (pu, pv) = (slot_of[u], slot_of[v]);
+        if pu != pv && pu != usize::MAX && pv != usize::MAX {
+            add(&mut seams[pu], pv, c);
+            add(&mut seams[pv], pu, c);
+        }
+    }
+    // A part's identity while it is unchanged, and the pairs of them that do not fit.
+    let mut ids: Vec<usize> = (0..parts.len()).collect();
+    let mut next_id = parts.len();
+    let mut too_large: HashSet<(usize, usize)> = HashSet::new();
+    let mut parts: Vec<Option<Vec<usize>>> = parts.into_iter().map(Some).collect();
+    loop {
         let mut joined = None;
-        'parts: for &k in &by_size {
+        'parts: for &BySize(_, k) in &by_size {
             // Neighbours by shared seam length, longest first.
-            let mut shared: Vec<(usize, f64)> = Vec::new();
-            for &(u, v, c) in &isl.links {
-                let (pu, pv) = (part_of[u], part_of[v]);
-                let other = if pu == k && pv != k {
-                    pv
-                } else if pv == k && pu != k {
-                    pu
-                } else {
+            let near = &mut seams[k];
+            near.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            for &(j, _) in near.iter() {
+                let pair = (ids[k].min(ids[j]), ids[k].max(ids[j]));
+                if too_large.contains(&pair) {
+                    continue;
+                }
+                let (Some(pk), Some(pj)) = (&parts[k], &parts[j]) else {
                     continue;
                 };
-                match shared.iter_mut().find(|x| x.0 == other) {
-                    Some(x) => x.1 += c,
-                    None => shared.push((other, c)),
-                }
-            }
-            shared.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-            for (j, _) in shared {
-                let mut union = parts[k].clone();
-                union.extend_from_slice(&parts[j]);
+                let mut union = pk.clone();
+                union.extend_from_slice(pj);
                 if isl.overflow(&union) <= 0.0 {
                     joined = Some((k, j, union));
                     break 'parts;
                 }
+                too_large.insert(pair);
             }
         }
         let Some((k, j, mut union)) = joined else {
-            return parts;
+            return parts.into_iter().flatten().collect();
         };
         union.sort_unstable();
         let (keep, drop) = (k.min(j), k.max(j));
-        parts[keep] = union;
-        parts.remove(drop);
+        by_size.remove(&BySize(area[k], k));
+        by_size.remove(&BySize(area[j], j));
+        for &u in &union {
+            slot_of[u] = keep;
+        }
+        // The union's seams over its links in the island's order.
+        let mut mine: Vec<usize> = union
+            .iter()
+            .flat_map(|&u| links_of[u].iter().copied())
+            .collect();
+        mine.sort_unstable();
+        mine.dedup();
+        let mut around: Vec<(usize, f64)> = Vec::new();
+        for i in mine {
+            let (u, v, c) = isl.links[i];
+            let (pu, pv) = (slot_of[u], slot_of[v]);
+            if pu != pv && pu != usize::MAX && pv != usize::MAX {
+                add(&mut around, if pu == keep { pv } else { pu }, c);
+            }
+        }
+        for &(o, c) in &around {
+            seams[o].retain(|x| x.0 != k && x.0 != j);
+            seams[o].push((keep, c));
+        }
+        seams[keep] = around;
+        seams[drop].clear();
+        area[keep] = sum_area(&union);
+        parts[keep] = Some(union);
+        parts[drop] = None;
+        ids[keep] = next_id;
+        next_id += 1;
+        by_size.insert(BySize(area[keep], keep));
+    }
+}
+
+/// A part in [`merge`]'s order: by area, then by place.
+#[derive(Clone, Copy, PartialEq)]
+struct BySize(f64, usize);
+
+impl Eq for BySize {}
+
+impl PartialOrd for BySize {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for BySize {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
     }
 }
 
