@@ -253,7 +253,8 @@ pub fn build_to_fit(
             split_edges.push(cut);
         }
         let mut pieces = super::build_tagged(flats, &tags, opts)?;
-        let mut again = false;
+        // Each island's largest overflow this round (its parts come out over together).
+        let mut worst: Vec<((usize, usize), f64)> = Vec::new();
         for (p, &(fi, ii, one)) in pieces.iter().zip(&origin) {
             let over = piece_overflow(p, room);
             if over <= 0.0 {
@@ -262,6 +263,13 @@ pub fn build_to_fit(
             if one {
                 return Err(too_large(p, room));
             }
+            match worst.iter_mut().find(|w| w.0 == (fi, ii)) {
+                Some(w) => w.1 = w.1.max(over),
+                None => worst.push(((fi, ii), over)),
+            }
+        }
+        let again = !worst.is_empty();
+        for ((fi, ii), over) in worst {
             // Grown by the overflow (an island that fit as a whole now needs splitting too:
             // possible only when the piece changed, which the same faces cannot), doubled
             // each round the island still came out whole: the estimate can be short by much
@@ -269,6 +277,7 @@ pub fn build_to_fit(
             // past its width), while a part of a split island is only a little too large,
             // unless it still is after two rounds (a new partition can land its parts just
             // as far over: couplingdown in fabric, part 3a 0.12 mm over after 8 rounds).
+            // Once per island and round, by its worst part: its parts share one estimate.
             let whole = cache
                 .get(&(fi, ii))
                 .is_none_or(|(_, parts)| parts.len() <= 1);
@@ -281,7 +290,6 @@ pub fn build_to_fit(
             *k = (*k + 1).min(16);
             let g = grow[fi][ii].get_or_insert(base);
             *g += (0.5 * over + 0.5) * factor;
-            again = true;
         }
         let offset: Vec<usize> = flats
             .iter()
@@ -500,5 +508,67 @@ mod tests {
             .iter()
             .all(|s| s.count == 1 && (s.length - 100.0).abs() < 1e-9));
         assert_eq!(flats[0].islands.len(), 3);
+    }
+
+    /// A flat sheet of `nx` × `ny` squares of `side` mm, each cut by a diagonal, its inner
+    /// corners moved by up to `jitter` mm (the same each run), as one surface.
+    fn triangulated_sheet(nx: usize, ny: usize, side: f64, jitter: f64) -> crate::surface::Surface {
+        let mut rng = crate::geom::rng::Rng::new(7);
+        let mut verts = Vec::new();
+        for j in 0..=ny {
+            for i in 0..=nx {
+                let inner = 0 < i && i < nx && 0 < j && j < ny;
+                let d = if inner {
+                    glam::DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, 0.0) * (2.0 * jitter)
+                } else {
+                    glam::DVec3::ZERO
+                };
+                verts.push(glam::DVec3::new(side * i as f64, side * j as f64, 0.0) + d);
+            }
+        }
+        let at = |i: usize, j: usize| j * (nx + 1) + i;
+        let mut faces: Vec<[usize; 3]> = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        crate::surface::Surface {
+            name: "sheet".into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
+            ..Default::default()
+        }
+    }
+
+    /// Regression (blade in fabric at 3,000 mm on A4 went on for over 5 minutes): when
+    /// several parts of a split piece came out a little too large once their seam allowance
+    /// was added, the growth estimate was raised once per part, doubling from the third on, so
+    /// that it passed the sheet and every face became a part of its own (16,222 parts for the
+    /// nest). It is now raised once per round by the worst part. A 600 × 400 mm sheet of
+    /// uneven triangles (the allowance mitred at their sharp corners reaches past its width)
+    /// with a 10 mm allowance on A4 (200 × 287 mm inside the margins): 71 parts before, 18
+    /// now, each fitting the sheet.
+    #[test]
+    fn parts_that_come_out_too_large_grow_the_estimate_once_per_round() {
+        let sheet = triangulated_sheet(30, 20, 20.0, 8.0);
+        let mut flats = vec![unfold(sheet, &UnfoldOptions::default()).unwrap()];
+        let room = Room::inside(210.0, Some(297.0), 5.0);
+        let opts = PatternOptions {
+            allowance: 10.0,
+            ..Default::default()
+        };
+        let pieces = build_to_fit(&mut flats, &opts, &room).unwrap();
+        assert!(pieces.iter().all(|p| fits(p, &room)));
+        // 240,000 mm² of faces, at most 180 × 267 mm of them per part: 5 parts at the least.
+        assert!(
+            (5..=24).contains(&pieces.len()),
+            "{} parts: {:?}",
+            pieces.len(),
+            pieces.iter().map(|p| p.faces.len()).collect::<Vec<_>>()
+        );
+        let faces: usize = pieces.iter().map(|p| p.faces.len()).sum();
+        assert_eq!(faces, 1200);
     }
 }
