@@ -60,36 +60,55 @@ pub(crate) fn collide(a: &Shape, pa: DVec2, b: &Shape, pb: DVec2, s: f64, work: 
     // Zero spacing: do some boundaries touch (a zero orientation)? Only then can material
     // overlap without a proper crossing and without one shape's pole in the other.
     let mut touch = false;
-    for [a0, a1] in &a.segs {
-        let (alo, ahi) = (a0.min(*a1), a0.max(*a1));
+    // One pair of segments (b's in a's frame): true when they are closer than the spacing or
+    // cross; `touch` set where an orientation is exactly zero.
+    let mut pair = |a0: DVec2, a1: DVec2, alo: DVec2, ahi: DVec2, b0: DVec2, b1: DVec2| {
+        let (blo, bhi) = (b0.min(b1), b0.max(b1));
+        // Strictly apart only: touching segments must set `touch` below.
+        if blo.x > ahi.x + s || blo.y > ahi.y + s || alo.x > bhi.x + s || alo.y > bhi.y + s {
+            return false;
+        }
+        if s > 0.0 {
+            return segment_segment_dist2(a0, a1, b0, b1) < s2;
+        }
+        let o1 = orient2(a0, a1, b0);
+        let o2 = orient2(a0, a1, b1);
+        let o3 = orient2(b0, b1, a0);
+        let o4 = orient2(b0, b1, a1);
+        if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0))
+            && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0))
+        {
+            return true;
+        }
+        if o1 == 0.0 || o2 == 0.0 || o3 == 0.0 || o4 == 0.0 {
+            touch = true;
+        }
+        false
+    };
+    // Where b lists its segments by cell, only those near each of a's are looked at: the
+    // others fail the box test anyway, and the answer does not depend on the order of pairs.
+    let mut near: Vec<u32> = Vec::new();
+    let pad = DVec2::splat(s + 1e-6 * (1.0 + d.abs().max_element()));
+    for &[a0, a1] in &a.segs {
+        let (alo, ahi) = (a0.min(a1), a0.max(a1));
         if ahi.x < wlo.x || ahi.y < wlo.y || alo.x > whi.x || alo.y > whi.y {
             continue;
         }
-        for [b0, b1] in &b.segs {
-            let (b0, b1) = (*b0 + d, *b1 + d);
-            let (blo, bhi) = (b0.min(b1), b0.max(b1));
-            // Strictly apart only: touching segments must set `touch` below.
-            if blo.x > ahi.x + s || blo.y > ahi.y + s || alo.x > bhi.x + s || alo.y > bhi.y + s {
-                continue;
+        let hit = match &b.index {
+            Some(index) => {
+                index.query(alo - d - pad, ahi - d + pad, &mut near);
+                near.iter().any(|&k| {
+                    let [b0, b1] = b.segs[k as usize];
+                    pair(a0, a1, alo, ahi, b0 + d, b1 + d)
+                })
             }
-            if s > 0.0 {
-                if segment_segment_dist2(*a0, *a1, b0, b1) < s2 {
-                    return true;
-                }
-            } else {
-                let o1 = orient2(*a0, *a1, b0);
-                let o2 = orient2(*a0, *a1, b1);
-                let o3 = orient2(b0, b1, *a0);
-                let o4 = orient2(b0, b1, *a1);
-                if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0))
-                    && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0))
-                {
-                    return true;
-                }
-                if o1 == 0.0 || o2 == 0.0 || o3 == 0.0 || o4 == 0.0 {
-                    touch = true;
-                }
-            }
+            None => b
+                .segs
+                .iter()
+                .any(|&[b0, b1]| pair(a0, a1, alo, ahi, b0 + d, b1 + d)),
+        };
+        if hit {
+            return true;
         }
     }
     // No boundaries meet: either apart, or one inside the other.

@@ -6,7 +6,9 @@
 //! Choices: rotations by a multiple of 90° are exact ([`rotor`]), so that rectangles stay edge
 //! to edge; a mirror reverses the rings' point order, which is undone so that the outer ring
 //! stays counter-clockwise; the poles are also kept in fixed-size lanes ([`PoleLanes`]) for
-//! the vectorised overlap proxy.
+//! the vectorised overlap proxy; a shape of many segments lists them by grid cell
+//! ([`SegIndex`]), so that the collision test of two large pieces (a pattern piece's outline
+//! has thousands) looks at the pairs that can meet rather than at all of them.
 
 use crate::geom::polygon;
 use crate::geom::segment::point_segment_dist2;
@@ -69,6 +71,8 @@ pub(crate) struct Shape {
     /// the vectorised [`super::overlap_proxy`].
     pub lanes: PoleLanes,
     pub size: DVec2,
+    /// The segments by grid cell, for a shape with more than [`INDEX_SEGS`] of them.
+    pub index: Option<SegIndex>,
     /// Area of the material.
     pub area: f64,
     /// Add to a turned item point to get the shape point: `shape = orient(q) + shift`.
@@ -118,6 +122,8 @@ impl Shape {
             .collect();
         let lanes = PoleLanes::new(&poles);
         let area = turned.iter().map(|r| polygon::signed_area(r)).sum();
+        let size = hi - lo;
+        let index = (segs.len() > INDEX_SEGS).then(|| SegIndex::new(&segs, size));
         Shape {
             orient,
             rings: turned,
@@ -125,10 +131,89 @@ impl Shape {
             mids,
             poles,
             lanes,
-            size: hi - lo,
+            size,
+            index,
             area,
             shift,
         }
+    }
+}
+
+/// Shapes with more segments than this list them by grid cell ([`SegIndex`]).
+pub(crate) const INDEX_SEGS: usize = 48;
+
+/// A shape's segments listed in every cell of a uniform grid over its box that their own
+/// boxes touch (about as many cells as segments, at most 256 along a side); a segment outside
+/// the grid is listed in the edge cells nearest it, and a query outside finds those.
+#[derive(Debug, Clone)]
+pub(crate) struct SegIndex {
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// Cell `c`'s segments are `ids[start[c]..start[c + 1]]`, in order.
+    start: Vec<usize>,
+    ids: Vec<u32>,
+}
+
+impl SegIndex {
+    fn new(segs: &[[DVec2; 2]], size: DVec2) -> SegIndex {
+        let n = segs.len().max(1) as f64;
+        let side = size.max(DVec2::splat(1e-9));
+        let cell = (side.x * side.y / n)
+            .sqrt()
+            .max(side.max_element() / 256.0)
+            .max(1e-9);
+        let mut index = SegIndex {
+            cell,
+            nx: ((side.x / cell).ceil() as usize).clamp(1, 256),
+            ny: ((side.y / cell).ceil() as usize).clamp(1, 256),
+            start: Vec::new(),
+            ids: Vec::new(),
+        };
+        // Count, then fill: each segment in the cells of its box.
+        let mut count = vec![0usize; index.nx * index.ny + 1];
+        for [a, b] in segs {
+            index.each_cell(a.min(*b), a.max(*b), |c| count[c] += 1);
+        }
+        let mut start = vec![0usize; count.len()];
+        for c in 1..count.len() {
+            start[c] = start[c - 1] + count[c - 1];
+        }
+        let mut ids = vec![0u32; start[count.len() - 1]];
+        let mut next = start.clone();
+        for (k, [a, b]) in segs.iter().enumerate() {
+            index.each_cell(a.min(*b), a.max(*b), |c| {
+                ids[next[c]] = k as u32;
+                next[c] += 1;
+            });
+        }
+        index.start = start;
+        index.ids = ids;
+        index
+    }
+
+    /// Every cell of the box `lo`–`hi` (clamped to the grid).
+    fn each_cell(&self, lo: DVec2, hi: DVec2, mut f: impl FnMut(usize)) {
+        if !(lo.is_finite() && hi.is_finite()) {
+            return;
+        }
+        let at = |v: f64, n: usize| ((v / self.cell).floor().max(0.0) as usize).min(n - 1);
+        for j in at(lo.y, self.ny)..=at(hi.y, self.ny) {
+            for i in at(lo.x, self.nx)..=at(hi.x, self.nx) {
+                f(j * self.nx + i);
+            }
+        }
+    }
+
+    /// The segments listed in the cells of the box `lo`–`hi`, each once, in order: every
+    /// segment whose box meets it is among them.
+    pub(crate) fn query(&self, lo: DVec2, hi: DVec2, out: &mut Vec<u32>) {
+        out.clear();
+        self.each_cell(lo, hi, |c| {
+            out.extend_from_slice(&self.ids[self.start[c]..self.start[c + 1]])
+        });
+        out.sort_unstable();
+        out.dedup();
     }
 }
 
