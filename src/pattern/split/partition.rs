@@ -503,8 +503,14 @@ fn merge(isl: &Island, parts: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
 }
 
 /// A part in [`merge`]'s order: by area, then by place.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 struct BySize(f64, usize);
+
+impl PartialEq for BySize {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
 
 impl Eq for BySize {}
 
