@@ -34,9 +34,19 @@ struct Local {
     n0: f64,
     u: DVec2,
     k: f64,
-    /// D at the current position, and its gradient.
+    /// D at the current position, its reciprocal, and its gradient.
     d0: f64,
+    inv_d: f64,
     n: DVec2,
+}
+
+/// M and D of a triangle with flat corners `p` and 3D shape `shape` (see the module doc).
+fn m_and_d(p: [DVec2; 3], shape: &[DVec2; 3]) -> (DMat2, f64) {
+    let e = |i: usize| p[(i + 2) % 3] - p[(i + 1) % 3];
+    let m = (0..3).fold(DMat2::ZERO, |m, i| {
+        m + DMat2::from_cols(shape[i] * e(i).x, shape[i] * e(i).y)
+    });
+    (m, (p[1] - p[0]).perp_dot(p[2] - p[0]))
 }
 
 impl Local {
@@ -44,20 +54,27 @@ impl Local {
     /// at the layout `uv`.
     fn new(tri: [usize; 3], shape: &[DVec2; 3], a3: f64, c: usize, uv: &[DVec2]) -> Local {
         let p = [uv[tri[0]], uv[tri[1]], uv[tri[2]]];
-        let e = |i: usize| p[(i + 2) % 3] - p[(i + 1) % 3];
-        let m = (0..3).fold(DMat2::ZERO, |m, i| {
-            m + DMat2::from_cols(shape[i] * e(i).x, shape[i] * e(i).y)
-        });
+        let (m, _) = m_and_d(p, shape);
         let w = shape[(c + 1) % 3] - shape[(c + 2) % 3];
         let (a, b) = (p[(c + 1) % 3], p[(c + 2) % 3]);
+        let d0 = (a - p[c]).perp_dot(b - p[c]);
         Local {
             a3,
             n0: m.x_axis.length_squared() + m.y_axis.length_squared(),
             u: m.transpose() * w,
             k: w.length_squared(),
-            d0: (a - p[c]).perp_dot(b - p[c]),
+            d0,
+            inv_d: 1.0 / d0,
             n: (b - a).perp(),
         }
+    }
+
+    /// (A₃·f, A₂) where the vertex is; `None` when the triangle is flipped or collapsed.
+    fn here(&self) -> Option<(f64, f64)> {
+        if !(self.d0 > 0.0 && self.d0.is_finite()) {
+            return None;
+        }
+        Some((self.a3 * self.n0 * self.inv_d * self.inv_d, 0.5 * self.d0))
     }
 
     /// (A₃·f, A₂) after moving the vertex by `x`; `None` when the triangle flips or collapses.
@@ -70,16 +87,20 @@ impl Local {
         Some((self.a3 * num / (d * d), 0.5 * d))
     }
 
-    /// The gradient and Hessian of A₃·f in the vertex, where it is.
-    fn derivatives(&self) -> (DVec2, DMat2) {
-        let (d, n, u) = (self.d0, self.n, self.u);
-        let (d2, d3) = (d * d, d * d * d);
-        let g = 2.0 * u / d2 - 2.0 * self.n0 * n / d3;
-        let un = DMat2::from_cols(u * n.x, u * n.y);
-        let nn = DMat2::from_cols(n * n.x, n * n.y);
-        let h = DMat2::IDENTITY * (2.0 * self.k / d2) - (un + un.transpose()) * (4.0 / d3)
-            + nn * (6.0 * self.n0 / (d2 * d2));
-        (g * self.a3, h * self.a3)
+    /// The gradient of A₃·f in the vertex, where it is, and its Hessian's entries (xx, xy,
+    /// yy).
+    fn derivatives(&self) -> (DVec2, [f64; 3]) {
+        let (n, u) = (self.n, self.u);
+        let i2 = self.inv_d * self.inv_d;
+        let i3 = i2 * self.inv_d;
+        let g = u * (2.0 * i2) - n * (2.0 * self.n0 * i3);
+        let (diag, cross, outer) = (2.0 * self.k * i2, 4.0 * i3, 6.0 * self.n0 * i2 * i2);
+        let h = [
+            diag - cross * (2.0 * u.x * n.x) + outer * n.x * n.x,
+            -cross * (u.x * n.y + u.y * n.x) + outer * n.x * n.y,
+            diag - cross * (2.0 * u.y * n.y) + outer * n.y * n.y,
+        ];
+        (g * self.a3, h.map(|v| v * self.a3))
     }
 }
 
@@ -98,20 +119,34 @@ pub(super) fn minimise_stretch(
         .iter()
         .map(|s| 0.5 * (s[1] - s[0]).perp_dot(s[2] - s[0]))
         .collect();
-    let mut vt: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nv];
-    for (t, tri) in chart.tris.iter().enumerate() {
-        for (c, &v) in tri.iter().enumerate() {
-            vt[v].push((t, c));
+    // Each vertex's (triangle, corner), listed flat by vertex.
+    let mut first = vec![0usize; nv + 1];
+    for tri in &chart.tris {
+        for &v in tri {
+            first[v + 1] += 1;
         }
     }
-    let local =
-        |t: usize, c: usize, uv: &[DVec2]| Local::new(chart.tris[t], &shapes[t], a3[t], c, uv);
+    for v in 0..nv {
+        first[v + 1] += first[v];
+    }
+    let mut next = first.clone();
+    let mut corners = vec![(0usize, 0usize); first[nv]];
+    for (t, tri) in chart.tris.iter().enumerate() {
+        for (c, &v) in tri.iter().enumerate() {
+            corners[next[v]] = (t, c);
+            next[v] += 1;
+        }
+    }
     let totals = |uv: &[DVec2]| -> Option<(f64, f64)> {
         let (mut s, mut a) = (0.0, 0.0);
-        for t in 0..chart.tris.len() {
-            let (x, y) = local(t, 0, uv).at(DVec2::ZERO)?;
-            s += x;
-            a += y;
+        for ((tri, shape), &a3) in chart.tris.iter().zip(&shapes).zip(&a3) {
+            let (m, d) = m_and_d([uv[tri[0]], uv[tri[1]], uv[tri[2]]], shape);
+            if !(d > 0.0 && d.is_finite()) {
+                return None;
+            }
+            let n0 = m.x_axis.length_squared() + m.y_axis.length_squared();
+            s += a3 * n0 / (d * d);
+            a += 0.5 * d;
         }
         Some((s, a))
     };
@@ -121,7 +156,11 @@ pub(super) fn minimise_stretch(
     for _sweep in 0..sweeps {
         for v in (0..nv).filter(|&v| !fixed[v]) {
             around.clear();
-            around.extend(vt[v].iter().map(|&(t, c)| local(t, c, &uv)));
+            around.extend(
+                corners[first[v]..first[v + 1]]
+                    .iter()
+                    .map(|&(t, c)| Local::new(chart.tris[t], &shapes[t], a3[t], c, &uv)),
+            );
             if let Some(x) = step(&around, s_tot, a_tot) {
                 uv[v] += x.0;
                 (s_tot, a_tot) = (x.1, x.2);
@@ -144,19 +183,27 @@ pub(super) fn minimise_stretch(
 fn step(around: &[Local], s_tot: f64, a_tot: f64) -> Option<(DVec2, f64, f64)> {
     let (mut s_loc, mut a_loc) = (0.0, 0.0);
     let (mut gs, mut ga) = (DVec2::ZERO, DVec2::ZERO);
-    let mut hs = DMat2::ZERO;
-    let mut reach = f64::INFINITY;
+    let mut hs = [0.0; 3];
+    // The vertex's least height over an opposite edge, D/|n| (|n| the edge's length), kept as
+    // D and |n|² and compared cross-multiplied.
+    let mut low: Option<(f64, f64)> = None;
     for l in around {
-        let (s, a) = l.at(DVec2::ZERO)?;
+        let (s, a) = l.here()?;
         s_loc += s;
         a_loc += a;
         let (g, h) = l.derivatives();
         gs += g;
-        hs += h;
+        for (sum, x) in hs.iter_mut().zip(h) {
+            *sum += x;
+        }
         ga += 0.5 * l.n;
-        // |n| is the opposite edge's length, D/|n| the vertex's height over it.
-        reach = reach.min(l.d0 / l.n.length());
+        let n2 = l.n.length_squared();
+        if low.is_none_or(|(d, m2)| l.d0 * l.d0 * m2 < d * d * n2) {
+            low = Some((l.d0, n2));
+        }
     }
+    let reach = low.map_or(f64::INFINITY, |(d, n2)| d / n2.sqrt());
+    let hs = DMat2::from_cols(DVec2::new(hs[0], hs[1]), DVec2::new(hs[1], hs[2]));
     let (s_rest, a_rest) = (s_tot - s_loc, a_tot - a_loc);
     let e_here = s_tot * a_tot;
     let grad = gs * a_tot + ga * s_tot;
@@ -245,17 +292,11 @@ mod tests {
             let hxx = (fx(dx) - 2.0 * f0 + fx(-dx)) / (h * h);
             let hyy = (fx(dy) - 2.0 * f0 + fx(-dy)) / (h * h);
             let hxy = (fx(dx + dy) - fx(dx - dy) - fx(dy - dx) + fx(-dx - dy)) / (4.0 * h * h);
-            for (mine, fd) in [
-                (hess.x_axis.x, hxx),
-                (hess.y_axis.y, hyy),
-                (hess.y_axis.x, hxy),
-            ] {
-                assert!(
-                    (mine - fd).abs() < 1e-4 * hess.x_axis.x.abs(),
-                    "{mine} vs {fd}"
-                );
+            for (mine, fd) in [(hess[0], hxx), (hess[2], hyy), (hess[1], hxy)] {
+                assert!((mine - fd).abs() < 1e-4 * hess[0].abs(), "{mine} vs {fd}");
             }
-            assert_eq!(hess.x_axis.y, hess.y_axis.x);
+            let (here, exact) = (l.here().unwrap(), l.at(DVec2::ZERO).unwrap());
+            assert!((here.0 - exact.0).abs() < 1e-12 * exact.0 && here.1 == exact.1);
         }
         // A flipped or collapsed move is refused.
         let l = Local::new([0, 1, 2], &s, a3, 0, &uv);
