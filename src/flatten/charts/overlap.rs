@@ -30,18 +30,24 @@ pub(super) fn overlaps(uv: &[Vec<DVec2>], eps: f64, limit: usize) -> Vec<(usize,
             tris.push(([c[t[0]], c[t[1]], c[t[2]]], k));
         }
     }
-    let mut boxes: Vec<(f64, f64, usize)> = tris
+    // Each triangle's box: x from, x to, y from, y to.
+    let mut boxes: Vec<([f64; 4], usize)> = tris
         .iter()
         .enumerate()
         .filter_map(|(i, (t, _))| {
-            polygon::bounds(t.iter().copied()).map(|(lo, hi)| (lo.x, hi.x, i))
+            polygon::bounds(t.iter().copied()).map(|(lo, hi)| ([lo.x, hi.x, lo.y, hi.y], i))
         })
         .collect();
-    boxes.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
-    for (k, &(_, hx, i)) in boxes.iter().enumerate() {
-        for &(lx, _, j) in &boxes[k + 1..] {
+    boxes.sort_by(|a, b| a.0[0].total_cmp(&b.0[0]).then(a.1.cmp(&b.1)));
+    for (k, &([_, hx, ly, hy], i)) in boxes.iter().enumerate() {
+        for &([lx, _, ly2, hy2], j) in &boxes[k + 1..] {
             if lx >= hx - eps {
                 break;
+            }
+            // Boxes apart in y (or within `eps`): no edge of either triangle finds them
+            // overlapping deeper than that either.
+            if ly2 >= hy - eps || ly >= hy2 - eps {
+                continue;
             }
             if tris[i].1 == tris[j].1 {
                 continue;
