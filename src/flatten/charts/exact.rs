@@ -79,18 +79,18 @@ pub(super) fn exact(ctx: &Charts, faces: &[usize], eps: f64) -> Option<Vec<Laid>
 }
 
 /// Graft `done[part]` onto its neighbours `near` (see the module doc): each neighbour that
-/// takes faces becomes the two as one. The neighbours that took faces, with the faces each
-/// took; `None`, leaving all as they were, when a face stays apart or a neighbour would end
-/// over `tolerance` (the material's L2 tolerance). `eps` is the overlap depth that counts as
+/// takes faces becomes the two as one. The neighbours that took faces, each with the faces it
+/// took and what it becomes; `None` when a face stays apart or a neighbour would end over
+/// `tolerance` (the material's L2 tolerance). `eps` is the overlap depth that counts as
 /// touching.
 pub(super) fn graft(
     ctx: &Charts,
-    done: &mut [Laid],
+    done: &[Laid],
     near: &[usize],
     part: usize,
     tolerance: f64,
     eps: f64,
-) -> Option<Vec<(usize, Vec<usize>)>> {
+) -> Option<Vec<(usize, Vec<usize>, Laid)>> {
     let mut faces: Vec<usize> = near
         .iter()
         .flat_map(|&k| done[k].faces.iter().copied())
@@ -106,7 +106,6 @@ pub(super) fn graft(
         .or_else(|| unfold::unfold_onto(&mesh, &topo, &layouts, &opts, eps, true))?;
     snap_ends(&mesh, &topo, &mut uv, &joined, n);
     let mut out = Vec::new();
-    let mut laid = Vec::new();
     for (t, &k) in near.iter().enumerate() {
         let took: Vec<usize> = (n..faces.len()).filter(|&f| which[f] == t).collect();
         if took.is_empty() {
@@ -143,8 +142,9 @@ pub(super) fn graft(
         }
         cuts.sort_unstable();
         cuts.dedup();
-        laid.push((
+        out.push((
             k,
+            took.iter().map(|&f| faces[f]).collect(),
             Laid {
                 faces: fs,
                 cuts,
@@ -153,10 +153,6 @@ pub(super) fn graft(
                 gusset: false,
             },
         ));
-        out.push((k, took.iter().map(|&f| faces[f]).collect()));
-    }
-    for (k, l) in laid {
-        done[k] = l;
     }
     Some(out)
 }

@@ -15,7 +15,8 @@
 //! is small and both keep the tolerance (`rebalance`; the count of pieces stays);
 //! else it is grafted onto its neighbours as they lie ([`graft`]). The neighbours are tried
 //! two at a time where a spare thread is free, the first that takes it winning as in order
-//! (`first_merge`). What is still small once every merge below is done is hinged onto a
+//! (`first_merge`); so is the next small piece beside it, its fate kept where this one's
+//! changed none of its neighbours (`merge_small_once`). What is still small once every merge below is done is hinged onto a
 //! neighbour by one edge ([`super::hinge`]), and what hinges in no way is last shared out with
 //! a neighbour where the two overlap (`share_apart`): split between two faces that fold over
 //! each other, moved across where a part would be small. A piece too long for the sheet that
@@ -82,6 +83,10 @@ pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
 }
 
 /// One round of [`merge_small`]: each small piece, smallest first, tried with its neighbours.
+/// The next piece is tried beside it where a spare thread is free, on the pieces as they are
+/// before this one's fate: that is kept when this one changed none of the pieces the next one
+/// reads (itself and all its neighbours), and the next piece is tried again otherwise, so
+/// the result is the one trying them in turn gives.
 fn merge_small_once(
     ctx: &Charts,
     done: &mut Vec<Laid>,
@@ -91,34 +96,111 @@ fn merge_small_once(
 ) {
     let (small, order) = small_pieces(ctx, done);
     let mut owners = Owners::new(ctx.mesh.faces.len(), done);
-    for si in order {
-        if owners.gone[si] || ctx.area(&done[si].faces) >= small {
-            continue;
-        }
-        let near: Vec<usize> = owners.nearest(ctx, done, si, MERGE_TRIES);
-        // Laid out again as one, else shared out with a neighbour, else grafted onto the
-        // neighbours as they lie.
-        if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
-            done[k] = union;
-            owners.absorb(done, k, si);
-        } else if let Some((k, (ha, hb))) = near.iter().take(REBALANCE_TRIES).find_map(|&k| {
-            failed
-                .attempt(Trial::Share, &done[k], &done[si], || {
-                    rebalance(ctx, done, k, si, small, opts, eps)
+    let mut i = 0;
+    while let Some(&si) = order.get(i) {
+        let next = order.get(i + 1).copied();
+        let (here, beside) = crate::geom::par::speculate(
+            || fate(ctx, done, &owners, si, small, opts, eps, failed),
+            || {
+                next.map(|sj| {
+                    let mut reads = owners.neighbours(ctx, done, sj);
+                    reads.push(sj);
+                    (
+                        fate(ctx, done, &owners, sj, small, opts, eps, failed),
+                        reads,
+                    )
                 })
-                .map(|halves| (k, halves))
-        }) {
-            owners.shared(done, (k, si), (ha, hb));
-        } else if let Some(took) = graft(ctx, done, &near, si, opts.tolerance, eps) {
-            for (k, faces) in took {
-                for f in faces {
-                    owners.owner[f] = k;
-                }
+            },
+        );
+        let changed = here.apply(done, &mut owners, si);
+        i += 1;
+        if let (Some(sj), Some(Some((fate, reads)))) = (next, beside) {
+            if !changed.iter().any(|c| reads.contains(c)) {
+                fate.apply(done, &mut owners, sj);
+                i += 1;
             }
-            owners.gone[si] = true;
         }
     }
     owners.drop_gone(done);
+}
+
+/// What becomes of a small piece in [`merge_small_once`].
+enum Fate {
+    /// Nothing: it is gone or no longer small, or no neighbour takes it.
+    Stays,
+    /// Laid out again as one with neighbour `k`.
+    Merged(usize, Laid),
+    /// Shared out with neighbour `k` (its new layout first).
+    Shared(usize, (Laid, Laid)),
+    /// Grafted onto the neighbours as they lie: each neighbour that takes faces, the faces it
+    /// takes and what it becomes.
+    Grafted(Vec<(usize, Vec<usize>, Laid)>),
+}
+
+/// The fate of the small piece `done[si]` (see [`merge_small`]): laid out again as one with
+/// a neighbour, else shared out with one, else grafted onto the neighbours as they lie.
+#[allow(clippy::too_many_arguments)]
+fn fate(
+    ctx: &Charts,
+    done: &[Laid],
+    owners: &Owners,
+    si: usize,
+    small: f64,
+    opts: &FlattenOptions,
+    eps: f64,
+    failed: &Failed,
+) -> Fate {
+    if owners.gone[si] || ctx.area(&done[si].faces) >= small {
+        return Fate::Stays;
+    }
+    let near: Vec<usize> = owners.nearest(ctx, done, si, MERGE_TRIES);
+    if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
+        return Fate::Merged(k, union);
+    }
+    let shared = near.iter().take(REBALANCE_TRIES).find_map(|&k| {
+        failed
+            .attempt(Trial::Share, &done[k], &done[si], || {
+                rebalance(ctx, done, k, si, small, opts, eps)
+            })
+            .map(|halves| (k, halves))
+    });
+    if let Some((k, halves)) = shared {
+        return Fate::Shared(k, halves);
+    }
+    match graft(ctx, done, &near, si, opts.tolerance, eps) {
+        Some(took) => Fate::Grafted(took),
+        None => Fate::Stays,
+    }
+}
+
+impl Fate {
+    /// Make it so for `done[si]`; the pieces it changed.
+    fn apply(self, done: &mut [Laid], owners: &mut Owners, si: usize) -> Vec<usize> {
+        match self {
+            Fate::Stays => Vec::new(),
+            Fate::Merged(k, union) => {
+                done[k] = union;
+                owners.absorb(done, k, si);
+                vec![k, si]
+            }
+            Fate::Shared(k, halves) => {
+                owners.shared(done, (k, si), halves);
+                vec![k, si]
+            }
+            Fate::Grafted(took) => {
+                let mut changed = vec![si];
+                for (k, faces, laid) in took {
+                    done[k] = laid;
+                    for f in faces {
+                        owners.owner[f] = k;
+                    }
+                    changed.push(k);
+                }
+                owners.gone[si] = true;
+                changed
+            }
+        }
+    }
 }
 
 /// The area under which a piece of `done` is small ([`SMALL_SHARE`] of the whole), and the
@@ -571,6 +653,63 @@ fn merged_defect(ctx: &Charts, defect: &[f64], around: &[usize], a: &Laid, b: &L
 mod tests {
     use super::*;
     use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
+
+    /// A round of small-piece merges, the next piece tried beside each where a thread is
+    /// free, ends as trying them in turn does: two squares of 80 cells and single cells
+    /// round them, each under 1 % of the area: two cells of the 1.5 mm strip under each
+    /// square, and a cell beside the first square with one beside it that touches nothing
+    /// else (decided before the first merges, it would merge into the first, which is gone by
+    /// then). Every piece's faces and layout are the same, bit for bit; and the small cells
+    /// are gone.
+    #[test]
+    fn small_pieces_tried_side_by_side_merge_as_tried_in_turn() {
+        let (mesh, ranges) = strip_and_squares(&[
+            (0..8, 1..11),
+            (12..20, 1..11),
+            (8..9, 1..2),
+            (9..10, 1..2),
+            (11..12, 5..6),
+            (2..3, 0..1),
+            (5..6, 0..1),
+            (15..16, 0..1),
+            (17..18, 0..1),
+        ]);
+        let fx = Fixture::new(mesh);
+        let opts = FlattenOptions::default();
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        let start: Vec<Laid> = ranges
+            .iter()
+            .map(|r| ctx.piece(r.clone().collect()))
+            .collect();
+        let (small, order) = small_pieces(&ctx, &start);
+        // The strip's cells first, two by two; then the two cells one beside the other.
+        assert_eq!(order, [5, 6, 7, 8, 2, 3, 4], "small {small}");
+        let mut side_by_side = start.clone();
+        merge_small_once(&ctx, &mut side_by_side, &opts, eps, &Failed::default());
+        let mut in_turn = start.clone();
+        let failed = Failed::default();
+        let mut owners = Owners::new(ctx.mesh.faces.len(), &in_turn);
+        for si in order {
+            fate(&ctx, &in_turn, &owners, si, small, &opts, eps, &failed).apply(
+                &mut in_turn,
+                &mut owners,
+                si,
+            );
+        }
+        owners.drop_gone(&mut in_turn);
+        assert_eq!(side_by_side.len(), in_turn.len());
+        assert!(
+            side_by_side.len() < start.len(),
+            "{} pieces",
+            side_by_side.len()
+        );
+        for (a, b) in side_by_side.iter().zip(&in_turn) {
+            assert_eq!(a.faces, b.faces);
+            assert_eq!(a.cuts, b.cuts);
+            assert_eq!(a.uv, b.uv);
+        }
+    }
 
     /// One sector of the zigzag cone beside the next four turns 400° round the apex: joined
     /// as they lie, or laid out as one, it folds over the fourth. Shared out where they
