@@ -42,11 +42,9 @@ struct Local {
 
 /// M and D of a triangle with flat corners `p` and 3D shape `shape` (see the module doc).
 fn m_and_d(p: [DVec2; 3], shape: &[DVec2; 3]) -> (DMat2, f64) {
-    let e = |i: usize| p[(i + 2) % 3] - p[(i + 1) % 3];
-    let m = (0..3).fold(DMat2::ZERO, |m, i| {
-        m + DMat2::from_cols(shape[i] * e(i).x, shape[i] * e(i).y)
-    });
-    (m, (p[1] - p[0]).perp_dot(p[2] - p[0]))
+    let e = [p[2] - p[1], p[0] - p[2], p[1] - p[0]];
+    let col = |j: usize| shape[0] * e[0][j] + shape[1] * e[1][j] + shape[2] * e[2][j];
+    (DMat2::from_cols(col(0), col(1)), e[2].perp_dot(-e[1]))
 }
 
 impl Local {
@@ -55,8 +53,13 @@ impl Local {
     fn new(tri: [usize; 3], shape: &[DVec2; 3], a3: f64, c: usize, uv: &[DVec2]) -> Local {
         let p = [uv[tri[0]], uv[tri[1]], uv[tri[2]]];
         let (m, _) = m_and_d(p, shape);
-        let w = shape[(c + 1) % 3] - shape[(c + 2) % 3];
-        let (a, b) = (p[(c + 1) % 3], p[(c + 2) % 3]);
+        let (c1, c2) = match c {
+            0 => (1, 2),
+            1 => (2, 0),
+            _ => (0, 1),
+        };
+        let w = shape[c1] - shape[c2];
+        let (a, b) = (p[c1], p[c2]);
         let d0 = (a - p[c]).perp_dot(b - p[c]);
         Local {
             a3,
