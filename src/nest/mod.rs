@@ -27,7 +27,9 @@
 //! the sheet's y axis (the roll's length), either way, whatever the rotation setting. On a roll,
 //! a few freely turning pieces ([`problem::FEW_ITEMS`]) also try the turns that make them
 //! shortest along it ([`problem::Item::add_shortest_shapes`]), so that a lone piece takes the
-//! least roll; on sheets, a piece that none of its usual turns fits tries them too.
+//! least roll; on sheets, a piece that none of its usual turns fits tries them too, and one
+//! that none of those fits either the whole degree that fits it best
+//! (`Item::add_fitting_shapes`: a long thin piece across the sheet).
 //!
 //! Frames: on sheets the optimiser's container is the sheet inside the margins; on a roll the
 //! optimiser's strip (length along its x) is the roll turned by 90°, so the length used runs
@@ -268,13 +270,17 @@ fn piece_orients(piece: &Piece, opts: &NestOptions) -> Orients {
 }
 
 /// A few pieces on a roll, and a piece that fits a sheet in none of its usual turns, also try
-/// the turns that make them shortest ([`Item::add_shortest_shapes`]); `uw` × `uh` is the room
-/// inside the margins.
+/// the turns that make them shortest ([`Item::add_shortest_shapes`]); a piece that fits a
+/// sheet in none of those either, the whole degree that fits it best
+/// ([`Item::add_fitting_shapes`]). `uw` × `uh` is the room inside the margins.
 fn add_shortest_turns(items: &mut [Item], roll: bool, uw: f64, uh: f64) {
     let few = items.len() <= problem::FEW_ITEMS;
     for it in items.iter_mut() {
         if (roll && few) || (!roll && !it.fits(uw, uh)) {
             it.add_shortest_shapes(if roll { uw } else { uh });
+        }
+        if !roll {
+            it.add_fitting_shapes(uw, uh);
         }
     }
 }

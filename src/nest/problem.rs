@@ -143,6 +143,39 @@ impl Item {
         }
     }
 
+    /// A freely turning item that fits `length` × `height` (a sheet) in none of its
+    /// construction turns may still fit turned between them: a long thin piece across the
+    /// sheet's diagonal. Add the whole degree that leaves it the most room (the larger of
+    /// the two least slacks; ties: the smaller angle), and its half turn, as [`check_fit`]
+    /// looks for a fit among whole degrees.
+    pub(crate) fn add_fitting_shapes(&mut self, length: f64, height: f64) {
+        if !matches!(self.orients, Orients::Free { .. }) || self.fits(length, height) {
+            return;
+        }
+        let hull = crate::geom::polygon::convex_hull(&self.rings[0]);
+        let best = (0..360u32)
+            .filter_map(|d| {
+                let o = Orient {
+                    angle_deg: f64::from(d),
+                    mirror: false,
+                };
+                let (lo, hi) = crate::geom::polygon::bounds(hull.iter().map(|p| o.apply(*p)))?;
+                let slack = (length - (hi.x - lo.x)).min(height - (hi.y - lo.y));
+                (slack >= -1e-9).then_some((slack, d))
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
+        if let Some((_, d)) = best {
+            for deg in [d, (d + 180) % 360] {
+                let o = Orient {
+                    angle_deg: f64::from(deg),
+                    mirror: false,
+                };
+                self.shapes
+                    .push(Arc::new(Shape::new(&self.rings, &self.poles, o)));
+            }
+        }
+    }
+
     /// Whether one of the construction shapes fits in `length` × `height`.
     pub(crate) fn fits(&self, length: f64, height: f64) -> bool {
         self.shapes

@@ -372,6 +372,56 @@ fn split_none_keeps_the_refusal_and_a_face_too_large_is_an_error() {
     );
 }
 
+/// A 300 × 20 mm strip of one face on A4 (200 × 287 mm inside the 5 mm margins) fits no
+/// quarter turn of its least rectangle, but fits across the sheet (whose diagonal inside the
+/// margins is 350 mm): it is cut whole, turned between quarter turns, inside the margins. At
+/// 400 mm, longer than that diagonal, the face is too large.
+#[test]
+fn a_long_thin_face_is_cut_across_the_sheet() {
+    let dir = scratch("split-across");
+    let strip = |len: f64| format!("v 0 0 0\nv {len} 0 0\nv {len} 20 0\nv 0 20 0\nf 1 2 3 4\n");
+    let obj = write(&dir, "strip.obj", &strip(300.0));
+    let out = dir.join("out");
+    let o = flatcut(&[
+        "cut",
+        obj.to_str().unwrap(),
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rep = report(&out);
+    let pieces = rep["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 1);
+    let turn = pieces[0]["rotation_deg"].as_f64().unwrap();
+    let off_quarter = (turn.rem_euclid(90.0)).min(90.0 - turn.rem_euclid(90.0));
+    assert!(off_quarter > 20.0, "turned {turn}°");
+    let b: Vec<f64> = pieces[0]["bbox_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        b[0] >= 5.0 - 1e-6 && b[1] >= 5.0 - 1e-6 && b[2] <= 205.0 + 1e-6 && b[3] <= 292.0 + 1e-6,
+        "box {b:?}"
+    );
+    let long = write(&dir, "long.obj", &strip(400.0));
+    let o = flatcut(&[
+        "cut",
+        long.to_str().unwrap(),
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("face 1 alone is 400.0 × 20.0 mm"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn jobs_that_fit_are_not_split() {
     let mut names: Vec<_> = std::fs::read_dir(manifest("patterns"))

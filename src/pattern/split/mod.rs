@@ -19,7 +19,12 @@
 //! minimum-area rectangle is axis-aligned, at one of four quarter turns (a piece with a grain
 //! line: grain along the sheet's y axis, either way); a piece fits when one of those boxes
 //! lies within the room. The same test is applied to the built pieces, so that a piece that
-//! fits today is never split and the bundled patterns' outputs do not change. Before a part is
+//! fits today is never split and the bundled patterns' outputs do not change. A freely
+//! turning piece that fits a sheet at none of those turns also fits when it does at a whole
+//! degree between them (a long thin piece across the sheet's diagonal), which the nest then
+//! tries; a part of several faces does not count so (parts at quarter turns pack better), a
+//! single face does: it cannot be split further, and the pattern would otherwise be refused.
+//! Before a part is
 //! built, its size is estimated from its faces' corners grown on every side by what the
 //! material adds (tab height or seam allowance, half the kerf); a part that then does not fit
 //! once built has its island split again with the estimate grown by the overflow.
@@ -111,6 +116,32 @@ impl Room {
     }
 }
 
+/// The least overflow (mm) of a point set over the orientations the nest tries (see
+/// [`overflow`]): `angles_deg`, and where it fits a sheet at none of them and may turn freely
+/// (`free`: no grain line), every whole degree, as the nest then does (it adds the whole
+/// degree that leaves the most room to the turns it tries): a long thin piece may fit across
+/// the sheet's diagonal. ≤ 0 fits.
+fn turned_overflow(points: &[DVec2], angles_deg: &[f64], room: &Room, free: bool) -> f64 {
+    let least = overflow(points, angles_deg, room);
+    let Some(height) = room.height else {
+        return least;
+    };
+    if least <= 0.0 || !free {
+        return least;
+    }
+    // Nothing longer than the sheet's diagonal fits it at any turn.
+    let hull = polygon::convex_hull(points);
+    let diameter2 = hull
+        .iter()
+        .flat_map(|p| hull.iter().map(move |q| p.distance_squared(*q)))
+        .fold(0.0, f64::max);
+    if diameter2 > room.width * room.width + height * height {
+        return least;
+    }
+    let whole: Vec<f64> = (0..360).map(f64::from).collect();
+    least.min(overflow(&hull, &whole, room))
+}
+
 /// The least overflow (mm) of a point set over the orientations given (degrees): ≤ 0 fits.
 fn overflow(points: &[DVec2], angles_deg: &[f64], room: &Room) -> f64 {
     angles_deg
@@ -170,7 +201,7 @@ pub fn piece_overflow(piece: &Piece, room: &Room) -> f64 {
         .flatten()
         .copied()
         .collect();
-    overflow(&pts, &angles, room)
+    turned_overflow(&pts, &angles, room, piece.grain.is_none())
 }
 
 /// Whether a built piece fits the room in an orientation the nest tries.
@@ -473,6 +504,55 @@ mod tests {
             mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
             ..Default::default()
         }
+    }
+
+    /// A 300 × 20 mm face on a 190 × 277 mm room (A4 inside 10 mm margins) fits no quarter
+    /// turn of its least rectangle, but fits turned by a whole degree between them: it is
+    /// kept whole. With a grain line, which fixes its turn, it does not fit, and as a part
+    /// that cannot be split it is too large.
+    #[test]
+    fn a_long_thin_face_fits_across_the_room_unless_its_grain_fixes_the_turn() {
+        let strip = crate::surface::Surface {
+            name: "strip".into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(
+                vec![
+                    glam::DVec3::new(0.0, 0.0, 0.0),
+                    glam::DVec3::new(300.0, 0.0, 0.0),
+                    glam::DVec3::new(300.0, 20.0, 0.0),
+                    glam::DVec3::new(0.0, 20.0, 0.0),
+                ],
+                &[[0, 1, 2, 3]],
+            ),
+            ..Default::default()
+        };
+        let room = Room {
+            width: 190.0,
+            height: Some(277.0),
+        };
+        let opts = PatternOptions::default();
+        let mut flats = vec![unfold(strip, &UnfoldOptions::default()).unwrap()];
+        let pieces = build_to_fit(&mut flats, &opts, &room).expect("fits across");
+        assert_eq!(pieces.len(), 1);
+        let outer = &pieces[0].outline[0];
+        let quarters = rect_angles(polygon::min_area_rect_angle(outer), false);
+        assert!(overflow(outer, &quarters, &room) > 10.0);
+        let whole: Vec<f64> = (0..360).map(f64::from).collect();
+        assert!(overflow(outer, &whole, &room) <= 0.0);
+        assert!(fits(&pieces[0], &room));
+        let mut grained = pieces[0].clone();
+        grained.grain = Some(0.0);
+        assert!(!fits(&grained, &room));
+        // Less room than the strip's length across it: too large at any turn.
+        let narrow = Room {
+            width: 150.0,
+            height: Some(250.0),
+        };
+        assert!(!fits(&pieces[0], &narrow));
+        assert!(matches!(
+            build_to_fit(&mut flats, &opts, &narrow),
+            Err(PatternError::TooLarge { .. })
+        ));
     }
 
     /// A flat row of five 100 mm squares on a 250 × 250 mm room: three parts (two squares

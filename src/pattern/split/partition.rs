@@ -23,7 +23,7 @@
 //! largest part's excess area over the mean. On a large cone this gives what a shop lays out:
 //! equal segments joined along rulings, each with its own bend lines.
 
-use super::{overflow, rect_angles, rect_size, Room};
+use super::{rect_angles, rect_size, turned_overflow, Room};
 use crate::flatten::Flat;
 use crate::geom::polygon;
 use crate::pattern::{PatternError, PatternOptions};
@@ -178,7 +178,9 @@ impl<'a> Island<'a> {
             width: self.room.width - 2.0 * grow,
             height: self.room.height.map(|h| h - 2.0 * grow),
         };
-        overflow(&pts, &angles, &room)
+        // A part of several faces fits at the quarter turns the nest packs best; a face on its
+        // own, which cannot be split further, may also fit turned between them.
+        turned_overflow(&pts, &angles, &room, set.len() == 1 && !self.grain)
     }
 
     /// Connected pieces (through joined edges) of a set of local faces, each in set order.
