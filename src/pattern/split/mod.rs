@@ -24,10 +24,10 @@
 //! degree between them (a long thin piece across the sheet's diagonal), which the nest then
 //! tries; a part of several faces does not count so (parts at quarter turns pack better), a
 //! single face does: it cannot be split further, and the pattern would otherwise be refused.
-//! Before a part is
-//! built, its size is estimated from its faces' corners grown on every side by what the
-//! material adds (tab height or seam allowance, half the kerf); a part that then does not fit
-//! once built has its island split again with the estimate grown by the overflow.
+//! Before a part is built, its size is estimated from its faces' corners grown on every side
+//! by what the material adds (tab height or seam allowance, half the kerf); a part that then
+//! does not fit once built has its island split again with the estimate grown by the
+//! overflow.
 //!
 //! **How** the faces of an island are partitioned into parts that fit: `partition::partition`.
 
@@ -508,8 +508,8 @@ mod tests {
 
     /// A 300 × 20 mm face on a 190 × 277 mm room (A4 inside 10 mm margins) fits no quarter
     /// turn of its least rectangle, but fits turned by a whole degree between them: it is
-    /// kept whole. With a grain line, which fixes its turn, it does not fit, and as a part
-    /// that cannot be split it is too large.
+    /// kept whole. With a grain line, which fixes its turn, it does not fit; in a room whose
+    /// diagonal is shorter than the face, it is too large.
     #[test]
     fn a_long_thin_face_fits_across_the_room_unless_its_grain_fixes_the_turn() {
         let strip = crate::surface::Surface {
