@@ -32,6 +32,17 @@ fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     p
 }
 
+/// `flatcut cut OBJ --dry-run -o OUT`, the defaults otherwise (A4).
+fn dry_cut(obj: &Path, out: &Path) -> std::process::Output {
+    flatcut(&[
+        "cut",
+        obj.to_str().unwrap(),
+        "--dry-run",
+        "-o",
+        out.to_str().unwrap(),
+    ])
+}
+
 fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
@@ -356,13 +367,7 @@ fn split_none_keeps_the_refusal_and_a_face_too_large_is_an_error() {
         "panel.obj",
         "v 0 0 0\nv 300 0 0\nv 300 250 0\nv 0 250 0\nv 0 250 50\nv 300 250 50\nf 1 2 3 4\nf 4 3 6 5\n",
     );
-    let o = flatcut(&[
-        "cut",
-        panel.to_str().unwrap(),
-        "--dry-run",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = dry_cut(&panel, &out);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let err = stderr(&o);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -382,13 +387,7 @@ fn a_long_thin_face_is_cut_across_the_sheet() {
     let strip = |len: f64| format!("v 0 0 0\nv {len} 0 0\nv {len} 20 0\nv 0 20 0\nf 1 2 3 4\n");
     let obj = write(&dir, "strip.obj", &strip(300.0));
     let out = dir.join("out");
-    let o = flatcut(&[
-        "cut",
-        obj.to_str().unwrap(),
-        "--dry-run",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = dry_cut(&obj, &out);
     assert!(o.status.success(), "{}", stderr(&o));
     let rep = report(&out);
     let pieces = rep["pieces"].as_array().unwrap();
@@ -407,13 +406,7 @@ fn a_long_thin_face_is_cut_across_the_sheet() {
         "box {b:?}"
     );
     let long = write(&dir, "long.obj", &strip(400.0));
-    let o = flatcut(&[
-        "cut",
-        long.to_str().unwrap(),
-        "--dry-run",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = dry_cut(&long, &out);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("face 1 alone is 400.0 × 20.0 mm"),

@@ -488,6 +488,20 @@ mod tests {
         assert_eq!(names, ["a", "b", "z", "aa", "ab", "zz", "aaa"]);
     }
 
+    /// A surface of the faces `faces` over `verts`, for tests.
+    fn surface<F: AsRef<[usize]>>(
+        name: &str,
+        verts: Vec<glam::DVec3>,
+        faces: &[F],
+    ) -> crate::surface::Surface {
+        crate::surface::Surface {
+            name: name.into(),
+            source: "t.obj".into(),
+            mesh: crate::geom::mesh::Mesh::from_polygons(verts, faces),
+            ..Default::default()
+        }
+    }
+
     /// A flat row of `n` squares of `side` mm along x, as one surface.
     pub(super) fn row_of_squares(n: usize, side: f64) -> crate::surface::Surface {
         let mut verts = Vec::new();
@@ -498,12 +512,7 @@ mod tests {
         let faces: Vec<[usize; 4]> = (0..n)
             .map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1])
             .collect();
-        crate::surface::Surface {
-            name: "row".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
-            ..Default::default()
-        }
+        surface("row", verts, &faces)
     }
 
     /// A 300 × 20 mm face on a 190 × 277 mm room (A4 inside 10 mm margins) fits no quarter
@@ -512,20 +521,9 @@ mod tests {
     /// diagonal is shorter than the face, it is too large.
     #[test]
     fn a_long_thin_face_fits_across_the_room_unless_its_grain_fixes_the_turn() {
-        let strip = crate::surface::Surface {
-            name: "strip".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(
-                vec![
-                    glam::DVec3::new(0.0, 0.0, 0.0),
-                    glam::DVec3::new(300.0, 0.0, 0.0),
-                    glam::DVec3::new(300.0, 20.0, 0.0),
-                    glam::DVec3::new(0.0, 20.0, 0.0),
-                ],
-                &[[0, 1, 2, 3]],
-            ),
-            ..Default::default()
-        };
+        let corners = [(0.0, 0.0), (300.0, 0.0), (300.0, 20.0), (0.0, 20.0)];
+        let verts = corners.map(|(x, y)| glam::DVec3::new(x, y, 0.0)).to_vec();
+        let strip = surface("strip", verts, &[[0, 1, 2, 3]]);
         let room = Room {
             width: 190.0,
             height: Some(277.0),
@@ -614,12 +612,7 @@ mod tests {
                 faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
             }
         }
-        crate::surface::Surface {
-            name: "sheet".into(),
-            source: "t.obj".into(),
-            mesh: crate::geom::mesh::Mesh::from_polygons(verts, &faces),
-            ..Default::default()
-        }
+        surface("sheet", verts, &faces)
     }
 
     /// Regression (blade in fabric at 3,000 mm on A4 went on for over 5 minutes): when
