@@ -1,5 +1,6 @@
 //! Sparse matrices for the crate's Cholesky solves (faer): a compressed-column matrix
-//! assembled from (row, column, value) triplets.
+//! assembled from (row, column, value) triplets, and a factorisation kept for every system of
+//! one pattern ([`Cholesky`]).
 //!
 //! Choices: the triplets are bucketed by column (a counting sort, linear in their number),
 //! each column sorted by row and its repeated entries summed in the order given, so the
@@ -7,9 +8,18 @@
 //! with a comparison sort). A solver that assembles systems of one pattern again and again
 //! (Newton steps, one chart laid twice) keeps the [`Pattern`]: where each triplet's value goes,
 //! so the next system of that pattern is filled in one pass, its values summed in the same
-//! order and so the same to the bit.
+//! order and so the same to the bit. Its [`Cholesky`] keeps the ordering and symbolic
+//! factorisation (faer's defaults, as its `Llt` solver makes them) with the numeric factor's
+//! storage and work space, so a Newton step allocates nothing for its solve.
 
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::{Conj, MatMut, Par, Side};
 
 /// The `n` × `n` matrix with the sum of the `triplets`' values at each (row, column) they
 /// name; `None` when an index is `n` or more.
@@ -110,6 +120,68 @@ impl Pattern {
     }
 }
 
+/// A sparse Cholesky factorisation kept for systems of one [`Pattern`]: the fill-reducing
+/// ordering and symbolic factorisation made once, the numeric factor and the work space
+/// reused by every system factorised with it.
+pub struct Cholesky {
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    scratch: MemBuffer,
+}
+
+impl Cholesky {
+    /// The symbolic factorisation of `pattern`'s lower triangle; `None` where faer cannot
+    /// order it (out of memory, an index overflow).
+    pub fn new(pattern: &Pattern) -> Option<Cholesky> {
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic().as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .ok()?;
+        let req = symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(2, Par::Seq));
+        let scratch = MemBuffer::try_new(req).ok()?;
+        Some(Cholesky {
+            values: vec![0.0; symbolic.len_val()],
+            symbolic,
+            scratch,
+        })
+    }
+
+    /// Factorise `a` (of the pattern this was made for, its lower triangle given); false
+    /// where it is not numerically positive definite.
+    pub fn factor(&mut self, a: &SparseColMat<usize, f64>) -> bool {
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut self.values,
+                a.as_ref(),
+                Side::Lower,
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut self.scratch),
+                Default::default(),
+            )
+            .is_ok()
+    }
+
+    /// Solve the last factorised system in place for one or two right-hand sides: `x` holds
+    /// them one after the other (`cols` of them), then the solutions.
+    pub fn solve(&mut self, x: &mut [f64], cols: usize) {
+        let cols = cols.clamp(1, 2);
+        let n = x.len() / cols;
+        let llt = LltRef::new(&self.symbolic, &self.values);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut x[..n * cols], n, cols),
+            Par::Seq,
+            MemStack::new(&mut self.scratch),
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,5 +238,49 @@ mod tests {
         assert!(!p.fits(3, &[again[1], again[0], again[2], again[3], again[4]]));
         assert!(!p.fits(3, &again[..4]));
         assert!(!p.fits(4, &again));
+    }
+
+    #[test]
+    fn a_kept_factorisation_solves_every_system_of_its_pattern() {
+        let t = |r, c, v| Triplet::new(r, c, v);
+        // A path graph's Laplacian plus the identity (lower triangle), then twice it.
+        let system = |k: f64| -> Vec<Triplet<usize, usize, f64>> {
+            let mut trip = Vec::new();
+            for i in 0..5 {
+                trip.push(t(i, i, k * if i == 0 || i == 4 { 2.0 } else { 3.0 }));
+                if i > 0 {
+                    trip.push(t(i, i - 1, -k));
+                }
+            }
+            trip
+        };
+        let product = |trip: &[Triplet<usize, usize, f64>], x: &[f64]| -> Vec<f64> {
+            let mut y = vec![0.0; 5];
+            for e in trip {
+                y[e.row] += e.val * x[e.col];
+                if e.row != e.col {
+                    y[e.col] += e.val * x[e.row];
+                }
+            }
+            y
+        };
+        let p = Pattern::new(5, &system(1.0)).unwrap();
+        let mut chol = Cholesky::new(&p).unwrap();
+        for k in [1.0, 2.0] {
+            let trip = system(k);
+            assert!(chol.factor(&p.matrix(&trip)));
+            // Two right-hand sides at once, one after the other.
+            let rhs: Vec<f64> = (0..10).map(|i| (i * i) as f64 - 3.0).collect();
+            let mut x = rhs.clone();
+            chol.solve(&mut x, 2);
+            for c in 0..2 {
+                let back = product(&trip, &x[5 * c..5 * c + 5]);
+                for (b, r) in back.iter().zip(&rhs[5 * c..5 * c + 5]) {
+                    assert!((b - r).abs() < 1e-12, "{b} against {r} at k = {k}");
+                }
+            }
+        }
+        // Not positive definite: refused.
+        assert!(!chol.factor(&p.matrix(&system(-1.0))));
     }
 }

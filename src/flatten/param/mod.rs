@@ -51,12 +51,9 @@
 
 use super::distortion::{self, corner_angle, face_triangles, Stretch};
 use crate::geom::mesh::Mesh;
-use crate::geom::sparse::Pattern;
+use crate::geom::sparse::{Cholesky, Pattern};
 use crate::geom::unionfind::UnionFind;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::Triplet;
-use faer::{Mat, Side};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
@@ -574,7 +571,7 @@ fn shape_from_angles(a: [f64; 3]) -> [DVec2; 3] {
 /// and again from ABF++'s angles).
 pub(super) struct Solver {
     pattern: Pattern,
-    symbolic: SymbolicLlt<usize>,
+    factor: Cholesky,
 }
 
 /// Solve a symmetric positive definite system given by its lower-triangle triplets, with the
@@ -600,19 +597,17 @@ fn spd_solve(
                     "cannot build the sparse system: an index out of range",
                 )
             })?;
-            let symbolic =
-                SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower).map_err(|e| {
-                    chart.solver_error(method, format!("cannot order the sparse system: {e:?}"))
-                })?;
-            solver.insert(Solver { pattern, symbolic })
+            let factor = Cholesky::new(&pattern)
+                .ok_or_else(|| chart.solver_error(method, "cannot order the sparse system"))?;
+            solver.insert(Solver { pattern, factor })
         }
     };
     let a = solver.pattern.matrix(triplets);
-    let llt = Llt::try_new_with_symbolic(solver.symbolic.clone(), a.as_ref(), Side::Lower)
-        .map_err(|e| chart.solver_error(method, format!("the system is singular ({e:?})")))?;
-    let b = Mat::<f64>::from_fn(n, 1, |i, _| rhs[i]);
-    let x = llt.solve(&b);
-    let mut out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    if !solver.factor.factor(&a) {
+        return Err(chart.solver_error(method, "the system is singular"));
+    }
+    let mut out = rhs.to_vec();
+    solver.factor.solve(&mut out, 1);
     // `refine` steps of iterative refinement: the residual b − A x (A from its lower
     // triangle) solved again and added; LSCM takes two, which brings an exactly developable
     // chart to isometry within rounding (seam sides equal to 1e-9 mm and better).
@@ -624,9 +619,9 @@ fn spd_solve(
                 r[t.col] -= t.val * out[t.row];
             }
         }
-        let d = llt.solve(&Mat::<f64>::from_fn(n, 1, |i, _| r[i]));
-        for (i, o) in out.iter_mut().enumerate() {
-            *o += d[(i, 0)];
+        solver.factor.solve(&mut r, 1);
+        for (o, d) in out.iter_mut().zip(&r) {
+            *o += d;
         }
     }
     if out.iter().any(|v| !v.is_finite()) {

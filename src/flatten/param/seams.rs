@@ -30,11 +30,8 @@
 use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
-use crate::geom::sparse::Pattern;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use crate::geom::sparse::{Cholesky, Pattern};
 use faer::sparse::Triplet;
-use faer::{Mat, Side};
 use glam::DVec2;
 
 /// Boundary weights, in turn (the cotangent weights are of order 1).
@@ -159,7 +156,7 @@ fn relax(
     let n = uv.len();
     // The pinned vertex keeps its place softly: translation is free in the energy.
     let pin = edges.first().map_or(0, |e| e.0);
-    let mut solver: Option<(Pattern, SymbolicLlt<usize>)> = None;
+    let mut solver: Option<(Pattern, Cholesky)> = None;
     for &w in &WEIGHTS {
         let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(tris.len() * 9);
         let mut add = |i: usize, j: usize, c: f64| {
@@ -180,12 +177,13 @@ fn relax(
         // factorisation.
         if !solver.as_ref().is_some_and(|s| s.0.fits(n, &trip)) {
             let pattern = Pattern::new(n, &trip)?;
-            let sym = SymbolicLlt::try_new(pattern.symbolic().as_ref(), Side::Lower).ok()?;
-            solver = Some((pattern, sym));
+            let factor = Cholesky::new(&pattern)?;
+            solver = Some((pattern, factor));
         }
-        let (pattern, sym) = solver.as_ref()?;
-        let m = pattern.matrix(&trip);
-        let llt = Llt::try_new_with_symbolic(sym.clone(), m.as_ref(), Side::Lower).ok()?;
+        let (pattern, factor) = solver.as_mut()?;
+        if !factor.factor(&pattern.matrix(&trip)) {
+            return None;
+        }
         for _ in 0..ITERATIONS {
             let mut rhs = vec![DVec2::ZERO; n];
             for ((tri, s), c) in tris.iter().zip(shapes).zip(cots) {
@@ -219,15 +217,14 @@ fn relax(
                 rhs[b] -= w * t;
             }
             rhs[pin] += uv[pin];
-            let x = llt.solve(&Mat::<f64>::from_fn(n, 2, |i, k| {
-                if k == 0 {
-                    rhs[i].x
-                } else {
-                    rhs[i].y
-                }
-            }));
+            let mut x: Vec<f64> = rhs
+                .iter()
+                .map(|r| r.x)
+                .chain(rhs.iter().map(|r| r.y))
+                .collect();
+            factor.solve(&mut x, 2);
             for (i, p) in uv.iter_mut().enumerate() {
-                *p = DVec2::new(x[(i, 0)], x[(i, 1)]);
+                *p = DVec2::new(x[i], x[n + i]);
             }
             if uv.iter().any(|p| !p.is_finite()) {
                 return None;
