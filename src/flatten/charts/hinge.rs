@@ -28,7 +28,9 @@
 //! overlap, they are split between the overlapping faces into two parts, one or both under
 //! the small share (a narrow arm of the neighbour that the piece folds over, say), and each
 //! small part joined to a piece next to it in any of the ways above; the small piece is gone,
-//! and the neighbour too where both parts were small.
+//! and the neighbour too where both parts were small. Last of all, it is laid out anew with
+//! a neighbour as one with none of their cuts but those the union needs to be a disk
+//! ([`uncut_merge`]: a piece filling a hole of its neighbour).
 //!
 //! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
 //! share is hinged in parts so too (after the small pieces): the pattern stage would split it
@@ -56,7 +58,7 @@
 use super::join::{common, fits_room, Common};
 use super::merge::{pass_apart, share_across, share_apart, small_pieces, MERGE_TRIES};
 use super::overlap::{first_merge, keeps, self_overlap, Failed, Owners, Trial};
-use super::slit::{dart_merge, slit_merge, SLIT_TRIES};
+use super::slit::{dart_merge, slit_merge, uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::bisect;
@@ -159,6 +161,12 @@ pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOpti
                 owners.absorb(done, k, si);
                 any = true;
             } else if pass_on(&try_onto, done, &mut owners, si, small) {
+                any = true;
+            } else if let Some((k, l)) =
+                try_onto.merge(done, &owners, si, (Trial::Uncut, uncut_merge))
+            {
+                done[k] = l;
+                owners.absorb(done, k, si);
                 any = true;
             }
         }

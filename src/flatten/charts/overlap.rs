@@ -432,6 +432,8 @@ pub(super) enum Trial {
     /// Shared out where the two overlap, the smaller part hinged onto a piece next to it
     /// ([`super::hinge`]'s `pass_on`).
     Pass,
+    /// Laid out as one without the cuts of either ([`super::slit::uncut_merge`]).
+    Uncut,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A

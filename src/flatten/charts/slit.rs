@@ -23,6 +23,11 @@
 //! A small piece on a bump of the surface (positive curvature) stretches the two as one past
 //! the tolerance instead: they are laid out as one and relieved by darts as a chart over the
 //! tolerance is ([`dart_merge`]; [`super::darts`]).
+//!
+//! Last, the two are laid out anew as one with none of their cuts but those the union needs
+//! to be a disk ([`uncut_merge`]): a merge keeps the cuts of both, but a small piece that
+//! fills a hole of its neighbour leaves the seam that opened the hole useless, and that seam
+//! can be what makes the union overlap.
 
 use super::darts::{darts, DART_MIN_FACES};
 use super::join::fits_room;
@@ -81,6 +86,37 @@ pub(super) fn dart_merge(
         return None;
     }
     darts(ctx, &mut l, opts, eps).ok()?;
+    (keeps(ctx, &l, opts, eps) && fits_room(opts.room, &l.uv)).then_some(l)
+}
+
+/// `done[part]` and `done[k]` laid out anew as one with only the cuts the two as one need to
+/// be a disk, where those are not the cuts of both (see the module doc): a small piece that
+/// fills a hole of its neighbour (a region cut off it, a gusset) leaves the seam that opened
+/// the hole useless, and the slits and darts of both were made for each alone. `None` unless
+/// the union is kept as a merge is and fits the sheet.
+pub(super) fn uncut_merge(
+    ctx: &Charts,
+    done: &[Laid],
+    k: usize,
+    part: usize,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<Laid> {
+    let (faces, both) = as_one(ctx, &done[k], &done[part])?;
+    let cuts = ctx.disk(&faces, &[])?;
+    if cuts == both {
+        return None;
+    }
+    let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &cuts) else {
+        return None;
+    };
+    let l = Laid {
+        faces,
+        cuts,
+        uv,
+        stretch,
+        gusset: false,
+    };
     (keeps(ctx, &l, opts, eps) && fits_room(opts.room, &l.uv)).then_some(l)
 }
 
@@ -228,10 +264,52 @@ impl<'a> Fans<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flatten::charts::{zigzag_cone, Fixture};
+    use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
     use crate::geom::mesh::{Face, Mesh};
     use crate::surface::MaterialKind;
     use glam::DVec3;
+
+    /// A ring of eight cells round one cell: laid alone, the ring needs a seam from its hole
+    /// to its rim. Merged with the cell that fills the hole, the two are a disk: the union is
+    /// laid without the seam, every face in one piece. A cell beside the ring's rim leaves
+    /// the same cuts: no such merge.
+    #[test]
+    fn a_piece_filling_its_neighbours_hole_merges_without_the_seam_that_opened_it() {
+        let (mesh, blocks) = strip_and_squares(&[
+            (0..3, 1..2),
+            (0..1, 2..3),
+            (2..3, 2..3),
+            (0..3, 3..4),
+            (1..2, 2..3),
+            (3..4, 1..2),
+        ]);
+        let fx = Fixture::new(mesh);
+        let opts = FlattenOptions::default();
+        let ctx = fx.charts(&opts);
+        let ring: Vec<usize> = blocks[..4].iter().flat_map(|b| b.clone()).collect();
+        let seam = ctx.disk(&ring, &[]).expect("a ring is cut into a disk");
+        assert!(!seam.is_empty());
+        let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&ring, &seam) else {
+            panic!("the ring is not laid");
+        };
+        let done = vec![
+            Laid {
+                faces: ring.clone(),
+                cuts: seam,
+                uv,
+                stretch,
+                gusset: false,
+            },
+            ctx.piece(blocks[4].clone().collect()),
+            ctx.piece(blocks[5].clone().collect()),
+        ];
+        let eps = 1e-6;
+        let l = uncut_merge(&ctx, &done, 0, 1, &opts, eps).expect("merged without the seam");
+        assert!(l.cuts.is_empty(), "cuts {:?}", l.cuts);
+        assert_eq!(l.faces.len(), ring.len() + 2);
+        assert!(l.stretch.l2 < 1.0 + 1e-9, "L2 {}", l.stretch.l2);
+        assert!(uncut_merge(&ctx, &done, 0, 2, &opts, eps).is_none());
+    }
 
     /// Five sectors of the cone as one chart turn 400° round the apex on its border: one
     /// slit from the apex into the chart splits them into two wedges under a full turn, and
