@@ -283,7 +283,9 @@ fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
 /// of the area became 5 (40 pieces became 38); shared out with a neighbour where the two
 /// overlap (`flatten::charts::merge::share_apart`), 3 are. A piece of two faces filling a
 /// hole of its neighbour, which no merge took with the seam that opened the hole, is laid
-/// out with it without that seam (`flatten::charts::slit::uncut_merge`): 2 are (37 pieces).
+/// out with it without that seam (`flatten::charts::slit::uncut_merge`): 2 are (37 pieces);
+/// tried so with the small-piece merges already (where the merge with the cuts failed
+/// within the tolerance), none is (33 pieces).
 #[test]
 fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     require_shared!();
@@ -291,8 +293,8 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 2, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 37, "{} pieces", r.pieces);
+    assert_eq!(r.small, 0, "pieces under 1 % of the area");
+    assert!(r.pieces <= 33, "{} pieces", r.pieces);
 }
 
 /// Issue 20, items 2 and 3: cow in metal (L2 1.001) at 300 mm on A4. Charts still over the

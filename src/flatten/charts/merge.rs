@@ -9,7 +9,12 @@
 //! then another round, while the last one merged any (a piece that failed early may fit a
 //! neighbour a later merge has changed; a pair that failed is not tried again while neither
 //! piece has changed: [`super::overlap::Failed`]). The merged chart keeps the cuts of both
-//! (and more where it is not a disk). A small piece that no neighbour takes is shared out
+//! (and more where it is not a disk). Where that fails but not for being over the tolerance,
+//! the small piece is laid out anew with one of its [`SLIT_TRIES`] nearest with none of
+//! their cuts but those the two as one need to be a disk ([`uncut_merge`]): a piece filling a
+//! hole of its neighbour leaves useless the seam that opened the hole, which can make the two
+//! as one overlap; a union over the tolerance with its cuts would only be more so without
+//! them. A small piece that no neighbour takes is shared out
 //! with one of its [`REBALANCE_TRIES`] nearest: the two are halved anew (into halves of equal
 //! area where the bisector would leave one small) and kept as the halves when neither half
 //! is small and both keep the tolerance (`rebalance`; the count of pieces stays);
@@ -54,6 +59,7 @@ use super::join::{fits_room, moved_onto};
 use super::overlap::{
     both_cuts, first_merge, keeps, laid_as_one, overlaps, self_overlap, Failed, Owners, Trial,
 };
+use super::slit::{uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between, split_between_area};
@@ -155,6 +161,22 @@ fn fate(
     }
     let near: Vec<usize> = owners.nearest(ctx, done, si, MERGE_TRIES);
     if let Some((k, union)) = first_merge(ctx, done, &near, si, opts, eps, failed) {
+        return Fate::Merged(k, union);
+    }
+    // Without the cuts the two as one do not need, where the union with them was not over
+    // the tolerance (see `Trial::Stretched`).
+    let uncut = near
+        .iter()
+        .take(SLIT_TRIES)
+        .filter(|&&k| !failed.known(Trial::Stretched, &done[k], &done[si]))
+        .find_map(|&k| {
+            failed
+                .attempt(Trial::Uncut, &done[k], &done[si], || {
+                    uncut_merge(ctx, done, k, si, opts, eps)
+                })
+                .map(|l| (k, l))
+        });
+    if let Some((k, union)) = uncut {
         return Fate::Merged(k, union);
     }
     let shared = near.iter().take(REBALANCE_TRIES).find_map(|&k| {
@@ -708,6 +730,44 @@ mod tests {
             assert_eq!(a.faces, b.faces);
             assert_eq!(a.cuts, b.cuts);
             assert_eq!(a.uv, b.uv);
+        }
+    }
+
+    /// Two halves of a fan of six triangles round an apex: flat, they merge; with the apex
+    /// raised (305° round it) the two as one are over the tolerance, and that is noted
+    /// (`Trial::Stretched`), so that they are not laid out again with fewer cuts
+    /// (`uncut_merge`: less room, not more).
+    #[test]
+    fn a_merge_over_the_tolerance_is_noted_as_such() {
+        use crate::geom::mesh::{Face, Mesh};
+        use glam::DVec3;
+        let fan = |h: f64| {
+            let mut vertices = vec![DVec3::new(0.0, 0.0, h)];
+            for i in 0..6 {
+                let a = std::f64::consts::TAU * i as f64 / 6.0;
+                vertices.push(DVec3::new(10.0 * a.cos(), 10.0 * a.sin(), 0.0));
+            }
+            let faces = (0..6)
+                .map(|i| Face {
+                    verts: vec![0, 1 + i, 1 + (i + 1) % 6],
+                    line: None,
+                })
+                .collect();
+            Mesh { vertices, faces }
+        };
+        for (h, over) in [(0.0, false), (6.0, true)] {
+            let fx = Fixture::new(fan(h));
+            let opts = FlattenOptions::default();
+            let ctx = fx.charts(&opts);
+            let done = vec![ctx.piece((0..3).collect()), ctx.piece((3..6).collect())];
+            let failed = Failed::default();
+            let got = first_merge(&ctx, &done, &[0], 1, &opts, 1e-6, &failed);
+            assert_eq!(got.is_none(), over, "apex at {h} mm");
+            assert_eq!(
+                failed.known(Trial::Stretched, &done[0], &done[1]),
+                over,
+                "apex at {h} mm"
+            );
         }
     }
 

@@ -394,7 +394,7 @@ pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> 
 /// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
 /// the union, as trying them in order finds it; two are tried at a time where a spare thread
 /// is free ([`crate::geom::par::first`]). A pair `failed` already is skipped; one that fails
-/// now is noted there.
+/// now is noted there, and so is a union over the tolerance ([`Trial::Stretched`]).
 pub(super) fn first_merge(
     ctx: &Charts,
     done: &[Laid],
@@ -406,7 +406,11 @@ pub(super) fn first_merge(
 ) -> Option<(usize, Laid)> {
     crate::geom::par::first(near, |&k| {
         failed.attempt(Trial::Merge, &done[k], &done[part], || {
-            merged(ctx, done, k, part, opts, eps)
+            let l = laid_as_one(ctx, done, k, part)?;
+            if l.stretch.l2 > opts.tolerance {
+                failed.note(Trial::Stretched, &done[k], &done[part]);
+            }
+            Some(l).filter(|l| keeps(ctx, l, opts, eps))
         })
     })
     .map(|(i, l)| (near[i], l))
@@ -434,6 +438,9 @@ pub(super) enum Trial {
     Pass,
     /// Laid out as one without the cuts of either ([`super::slit::uncut_merge`]).
     Uncut,
+    /// Laid out as one with the cuts of both ([`first_merge`]), over the tolerance: with fewer
+    /// cuts the layout has less room, not more, so [`Trial::Uncut`] is not tried.
+    Stretched,
 }
 
 /// Pairs of pieces, as they are laid (faces, cuts, layout), that a [`Trial`] failed on. A
@@ -463,8 +470,15 @@ impl Failed {
         half(0) << 64 | half(1)
     }
 
+    /// Note that `trial` failed on `a` and `b` as they are.
+    pub(super) fn note(&self, trial: Trial, a: &Laid, b: &Laid) {
+        let key = Self::key(trial, a, b);
+        if let Ok(mut s) = self.0.lock() {
+            s.insert(key);
+        }
+    }
+
     /// Whether `trial` failed on `a` and `b` as they are.
-    #[cfg(test)]
     pub(super) fn known(&self, trial: Trial, a: &Laid, b: &Laid) -> bool {
         let key = Self::key(trial, a, b);
         self.0.lock().is_ok_and(|s| s.contains(&key))
