@@ -1,6 +1,7 @@
 //! 2D polygons: signed area, containment, convex hull, minimum-area bounding rectangle,
-//! ear-clipping triangulation, a separating-axis overlap test for triangles, and where a line
-//! crosses a polygon (`line_crossings`, `line_intervals`).
+//! ear-clipping triangulation, a separating-axis overlap test for triangles, where a line
+//! crosses a polygon (`line_crossings`, `line_intervals`), and a ring cut down to a box
+//! (`clip_to_box`).
 //!
 //! Conventions: a polygon is a slice of points without the closing duplicate; counter-clockwise
 //! rings have positive area. Overlap tests take a tolerance: shapes that only touch (share an
@@ -30,6 +31,51 @@ pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> Option<(DVec2, DVec2)>
     let mut it = points.into_iter();
     let first = it.next()?;
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+/// The ring cut down to the box `lo`..`hi` (Sutherland–Hodgman, one side of the box at a
+/// time): each stretch of the ring beyond a side is replaced by the straight run along that
+/// side between where it leaves and comes back. A point strictly inside the box has the same
+/// winding number about the result as about the ring (a stretch and the run that replaces
+/// it close a loop outside the box), so a boolean under the non-zero rule is the same there
+/// with the rings cut down; the result may run back and forth along the sides, and is empty
+/// when the ring lies beyond one side. Work linear in the ring's points.
+pub fn clip_to_box(ring: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
+    let mut out = ring.to_vec();
+    for (axis, bound, below) in [
+        (0, lo.x, false),
+        (0, hi.x, true),
+        (1, lo.y, false),
+        (1, hi.y, true),
+    ] {
+        let coord = |p: DVec2| if axis == 0 { p.x } else { p.y };
+        let inside = |p: DVec2| {
+            if below {
+                coord(p) <= bound
+            } else {
+                coord(p) >= bound
+            }
+        };
+        let mut next = Vec::with_capacity(out.len());
+        for i in 0..out.len() {
+            let (a, b) = (out[i], out[(i + 1) % out.len()]);
+            if inside(a) {
+                next.push(a);
+            }
+            if inside(a) != inside(b) {
+                let t = (bound - coord(a)) / (coord(b) - coord(a));
+                let mut x = a + (b - a) * t;
+                if axis == 0 {
+                    x.x = bound;
+                } else {
+                    x.y = bound;
+                }
+                next.push(x);
+            }
+        }
+        out = next;
+    }
+    out
 }
 
 /// Even-odd point-in-polygon test (points on the boundary may go either way).
@@ -426,6 +472,55 @@ pub fn line_intervals(rings: &[Vec<DVec2>], p: DVec2, d: DVec2) -> Vec<(f64, f64
 
 #[cfg(test)]
 mod tests {
+
+    /// A comb (concave, its teeth crossing the box's sides) cut down to a box: every point
+    /// strictly inside the box is inside the cut ring exactly when it is inside the comb; a
+    /// ring round the whole box becomes the box; a ring beyond a side is gone.
+    #[test]
+    fn a_ring_cut_down_to_a_box_fills_the_box_as_it_did() {
+        let mut comb = vec![DVec2::new(0.0, 0.0), DVec2::new(100.0, 0.0)];
+        for k in (0..5).rev() {
+            let x = 20.0 * k as f64;
+            comb.extend([
+                DVec2::new(x + 20.0, 80.0),
+                DVec2::new(x + 10.0, 80.0),
+                DVec2::new(x + 10.0, 20.0),
+            ]);
+            comb.push(DVec2::new(x, 20.0 + 3.0 * k as f64));
+        }
+        comb.pop();
+        comb.push(DVec2::new(0.0, 80.0));
+        let (lo, hi) = (DVec2::new(15.0, 10.0), DVec2::new(72.0, 50.0));
+        let cut = clip_to_box(&comb, lo, hi);
+        assert!(cut.len() >= 3 && cut.len() < 3 * comb.len());
+        let mut inside = 0;
+        for i in 1..57 {
+            for j in 1..40 {
+                let p = lo + DVec2::new(i as f64 + 0.37, j as f64 + 0.61);
+                assert!(p.x < hi.x && p.y < hi.y);
+                assert_eq!(contains(&cut, p), contains(&comb, p), "at {p}");
+                inside += contains(&comb, p) as usize;
+            }
+        }
+        assert!(
+            inside > 100 && inside < 56 * 39 - 100,
+            "{inside} points inside"
+        );
+        let square = [
+            DVec2::new(-1e3, -1e3),
+            DVec2::new(1e3, -1e3),
+            DVec2::new(1e3, 1e3),
+            DVec2::new(-1e3, 1e3),
+        ];
+        let boxed = clip_to_box(&square, lo, hi);
+        assert!((signed_area(&boxed) - (hi - lo).x * (hi - lo).y).abs() < 1e-9);
+        let beyond: Vec<DVec2> = square
+            .iter()
+            .map(|&q| q * 0.01 + DVec2::new(200.0, 0.0))
+            .collect();
+        assert!(clip_to_box(&beyond, lo, hi).is_empty());
+    }
+
     use super::*;
 
     fn v(x: f64, y: f64) -> DVec2 {

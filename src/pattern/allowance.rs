@@ -14,7 +14,9 @@
 //! to side A); tabs are placed in seam order, so the result is deterministic. The tab's fold
 //! is a mountain fold along the seam (the tab folds behind the printed side), bending by the
 //! surface's angle there. Other pieces are the nest stage's business: the tabs are part of
-//! the outline it nests.
+//! the outline it nests. What a tab loses is worked out over a box round its band only (the
+//! piece's rings and the tabs placed cut down to it, `polygon::clip_to_box`), so a piece of
+//! thousands of border segments and tabs costs per tab what lies near that tab.
 //!
 //! **Seam allowance** (fabric): the border offset outward by `allowance` mm with mitred
 //! corners (corners sharper than 30° are bevelled); holes shrink by the same amount. The
@@ -325,9 +327,21 @@ fn tab_region(p: &Piece, si: usize, gaps: &[Vec<DVec2>], h: f64) -> Option<Candi
     let tn = (chain[n - 1] - chain[n - 2]).try_normalize()?;
     let (o0, on) = (-t0.perp(), -tn.perp());
     let band = boolean::band(chain, h);
+    // The clip is only needed over the band: every ring is cut down to a box round it
+    // (`polygon::clip_to_box`, which leaves the fill inside the box as it was), so a tab costs
+    // work for what lies near it, not for the whole outline and every tab placed before.
+    let (wlo, whi) = polygon::bounds(band.iter().flatten().flatten().copied())?;
+    let (wlo, whi) = (wlo - DVec2::splat(TAB_GAP), whi + DVec2::splat(TAB_GAP));
+    let window = |ring: &Vec<DVec2>| -> Option<Vec<DVec2>> {
+        let (rlo, rhi) = polygon::bounds(ring.iter().copied())?;
+        if rhi.x < wlo.x || rlo.x > whi.x || rhi.y < wlo.y || rlo.y > whi.y {
+            return None;
+        }
+        Some(polygon::clip_to_box(ring, wlo, whi)).filter(|r| r.len() >= 3)
+    };
     // Clip: the piece itself, the 45° corners at both ends, the gap to the piece's other
     // border segments nearby and to the tabs already placed.
-    let mut clip: Vec<Vec<DVec2>> = p.border.clone();
+    let mut clip: Vec<Vec<DVec2>> = p.border.iter().filter_map(window).collect();
     let e = 0.01 * h + 1e-3;
     let big = 2.0 * h + 1.0;
     // Beyond the 45° lines from the chain's ends, outward: a quad at each end.
@@ -368,7 +382,7 @@ fn tab_region(p: &Piece, si: usize, gaps: &[Vec<DVec2>], h: f64) -> Option<Candi
             }
         }
     }
-    clip.extend(gaps.iter().cloned());
+    clip.extend(gaps.iter().filter_map(window));
     // Non-zero winding over the clip rings: the piece's holes (clockwise) stay open unless
     // something else (a gap band, a placed tab) covers them.
     let rest = boolean::difference(&boolean::rings(band), &clip);
