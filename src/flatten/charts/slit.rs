@@ -55,17 +55,7 @@ pub(super) fn slit_merge(
 ) -> Option<Laid> {
     let (faces, cuts) = as_one(ctx, &done[k], &done[part])?;
     let cuts = slit_saddles(ctx, &faces, &cuts)?;
-    let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &cuts) else {
-        return None;
-    };
-    let l = Laid {
-        faces,
-        cuts,
-        uv,
-        stretch,
-        gusset: false,
-    };
-    (keeps(ctx, &l, opts, eps) && fits_room(opts.room, &l.uv)).then_some(l)
+    laid_anew(ctx, faces, cuts, opts, eps)
 }
 
 /// `done[part]` and `done[k]` laid out as one ([`laid_as_one`]) and, where that is over the
@@ -107,6 +97,18 @@ pub(super) fn uncut_merge(
     if cuts == both {
         return None;
     }
+    laid_anew(ctx, faces, cuts, opts, eps)
+}
+
+/// `faces` opened along `cuts` laid out anew, when kept as a merge is ([`keeps`]) and fitting
+/// the sheet.
+fn laid_anew(
+    ctx: &Charts,
+    faces: Vec<usize>,
+    cuts: Vec<usize>,
+    opts: &FlattenOptions,
+    eps: f64,
+) -> Option<Laid> {
     let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&faces, &cuts) else {
         return None;
     };
