@@ -168,17 +168,21 @@ impl Cholesky {
     }
 
     /// Solve the last factorised system in place for one or two right-hand sides: `x` holds
-    /// them one after the other (`cols` of them), then the solutions.
-    pub fn solve(&mut self, x: &mut [f64], cols: usize) {
-        let cols = cols.clamp(1, 2);
-        let n = x.len() / cols;
+    /// them one after the other (`cols` of them), then the solutions; false (and `x` as it
+    /// was) when `x` is not `cols` times the system's size.
+    pub fn solve(&mut self, x: &mut [f64], cols: usize) -> bool {
+        let n = self.symbolic.nrows();
+        if !(1..=2).contains(&cols) || x.len() != n * cols {
+            return false;
+        }
         let llt = LltRef::new(&self.symbolic, &self.values);
         llt.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(&mut x[..n * cols], n, cols),
+            MatMut::from_column_major_slice_mut(x, n, cols),
             Par::Seq,
             MemStack::new(&mut self.scratch),
         );
+        true
     }
 }
 
@@ -272,7 +276,8 @@ mod tests {
             // Two right-hand sides at once, one after the other.
             let rhs: Vec<f64> = (0..10).map(|i| (i * i) as f64 - 3.0).collect();
             let mut x = rhs.clone();
-            chol.solve(&mut x, 2);
+            assert!(chol.solve(&mut x, 2));
+            assert!(!chol.solve(&mut x[..9], 2), "not twice the size");
             for c in 0..2 {
                 let back = product(&trip, &x[5 * c..5 * c + 5]);
                 for (b, r) in back.iter().zip(&rhs[5 * c..5 * c + 5]) {

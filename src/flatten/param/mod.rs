@@ -607,7 +607,9 @@ fn spd_solve(
         return Err(chart.solver_error(method, "the system is singular"));
     }
     let mut out = rhs.to_vec();
-    solver.factor.solve(&mut out, 1);
+    if !solver.factor.solve(&mut out, 1) {
+        return Err(chart.solver_error(method, "the right-hand side has the wrong size"));
+    }
     // `refine` steps of iterative refinement: the residual b − A x (A from its lower
     // triangle) solved again and added; LSCM takes two, which brings an exactly developable
     // chart to isometry within rounding (seam sides equal to 1e-9 mm and better).

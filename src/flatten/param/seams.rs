@@ -222,7 +222,9 @@ fn relax(
                 .map(|r| r.x)
                 .chain(rhs.iter().map(|r| r.y))
                 .collect();
-            factor.solve(&mut x, 2);
+            if !factor.solve(&mut x, 2) {
+                return None;
+            }
             for (i, p) in uv.iter_mut().enumerate() {
                 *p = DVec2::new(x[i], x[n + i]);
             }
