@@ -73,6 +73,8 @@ pub(crate) struct Shape {
     pub size: DVec2,
     /// The segments by grid cell, for a shape with more than [`INDEX_SEGS`] of them.
     pub index: Option<SegIndex>,
+    /// Where each ring's segments end in `segs`.
+    pub ring_ends: Vec<usize>,
     /// Area of the material.
     pub area: f64,
     /// Add to a turned item point to get the shape point: `shape = orient(q) + shift`.
@@ -109,12 +111,14 @@ impl Shape {
         }
         let mut segs = Vec::new();
         let mut mids = Vec::new();
+        let mut ring_ends = Vec::with_capacity(turned.len());
         for r in &turned {
             for k in 0..r.len() {
                 let (a, b) = (r[k], r[(k + 1) % r.len()]);
                 segs.push([a, b]);
                 mids.push((a + b) * 0.5);
             }
+            ring_ends.push(segs.len());
         }
         let poles: Vec<(DVec2, f64)> = poles
             .iter()
@@ -133,9 +137,42 @@ impl Shape {
             lanes,
             size,
             index,
+            ring_ends,
             area,
             shift,
         }
+    }
+
+    /// Is `p` (in the shape's frame) in its material: [`in_material`] of its rings, the same
+    /// answer to the bit. With an index only the segments listed in the cells along the ray
+    /// from `p` (from a cell before it) to the right are looked at: a segment that crosses the
+    /// ray there has its box, and so its cells, on the ray, and the crossing is computed as
+    /// `polygon::contains` computes it, from the segment's end.
+    pub(crate) fn in_material(&self, p: DVec2) -> bool {
+        let Some(index) = &self.index else {
+            return in_material(&self.rings, p);
+        };
+        if self.rings.is_empty() {
+            return false;
+        }
+        let mut near = Vec::new();
+        let lo = DVec2::new(p.x - index.cell, p.y);
+        let hi = DVec2::new(p.x.max(self.size.x) + index.cell, p.y);
+        index.query(lo, hi, &mut near);
+        let mut odd = vec![false; self.rings.len()];
+        for &k in &near {
+            let k = k as usize;
+            // `contains` walks each edge from its end back to its start.
+            let [b, a] = self.segs[k];
+            if (a.y > p.y) != (b.y > p.y) {
+                let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if p.x < x {
+                    let r = self.ring_ends.partition_point(|&e| e <= k);
+                    odd[r] = !odd[r];
+                }
+            }
+        }
+        odd[0] && !odd[1..].iter().any(|&o| o)
     }
 }
 
