@@ -98,13 +98,18 @@ type Joins<'a> = &'a (dyn Fn(Motion, &Common) -> bool + Sync);
 /// Hinge every small piece of `done` that has a neighbour it fits beside (see the module
 /// doc), smallest first, then in parts those too large for the sheet that would split into
 /// a small part, in rounds while one hinges.
-pub(super) fn hinge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
-    let failed = Failed::default();
+pub(super) fn hinge_small(
+    ctx: &Charts,
+    done: &mut Vec<Laid>,
+    opts: &FlattenOptions,
+    eps: f64,
+    failed: &Failed,
+) {
     let try_onto = Onto {
         ctx,
         opts,
         eps,
-        failed: &failed,
+        failed,
     };
     for _ in 0..HINGE_ROUNDS {
         let (small, mut order) = small_pieces(ctx, done);
@@ -898,7 +903,7 @@ mod tests {
         let strip = ctx.area(&done[2].faces) / total;
         assert!(0.01 < strip && strip < 0.02, "{strip}");
         assert!(!fits_room(opts.room, &done[2].uv));
-        hinge_small(&ctx, &mut done, &opts, 1e-6);
+        hinge_small(&ctx, &mut done, &opts, 1e-6, &Failed::default());
         assert_eq!(done.len(), 2);
         let mut owned = vec![0; mesh.faces.len()];
         for (k, l) in done.iter().enumerate() {

@@ -77,11 +77,16 @@ pub(crate) const NEAR_SHARE: f64 = 1.0 / 3.0;
 
 /// Merge the small pieces of `done` into neighbours (see the module doc), in rounds until
 /// none merges (at most [`MERGE_ROUNDS`]).
-pub(super) fn merge_small(ctx: &Charts, done: &mut Vec<Laid>, opts: &FlattenOptions, eps: f64) {
-    let failed = Failed::default();
+pub(super) fn merge_small(
+    ctx: &Charts,
+    done: &mut Vec<Laid>,
+    opts: &FlattenOptions,
+    eps: f64,
+    failed: &Failed,
+) {
     for _ in 0..MERGE_ROUNDS {
         let before = done.len();
-        merge_small_once(ctx, done, opts, eps, &failed);
+        merge_small_once(ctx, done, opts, eps, failed);
         if done.len() == before {
             break;
         }

@@ -952,10 +952,13 @@ pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenEr
     };
     let mut done = ctx.lay_trees(opts, overlap_eps, todo, &degenerate)?;
     reattach(&ctx, &mut done, opts, overlap_eps);
-    merge::merge_small(&ctx, &mut done, opts, overlap_eps);
+    // The trials that failed on pairs of pieces as they are, for every stage below: a trial
+    // is a function of the two pieces, so a pair no stage has changed since fails again.
+    let failed = overlap::Failed::default();
+    merge::merge_small(&ctx, &mut done, opts, overlap_eps, &failed);
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
     merge::merge_laid(&ctx, &mut done, opts, overlap_eps);
-    hinge::hinge_small(&ctx, &mut done, opts, overlap_eps);
+    hinge::hinge_small(&ctx, &mut done, opts, overlap_eps, &failed);
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {
