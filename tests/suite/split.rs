@@ -47,6 +47,21 @@ fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
 
+/// A report piece's `bbox_mm` (x0, y0, x1, y1).
+fn bbox(piece: &serde_json::Value) -> Vec<f64> {
+    piece["bbox_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+/// Whether a box lies on A4 inside the default 5 mm margins.
+fn inside_a4(b: &[f64]) -> bool {
+    b[0] >= 5.0 - 1e-6 && b[1] >= 5.0 - 1e-6 && b[2] <= 205.0 + 1e-6 && b[3] <= 292.0 + 1e-6
+}
+
 /// Length (mm) drawn with each pen in an HP-GL program (40 units per mm).
 fn pen_lengths(plt: &str) -> [f64; 4] {
     let mut len = [0.0; 4];
@@ -144,20 +159,8 @@ fn cube_obj_on_a4_is_split_into_parts_that_fit() {
     let faces: u64 = pieces.iter().map(|p| p["faces"].as_u64().unwrap()).sum();
     assert_eq!(faces, 6);
     for p in pieces {
-        let b: Vec<f64> = p["bbox_mm"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        assert!(
-            b[0] >= 5.0 - 1e-6
-                && b[1] >= 5.0 - 1e-6
-                && b[2] <= 205.0 + 1e-6
-                && b[3] <= 292.0 + 1e-6,
-            "piece {} at {b:?}",
-            p["name"]
-        );
+        let b = bbox(p);
+        assert!(inside_a4(&b), "piece {} at {b:?}", p["name"]);
     }
     for s in sheets {
         assert_eq!(
@@ -395,16 +398,8 @@ fn a_long_thin_face_is_cut_across_the_sheet() {
     let turn = pieces[0]["rotation_deg"].as_f64().unwrap();
     let off_quarter = (turn.rem_euclid(90.0)).min(90.0 - turn.rem_euclid(90.0));
     assert!(off_quarter > 20.0, "turned {turn}°");
-    let b: Vec<f64> = pieces[0]["bbox_mm"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
-    assert!(
-        b[0] >= 5.0 - 1e-6 && b[1] >= 5.0 - 1e-6 && b[2] <= 205.0 + 1e-6 && b[3] <= 292.0 + 1e-6,
-        "box {b:?}"
-    );
+    let b = bbox(&pieces[0]);
+    assert!(inside_a4(&b), "box {b:?}");
     let long = write(&dir, "long.obj", &strip(400.0));
     let o = dry_cut(&long, &out);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));

@@ -73,8 +73,6 @@ pub(crate) struct Shape {
     pub size: DVec2,
     /// The segments by grid cell, for a shape with more than [`INDEX_SEGS`] of them.
     pub index: Option<SegIndex>,
-    /// Where each ring's segments end in `segs`.
-    pub ring_ends: Vec<usize>,
     /// Area of the material.
     pub area: f64,
     /// Add to a turned item point to get the shape point: `shape = orient(q) + shift`.
@@ -111,14 +109,12 @@ impl Shape {
         }
         let mut segs = Vec::new();
         let mut mids = Vec::new();
-        let mut ring_ends = Vec::with_capacity(turned.len());
         for r in &turned {
             for k in 0..r.len() {
                 let (a, b) = (r[k], r[(k + 1) % r.len()]);
                 segs.push([a, b]);
                 mids.push((a + b) * 0.5);
             }
-            ring_ends.push(segs.len());
         }
         let poles: Vec<(DVec2, f64)> = poles
             .iter()
@@ -137,7 +133,6 @@ impl Shape {
             lanes,
             size,
             index,
-            ring_ends,
             area,
             shift,
         }
@@ -159,6 +154,15 @@ impl Shape {
         let lo = DVec2::new(p.x - index.cell, p.y);
         let hi = DVec2::new(p.x.max(self.size.x) + index.cell, p.y);
         index.query(lo, hi, &mut near);
+        // Each ring's segments end where its points do in `segs`, ring after ring.
+        let ends: Vec<usize> = self
+            .rings
+            .iter()
+            .scan(0, |n, r| {
+                *n += r.len();
+                Some(*n)
+            })
+            .collect();
         let mut odd = vec![false; self.rings.len()];
         for &k in &near {
             let k = k as usize;
@@ -167,7 +171,7 @@ impl Shape {
             if (a.y > p.y) != (b.y > p.y) {
                 let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
                 if p.x < x {
-                    let r = self.ring_ends.partition_point(|&e| e <= k);
+                    let r = ends.partition_point(|&e| e <= k);
                     odd[r] = !odd[r];
                 }
             }
