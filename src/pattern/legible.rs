@@ -15,14 +15,17 @@
 //!
 //! **Candidates**, tried in order until one lies inside the piece's border and clear of every
 //! stroke and every text placed before it, by a tenth of its height:
-//! 1. where it went before this step: a seam id and the label where [`super::marks`] put them
-//!    (so a piece without collisions keeps them as they were), a bend note at the middle of
-//!    its line on either side, as large as the line allows up to the largest mark height;
-//! 2. a seam id along each segment of its seam side, its own (the longest) first, a bend note
-//!    along its line on either side: at each size, at the standard gap (a quarter of the
-//!    height) then 1¼ and 2½ heights further off, sliding from the middle of the segment
-//!    towards its ends; a text set along a line is never turned off it (a seam id or a bend
-//!    note away from its line says nothing);
+//! 1. where it went before this step: a seam id where [`super::marks`] put it when it is at
+//!    least [`MIN_TEXT_MM`] high there, the label where marks put it (so a piece without
+//!    collisions keeps them as they were), a bend note at the middle of its line on either
+//!    side, as large as the line allows up to the largest mark height;
+//! 2. a seam id along each segment of its seam side, its own (the longest) first, then along
+//!    the chords of runs of segments the side keeps within a quarter of the floor of (a
+//!    saw-tooth seam of a dense mesh, each of whose segments holds only a text too small to
+//!    read, marks' choice on such a side); a bend note along its line on either side: at each
+//!    size, at the standard gap (a quarter of the height) then 1¼ and 2½ heights further off,
+//!    sliding from the middle of the segment towards its ends; a text set along a line is
+//!    never turned off it (a seam id or a bend note away from its line says nothing);
 //! 3. the label at the point of the piece farthest from every stroke and every text already
 //!    placed (a best-first search like polylabel's, on that clearance), as large as fits in
 //!    90 % of that clearance (as before, in the inscribed circle) up to its largest height:
@@ -30,11 +33,15 @@
 //!    the cut outline outside its border (a glue tab, the seam allowance), still inside the
 //!    outline. A textured piece (printed faces) tries its margin first, so that the label
 //!    goes on a tab rather than over the print;
-//! 4. sizes from the text's natural height down by a fifth at a time to [`MIN_TEXT_MM`]; a text
-//!    already smaller than that where it was (a small model) is moved but not shrunk.
+//! 4. sizes from the text's natural height down by a fifth at a time to [`MIN_TEXT_MM`]. A
+//!    seam id that goes nowhere at that height or more (a small model, a seam shorter than
+//!    the text) stays where marks put it under the floor, else moves at that height; the
+//!    toolpath stage warns of it. Seam ids are placed in three passes ([`seam_ids`]): those
+//!    legible where they were, those moved to a legible height, the rest, so that a legible
+//!    text never gives way to one too small to read.
 //!
-//! Texts are placed seam ids first (in seam order), then bend notes (in fold order), then the
-//! label, which has the whole piece to choose from. Everything is deterministic: fixed
+//! Texts are placed seam ids first (each pass in seam order), then bend notes (in fold order),
+//! then the label, which has the whole piece to choose from. Everything is deterministic: fixed
 //! candidate orders, ties to the first.
 //!
 //! **Bounded time.** The strokes of a piece (thousands of fold segments on a fine strip) go
@@ -65,8 +72,13 @@ const SHRINK: f64 = 0.8;
 const SLIDE: [f64; 11] = [0.5, 0.4, 0.6, 0.3, 0.7, 0.2, 0.8, 0.1, 0.9, 0.0, 1.0];
 /// Gaps between a text and its line tried, in heights.
 const GAPS: [f64; 3] = [0.25, 1.25, 2.5];
-/// At most this many segments of a seam side are tried (the longest).
+/// At most this many segments of a seam side are tried (the longest), and as many chords.
 const MAX_SEGMENTS: usize = 8;
+/// How far (mm) a seam side may stray from a chord a seam id is written along: a quarter of
+/// the smallest text, the gap the text keeps from its line.
+const CHORD_BAND: f64 = 0.25 * MIN_TEXT_MM;
+/// Points of a seam side a chord spans at most.
+const MAX_CHORD_POINTS: usize = 64;
 
 /// A text left off its piece: no place clear of the other texts and lines was found for it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -513,38 +525,57 @@ pub(super) fn place(p: &mut Piece, opts: &PatternOptions, textured: bool) {
     let mut room = Room::new(p);
     let mut left_out = Vec::new();
 
-    // Seam ids, where marks put them, else along their seam side.
-    for mi in 0..p.marks.len() {
-        let (id, a, b) = (p.marks[mi].id, p.marks[mi].a, p.marks[mi].b);
-        let words = id.to_string();
-        if let Some(f) = Footprint::of(&p.marks[mi].text) {
-            let h = text_height(&p.marks[mi].text);
-            if room.clear(&f.grown(MARGIN * h)) {
+    seam_ids(p, opts, &mut room, &mut left_out);
+    p.marks.retain(|m| !m.text.is_empty());
+
+    if opts.bend_notes {
+        bend_notes(p, opts, &mut room, &mut left_out);
+    }
+    label(p, opts, textured, &mut room, &mut left_out);
+    p.left_out = left_out;
+}
+
+/// The seam ids, in three passes so that legible text comes first: those legible where marks
+/// put them stay there; those under [`MIN_TEXT_MM`] there (or no longer clear) go along their
+/// seam side at that height or more ([`id_lines`]); last, those for which that found no place
+/// stay where they were under the floor (a small model), else move at that height, else are
+/// left out (in seam order).
+fn seam_ids(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mut Vec<LeftOut>) {
+    let was: Vec<Option<(Footprint, f64)>> = p
+        .marks
+        .iter()
+        .map(|m| Footprint::of(&m.text).map(|f| (f, text_height(&m.text))))
+        .collect();
+    let mut moved = Vec::new();
+    for (mi, w) in was.iter().enumerate() {
+        match *w {
+            Some((f, h)) if h >= MIN_TEXT_MM && room.clear(&f.grown(MARGIN * h)) => room.take(f),
+            _ => moved.push(mi),
+        }
+    }
+    let mut last = Vec::new();
+    for mi in moved {
+        let lines = id_lines(p, p.marks[mi].id, p.marks[mi].a, p.marks[mi].b);
+        let words = p.marks[mi].id.to_string();
+        // `along` tries a text under the floor where no line holds it at the floor.
+        match along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM) {
+            Some((f, text)) if text_height(&text) >= MIN_TEXT_MM => {
                 room.take(f);
-                continue;
+                p.marks[mi].text = text;
             }
+            _ => last.push((mi, lines, words)),
         }
-        let mut lines: Vec<(DVec2, DVec2, &[f64])> = vec![(a, b, &[1.0])];
-        for s in p.seams.iter().filter(|s| s.id == id) {
-            if !s.points.windows(2).any(|w| w[0] == a && w[1] == b) {
-                continue;
-            }
-            let mut segs: Vec<(DVec2, DVec2)> = s
-                .points
-                .windows(2)
-                .map(|w| (w[0], w[1]))
-                .filter(|&(x, y)| (x, y) != (a, b))
-                .collect();
-            segs.sort_by(|x, y| y.0.distance(y.1).total_cmp(&x.0.distance(x.1)));
-            segs.truncate(MAX_SEGMENTS - 1);
-            lines.extend(segs.into_iter().map(|(x, y)| (x, y, &[1.0][..])));
-        }
-        // A seam id already under the floor (a small model) is moved, not shrunk.
-        let floor = match text_height(&p.marks[mi].text) {
-            h if h > 0.0 => MIN_TEXT_MM.min(h),
-            _ => MIN_TEXT_MM,
-        };
-        match along(&mut room, &words, &lines, opts.max_mark_height, floor) {
+    }
+    for (mi, lines, words) in last {
+        let placed = was[mi]
+            .filter(|&(_, h)| h < MIN_TEXT_MM)
+            .and_then(|(f, h)| {
+                if room.clear(&f.grown(MARGIN * h)) {
+                    return Some((f, p.marks[mi].text.clone()));
+                }
+                along(room, &words, &lines, h, h)
+            });
+        match placed {
             Some((f, text)) => {
                 room.take(f);
                 p.marks[mi].text = text;
@@ -558,13 +589,6 @@ pub(super) fn place(p: &mut Piece, opts: &PatternOptions, textured: bool) {
             }
         }
     }
-    p.marks.retain(|m| !m.text.is_empty());
-
-    if opts.bend_notes {
-        bend_notes(p, opts, &mut room, &mut left_out);
-    }
-    label(p, opts, textured, &mut room, &mut left_out);
-    p.left_out = left_out;
 }
 
 /// `90° UP` (valley) or `90° DOWN` (mountain) beside each bend line (not the tab folds): at
@@ -758,6 +782,66 @@ fn clearest(room: &mut Room, cap: f64, precision: f64, within: Within) -> Option
 
 /// Height of a text: its tallest stroke across its reading direction (as the toolpath stage
 /// measures it), 0 for none.
+/// The lines a seam id may be written along (see the module doc): the segment `a → b` marks
+/// chose, the other segments of its seam side, longest first, then the chords of runs of
+/// segments the side keeps within [`CHORD_BAND`] of (a seam of many short segments, whose
+/// segments each hold only a text under [`MIN_TEXT_MM`]), longest first; [`MAX_SEGMENTS`]
+/// of each at most.
+fn id_lines(p: &Piece, id: usize, a: DVec2, b: DVec2) -> Vec<(DVec2, DVec2, &'static [f64])> {
+    let mut lines: Vec<(DVec2, DVec2, &'static [f64])> = vec![(a, b, &[1.0])];
+    let mut chords: Vec<(DVec2, DVec2)> = Vec::new();
+    for s in p.seams.iter().filter(|s| s.id == id) {
+        if !s.points.windows(2).any(|w| w[0] == a && w[1] == b) {
+            continue;
+        }
+        let mut segs: Vec<(DVec2, DVec2)> = s
+            .points
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .filter(|&(x, y)| (x, y) != (a, b))
+            .collect();
+        segs.sort_by(|x, y| y.0.distance(y.1).total_cmp(&x.0.distance(x.1)));
+        segs.truncate(MAX_SEGMENTS - 1);
+        lines.extend(segs.into_iter().map(|(x, y)| (x, y, &[1.0][..])));
+        chords.extend(chords_of(&s.points, CHORD_BAND));
+    }
+    chords.sort_by(|x, y| y.0.distance(y.1).total_cmp(&x.0.distance(x.1)));
+    chords.truncate(MAX_SEGMENTS);
+    lines.extend(chords.into_iter().map(|(x, y)| (x, y, &[1.0][..])));
+    lines
+}
+
+/// The chords of a polyline over runs of two segments or more whose inner points lie within
+/// `band` of the chord and between its ends: from the first point, each as long as it can be
+/// (at most [`MAX_CHORD_POINTS`] points), the next from where it ends.
+fn chords_of(points: &[DVec2], band: f64) -> Vec<(DVec2, DVec2)> {
+    let within = |i: usize, j: usize| {
+        let (a, b) = (points[i], points[j]);
+        let len = a.distance(b);
+        if len.is_nan() || len <= 0.0 {
+            return false;
+        }
+        let d = (b - a) / len;
+        points[i + 1..j].iter().all(|&q| {
+            let t = (q - a).dot(d);
+            (0.0..=len).contains(&t) && (q - a).perp_dot(d).abs() <= band
+        })
+    };
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i + 2 < points.len() {
+        let mut j = i + 1;
+        while j + 1 < points.len() && j + 1 - i < MAX_CHORD_POINTS && within(i, j + 1) {
+            j += 1;
+        }
+        if j >= i + 2 {
+            out.push((points[i], points[j]));
+        }
+        i = j;
+    }
+    out
+}
+
 fn text_height(t: &Text) -> f64 {
     let n = t.dir.unwrap_or(DVec2::X).perp();
     t.strokes
@@ -889,6 +973,88 @@ mod tests {
         // One line: every stroke within the cap height of the block's bottom.
         let (lo, hi) = polygon::bounds(p.label.points()).unwrap();
         assert!(hi.y - lo.y < h + 1e-9, "{lo} {hi}");
+    }
+
+    /// A 60 × 30 mm piece whose bottom side from x = 0 to 40 is seam 17, a saw-tooth of 1 mm
+    /// steps 0.3 mm deep, marked where marks put a seam id: on its longest segment, as high
+    /// as that segment allows (0.31 mm).
+    fn saw_tooth() -> Piece {
+        let tooth: Vec<DVec2> = (0..=40)
+            .map(|k| DVec2::new(k as f64, if k % 2 == 1 { 0.3 } else { 0.0 }))
+            .collect();
+        let mut ring = tooth.clone();
+        ring.extend([
+            DVec2::new(60.0, 0.0),
+            DVec2::new(60.0, 30.0),
+            DVec2::new(0.0, 30.0),
+        ]);
+        let mut p = Piece::from_outline(1, "1".into(), ring);
+        let (a, b) = (tooth[0], tooth[1]);
+        p.marks = vec![super::super::EdgeMark {
+            id: 17,
+            edge: 0,
+            a,
+            b,
+            text: super::super::marks::edge_text("17", a, b, f64::INFINITY, 3.0),
+        }];
+        p.seams = vec![super::super::marks::SeamSide {
+            id: 17,
+            is_a: true,
+            partner: 2,
+            ring: 0,
+            first: 0,
+            count: 40,
+            length: super::super::marks::polyline_length(&tooth),
+            length_3d: super::super::marks::polyline_length(&tooth),
+            points: tooth,
+            notches: Vec::new(),
+            tab: false,
+            split: false,
+        }];
+        p
+    }
+
+    #[test]
+    fn a_seam_id_too_small_on_its_segment_goes_along_its_side_at_a_legible_height() {
+        let mut p = saw_tooth();
+        let was = text_height(&p.marks[0].text);
+        assert!(was < 0.4, "{was}");
+        place(&mut p, &PatternOptions::default(), false);
+        assert!(p.left_out.is_empty(), "{:?}", p.left_out);
+        let h = text_height(&p.marks[0].text);
+        assert!(h >= MIN_TEXT_MM, "{h}");
+        // Beside the saw-tooth, inside the piece, along x.
+        let (lo, hi) = polygon::bounds(p.marks[0].text.points()).unwrap();
+        assert!(
+            lo.x >= 0.0 && hi.x <= 40.0 && lo.y > 0.3 && hi.y < 0.3 + 4.0 * h,
+            "{lo} {hi}"
+        );
+        assert!(p.marks[0].text.dir.unwrap().abs().x > 0.99);
+        // Where no chord of the side is long enough (a side of two teeth), it keeps its
+        // height, beside the side.
+        let mut p = saw_tooth();
+        p.seams[0].points.truncate(3);
+        p.seams[0].count = 2;
+        place(&mut p, &PatternOptions::default(), false);
+        assert!(p.left_out.is_empty(), "{:?}", p.left_out);
+        assert!((text_height(&p.marks[0].text) - was).abs() < 1e-9);
+        let (lo, hi) = polygon::bounds(p.marks[0].text.points()).unwrap();
+        assert!(lo.x >= 0.0 && hi.x <= 2.0 && hi.y < 2.0, "{lo} {hi}");
+    }
+
+    #[test]
+    fn chords_keep_within_their_band_and_stop_at_corners() {
+        // Two saw-tooth runs at a right angle: one chord each, the corner their common end.
+        let mut pts: Vec<DVec2> = (0..=10)
+            .map(|k| DVec2::new(k as f64, if k % 2 == 1 { 0.3 } else { 0.0 }))
+            .collect();
+        pts.extend(
+            (1..=10).map(|k| DVec2::new(10.0 - if k % 2 == 1 { 0.3 } else { 0.0 }, k as f64)),
+        );
+        let c = chords_of(&pts, 0.5);
+        assert_eq!(c, vec![(pts[0], pts[10]), (pts[10], pts[20])]);
+        // A band narrower than the teeth: no chord spans one.
+        assert!(chords_of(&pts, 0.1).is_empty());
     }
 
     #[test]

@@ -113,27 +113,47 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
     out
 }
 
-/// One message per text the pattern stage left off a piece (`pattern::legible`), the same
-/// text left out several times (a bend note on many lines) said once with the count: warnings
-/// of kind `text-left-out`.
+/// One message per kind of text the pattern stage left off a piece (`pattern::legible`):
+/// the one text it says, or how many and which, the same text on several lines (a bend
+/// note) once with its count: warnings of kind `text-left-out`. A piece of a curved metal
+/// model can lose dozens of bend notes; one line per piece keeps the other warnings in view.
 fn left_out(p: &Piece) -> Vec<String> {
-    let mut seen: Vec<(&str, &str, usize)> = Vec::new();
+    // (what, [(words, times)]) in the order first met.
+    let mut kinds: Vec<(&str, Vec<(&str, usize)>)> = Vec::new();
     for l in &p.left_out {
-        match seen.iter_mut().find(|s| s.0 == l.what && s.1 == l.words) {
-            Some(s) => s.2 += 1,
-            None => seen.push((l.what, &l.words, 1)),
+        let i = match kinds.iter().position(|k| k.0 == l.what) {
+            Some(i) => i,
+            None => {
+                kinds.push((l.what, Vec::new()));
+                kinds.len() - 1
+            }
+        };
+        match kinds[i].1.iter_mut().find(|w| w.0 == l.words) {
+            Some(w) => w.1 += 1,
+            None => kinds[i].1.push((&l.words, 1)),
         }
     }
-    seen.into_iter()
-        .map(|(what, words, n)| {
-            let times = if n > 1 { format!(" ({n} times)") } else { String::new() };
+    kinds
+        .into_iter()
+        .map(|(what, words)| {
             let hint = if what == "bend note" {
                 "make the model larger (--size) or mark fewer bend lines (--bend-lines shop or a spacing in mm)"
             } else {
                 "make the model larger (--size)"
             };
+            let times = |n: usize| if n > 1 { format!(" ({n} times)") } else { String::new() };
+            let said = match words[..] {
+                [(w, 1)] => format!("{what} \"{w}\" left out"),
+                [(w, n)] => format!("{n} {what}s left out: \"{w}\"{}", times(n)),
+                _ => {
+                    let total: usize = words.iter().map(|w| w.1).sum();
+                    let list: Vec<String> =
+                        words.iter().map(|&(w, n)| format!("\"{w}\"{}", times(n))).collect();
+                    format!("{total} {what}s left out: {}", list.join(", "))
+                }
+            };
             format!(
-                "piece {}: {what} \"{words}\" left out{times}: no place clear of the other text and the lines at {MIN_TEXT_MM} mm or more; {hint}",
+                "piece {}: {said}; no place clear of the other text and the lines at {MIN_TEXT_MM} mm or more; {hint}",
                 p.name
             )
         })
@@ -249,14 +269,38 @@ mod tests {
             what: "bend note",
             words: "2° DOWN".into(),
         });
+        let one = check(std::slice::from_ref(&p), &o);
+        assert_eq!(one.len(), 2, "{one:?}");
+        assert_eq!(one[1].kind, "text-left-out");
+        assert!(
+            one[1]
+                .message
+                .starts_with("piece 3: 2 bend notes left out: \"2° DOWN\" (2 times); no place"),
+            "{}",
+            one[1].message
+        );
+        // One line per kind of text, each text said once with its count.
+        for (what, words) in [("seam id", "7"), ("bend note", "5° UP")] {
+            p.left_out.push(crate::pattern::legible::LeftOut {
+                what,
+                words: words.into(),
+            });
+        }
         let w = check(&[p], &o);
-        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(w.len(), 3, "{w:?}");
         assert_eq!(w[1].kind, "text-left-out");
         assert!(
-            w[1].message
-                .starts_with("piece 3: bend note \"2° DOWN\" left out (2 times)"),
+            w[1].message.starts_with(
+                "piece 3: 3 bend notes left out: \"2° DOWN\" (2 times), \"5° UP\"; no place"
+            ),
             "{}",
             w[1].message
+        );
+        assert!(
+            w[2].message
+                .starts_with("piece 3: seam id \"7\" left out; no place"),
+            "{}",
+            w[2].message
         );
         assert_eq!(w[0].kind, "text-too-small");
         assert!(w[0].message.contains("1.50 mm high"), "{}", w[0].message);
