@@ -18,7 +18,9 @@
 //! 1. where it went before this step: a seam id where [`super::marks`] put it when it is at
 //!    least [`MIN_TEXT_MM`] high there, the label where marks put it (so a piece without
 //!    collisions keeps them as they were), a bend note at the middle of its line on either
-//!    side, as large as the line allows up to the largest mark height;
+//!    side, as large as the line allows up to the largest mark height, when that is at least
+//!    [`MIN_TEXT_MM`] (a crease of a dense mesh, a few mm long, holds only a note too small to
+//!    read: it is left out, its angle being in report.json);
 //! 2. a seam id along each segment of its seam side, its own (the longest) first, then along
 //!    the chords of runs of segments the side keeps within a quarter of the floor of (a
 //!    saw-tooth seam of a dense mesh, each of whose segments holds only a text too small to
@@ -605,16 +607,20 @@ fn bend_notes(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &
             FoldKind::Valley => "UP",
         };
         let words = format!("{:.0}° {way}", f.angle.to_degrees());
-        // At the middle of the line, on either side, as large as the line allows.
+        // At the middle of the line, on either side, as large as the line allows, when that
+        // is legible.
         let first = [(f.a, f.b), (f.b, f.a)].into_iter().find_map(|(a, b)| {
             let t = super::marks::edge_text(&words, a, b, f64::INFINITY, opts.max_mark_height);
             let fp = Footprint::of(&t)?;
             let h = text_height(&t);
-            room.clear(&fp.grown(MARGIN * h)).then_some((fp, t))
+            (h >= MIN_TEXT_MM && room.clear(&fp.grown(MARGIN * h))).then_some((fp, t))
         });
         let lines: [(DVec2, DVec2, &[f64]); 1] = [(f.a, f.b, &[1.0, -1.0])];
-        let placed =
-            first.or_else(|| along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM));
+        // `along` tries a text under the floor where the line does not hold it at the floor.
+        let placed = first.or_else(|| {
+            along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM)
+                .filter(|(_, t)| text_height(t) >= MIN_TEXT_MM)
+        });
         match placed {
             Some((fp, t)) => {
                 room.take(fp);
@@ -1055,6 +1061,45 @@ mod tests {
         assert_eq!(c, vec![(pts[0], pts[10]), (pts[10], pts[20])]);
         // A band narrower than the teeth: no chord spans one.
         assert!(chords_of(&pts, 0.1).is_empty());
+    }
+
+    #[test]
+    fn a_bend_note_too_small_to_read_on_its_line_is_left_out_not_drawn() {
+        // A 60 × 40 mm piece with a crease 5 mm long (a note along it would be 0.7 mm high)
+        // and a bend line across it.
+        let ring = vec![
+            DVec2::ZERO,
+            DVec2::new(60.0, 0.0),
+            DVec2::new(60.0, 40.0),
+            DVec2::new(0.0, 40.0),
+        ];
+        let mut p = Piece::from_outline(1, "1".into(), ring);
+        let fold = |a: DVec2, b: DVec2, edge: usize| super::super::Fold {
+            a,
+            b,
+            kind: FoldKind::Mountain,
+            angle: 0.5,
+            edge,
+            tab: false,
+        };
+        p.folds = vec![
+            fold(DVec2::new(40.0, 0.0), DVec2::new(40.0, 5.0), 1),
+            fold(DVec2::new(10.0, 0.0), DVec2::new(10.0, 40.0), 2),
+        ];
+        let opts = PatternOptions {
+            bend_notes: true,
+            ..PatternOptions::default()
+        };
+        place(&mut p, &opts, false);
+        assert_eq!(p.note_folds, vec![1]);
+        assert!(text_height(&p.notes[0]) >= MIN_TEXT_MM);
+        assert_eq!(
+            p.left_out,
+            vec![LeftOut {
+                what: "bend note",
+                words: "29° DOWN".into()
+            }]
+        );
     }
 
     #[test]

@@ -24,6 +24,9 @@ use glam::DVec2;
 /// Smallest height of text (mm) a knife scores or a pen draws legibly: the pattern stage's
 /// floor, below which it shrinks no text to make room.
 pub use crate::pattern::legible::MIN_TEXT_MM;
+/// Different texts a `text-left-out` warning lists at most; the rest are counted (what they
+/// say is in report.json: a bend line's angle, a seam's id).
+const LEFT_OUT_LISTED: usize = 8;
 /// Border rings with more segments than this are not searched for slits.
 pub const MAX_SLIT_SEGMENTS: usize = 4000;
 
@@ -114,8 +117,9 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
 }
 
 /// One message per kind of text the pattern stage left off a piece (`pattern::legible`):
-/// the one text it says, or how many and which, the same text on several lines (a bend
-/// note) once with its count: warnings of kind `text-left-out`. A piece of a curved metal
+/// the one text it says, or how many and which (at most [`LEFT_OUT_LISTED`] different ones,
+/// the rest counted), the same text on several lines (a bend note) once with its count:
+/// warnings of kind `text-left-out`. A piece of a curved metal
 /// model can lose dozens of bend notes; one line per piece keeps the other warnings in view.
 fn left_out(p: &Piece) -> Vec<String> {
     // (what, [(words, times)]) in the order first met.
@@ -136,10 +140,16 @@ fn left_out(p: &Piece) -> Vec<String> {
     kinds
         .into_iter()
         .map(|(what, words)| {
-            let hint = if what == "bend note" {
-                "make the model larger (--size) or mark fewer bend lines (--bend-lines shop or a spacing in mm)"
-            } else {
-                "make the model larger (--size)"
+            let (hint, record) = match what {
+                "bend note" => (
+                    "make the model larger (--size); for strips, bent sheets and spline surfaces, mark fewer bend lines (--bend-lines shop or a spacing in mm)",
+                    "every bend line's angle is in report.json (pieces[].fold_lines)",
+                ),
+                "seam id" => (
+                    "make the model larger (--size)",
+                    "every seam is in report.json (seams)",
+                ),
+                _ => ("make the model larger (--size)", ""),
             };
             let times = |n: usize| if n > 1 { format!(" ({n} times)") } else { String::new() };
             let said = match words[..] {
@@ -147,8 +157,15 @@ fn left_out(p: &Piece) -> Vec<String> {
                 [(w, n)] => format!("{n} {what}s left out: \"{w}\"{}", times(n)),
                 _ => {
                     let total: usize = words.iter().map(|w| w.1).sum();
-                    let list: Vec<String> =
-                        words.iter().map(|&(w, n)| format!("\"{w}\"{}", times(n))).collect();
+                    let mut list: Vec<String> = words
+                        .iter()
+                        .take(LEFT_OUT_LISTED)
+                        .map(|&(w, n)| format!("\"{w}\"{}", times(n)))
+                        .collect();
+                    if words.len() > LEFT_OUT_LISTED {
+                        let more: usize = words[LEFT_OUT_LISTED..].iter().map(|w| w.1).sum();
+                        list.push(format!("and {more} more ({record})"));
+                    }
                     format!("{total} {what}s left out: {}", list.join(", "))
                 }
             };
@@ -286,7 +303,7 @@ mod tests {
                 words: words.into(),
             });
         }
-        let w = check(&[p], &o);
+        let w = check(std::slice::from_ref(&p), &o);
         assert_eq!(w.len(), 3, "{w:?}");
         assert_eq!(w[1].kind, "text-left-out");
         assert!(
