@@ -8,7 +8,9 @@
 //!   (`nest::verify`);
 //! - every seam's two sides are as long as each other and as the 3D seam, within the
 //!   material's tolerance (`pattern::marks::seam_mismatches`: paper 0.2 %, metal 0.1 %,
-//!   fabric 1 %), and report.json says the 3D length.
+//!   fabric 1 %), and report.json says the 3D length;
+//! - no text (seam id, bend note, label) overlaps another text or a line of another kind, as
+//!   in the bundled patterns (`legible::collisions`).
 //!
 //! CI runs each mesh in one material (the three in turn, so every material meets several
 //! meshes); `corpus_every_mesh_in_every_material` (ignored, `cargo test --release -- --ignored
@@ -79,6 +81,15 @@ fn run(mesh: &std::path::Path, kind: MaterialKind) -> Row {
         mismatches.len(),
         mismatches[0].1
     );
+    for p in &pieces {
+        let hit = crate::legible::collisions(p);
+        assert!(
+            hit.is_empty(),
+            "{what}: piece {}: {:?}",
+            p.name,
+            &hit[..hit.len().min(3)]
+        );
+    }
     let row = measure(&flats, &pieces);
     let opts = flatcut::nest::NestOptions {
         width: spec.sheet.width,

@@ -234,7 +234,7 @@ fn strokes(p: &Piece) -> Vec<(String, Vec<(DVec2, DVec2)>)> {
 
 /// The collisions of one piece: (text, what it overlaps), one per pair of a text and another
 /// text or a stroke.
-fn collisions(p: &Piece) -> Vec<(String, String)> {
+pub(crate) fn collisions(p: &Piece) -> Vec<(String, String)> {
     let texts = texts(p);
     let strokes = strokes(p);
     let mut out = Vec::new();
