@@ -15,9 +15,10 @@
 //! hole of its neighbour leaves useless the seam that opened the hole, which can make the two
 //! as one overlap; a union over the tolerance with its cuts would only be more so without
 //! them. A small piece that no neighbour takes is shared out
-//! with one of its [`REBALANCE_TRIES`] nearest: the two are halved anew (into halves of equal
-//! area where the bisector would leave one small) and kept as the halves when neither half
-//! is small and both keep the tolerance (`rebalance`; the count of pieces stays);
+//! with one of its [`REBALANCE_TRIES`] nearest: the two are halved anew (along the bisector,
+//! then into halves of equal area, which differ where the two are long and narrow or bent)
+//! and kept as the halves when neither half is small and both keep the tolerance
+//! (`rebalance`; the count of pieces stays);
 //! else it is grafted onto its neighbours as they lie ([`graft`]). The neighbours are tried
 //! two at a time where a spare thread is free, the first that takes it winning as in order
 //! (`first_merge`); so is the next small piece beside it, its fate kept where this one's
@@ -250,9 +251,10 @@ const REBALANCE_TRIES: usize = 2;
 
 /// Share the faces of a small piece `done[part]` and its neighbour `done[k]` out anew: the
 /// two as one chart are halved along the bisector of their two faces farthest apart
-/// ([`bisect`]), or, where a half would be under `small`, across them into halves of equal
-/// area ([`bisect_area`]), and each half laid out, starting from the two layouts joined
-/// ([`moved_onto`]), the second beside the first where a spare thread is free. The halves
+/// ([`bisect`]), then, where a half would be under `small` or the halves are not kept,
+/// across them into halves of equal area ([`bisect_area`]), and each half laid out,
+/// starting from the two layouts joined ([`moved_onto`]), the second beside the first where
+/// a spare thread is free. The halves
 /// (to become `done[k]` and `done[part]`) when neither is under `small` in area and each is
 /// flip-free, without overlap, within the tolerance and with its seams matched; else `None`.
 fn rebalance(
@@ -266,21 +268,17 @@ fn rebalance(
 ) -> Option<(Laid, Laid)> {
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
-    // Along the bisector; where a half would be small, into halves of equal area.
     let is_small = |(a, b): &(Vec<usize>, Vec<usize>)| ctx.area(a) < small || ctx.area(b) < small;
-    let (a, b) = Some(bisect(ctx.graph, &faces))
-        .filter(|h| !is_small(h))
-        .or_else(|| bisect_area(ctx.graph, &faces).filter(|h| !is_small(h)))?;
     let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
-    lay_halves(
-        ctx,
-        joined.as_deref(),
-        &both_cuts(&done[k], &done[part]),
-        a,
-        b,
-        opts,
-        eps,
-    )
+    let cuts = both_cuts(&done[k], &done[part]);
+    // Along the bisector, then into halves of equal area where those are other halves.
+    let along = bisect(ctx.graph, &faces);
+    let equal = bisect_area(ctx.graph, &faces).filter(|h| *h != along);
+    [Some(along), equal]
+        .into_iter()
+        .flatten()
+        .filter(|h| !is_small(h))
+        .find_map(|(a, b)| lay_halves(ctx, joined.as_deref(), &cuts, a, b, opts, eps))
 }
 
 /// The halves `a` and `b` of two pieces (their cuts `cuts`) each laid out, starting from the
