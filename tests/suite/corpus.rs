@@ -296,7 +296,10 @@ fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
 /// hole of its neighbour, which no merge took with the seam that opened the hole, is laid
 /// out with it without that seam (`flatten::charts::slit::uncut_merge`): 2 are (37 pieces);
 /// tried so with the small-piece merges already (where the merge with the cuts failed
-/// within the tolerance), none is (33 pieces).
+/// within the tolerance), none is (33 pieces). Since a small piece shared out with a
+/// neighbour is also halved into equal areas where the bisector's halves are not kept
+/// (`rebalance`), the small pieces go other ways (one share-out more, which keeps the count
+/// where a graft lowers it): 34 pieces, none small.
 #[test]
 fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     require_shared!();
@@ -305,7 +308,7 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
     assert_eq!(r.small, 0, "pieces under 1 % of the area");
-    assert!(r.pieces <= 33, "{} pieces", r.pieces);
+    assert!(r.pieces <= 34, "{} pieces", r.pieces);
 }
 
 /// Issue 20, items 2 and 3: cow in metal (L2 1.001) at 300 mm on A4. Charts still over the
