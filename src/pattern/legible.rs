@@ -22,9 +22,9 @@
 //!    [`MIN_TEXT_MM`] (a crease of a dense mesh, a few mm long, holds only a note too small to
 //!    read: it is left out, its angle being in report.json);
 //! 2. a seam id along each segment of its seam side, its own (the longest) first, then along
-//!    the chords of runs of segments the side keeps within a quarter of the floor of (a
-//!    saw-tooth seam of a dense mesh, each of whose segments holds only a text too small to
-//!    read, marks' choice on such a side); a bend note along its line on either side: at each
+//!    chords of the side over runs of segments that stay within a quarter of the floor of
+//!    the chord (on a saw-tooth seam of a dense mesh each segment holds only a text too small
+//!    to read, which is where marks put it); a bend note along its line on either side: at each
 //!    size, at the standard gap (a quarter of the height) then 1¼ and 2½ heights further off,
 //!    sliding from the middle of the segment towards its ends; a text set along a line is
 //!    never turned off it (a seam id or a bend note away from its line says nothing);

@@ -119,8 +119,8 @@ pub fn check(pieces: &[Piece], o: &CuttableOptions) -> Vec<Warning> {
 /// One message per kind of text the pattern stage left off a piece (`pattern::legible`):
 /// the one text it says, or how many and which (at most [`LEFT_OUT_LISTED`] different ones,
 /// the rest counted), the same text on several lines (a bend note) once with its count:
-/// warnings of kind `text-left-out`. A piece of a curved metal
-/// model can lose dozens of bend notes; one line per piece keeps the other warnings in view.
+/// warnings of kind `text-left-out`. A piece of a curved metal model can lose dozens of bend
+/// notes; one line per piece keeps the other warnings in view.
 fn left_out(p: &Piece) -> Vec<String> {
     // (what, [(words, times)]) in the order first met.
     let mut kinds: Vec<(&str, Vec<(&str, usize)>)> = Vec::new();
@@ -164,7 +164,10 @@ fn left_out(p: &Piece) -> Vec<String> {
                         .collect();
                     if words.len() > LEFT_OUT_LISTED {
                         let more: usize = words[LEFT_OUT_LISTED..].iter().map(|w| w.1).sum();
-                        list.push(format!("and {more} more ({record})"));
+                        list.push(match record {
+                            "" => format!("and {more} more"),
+                            r => format!("and {more} more ({r})"),
+                        });
                     }
                     format!("{total} {what}s left out: {}", list.join(", "))
                 }
