@@ -521,6 +521,17 @@ fn along(
     None
 }
 
+/// [`along`] at [`MIN_TEXT_MM`] or more only: where no line holds the text at the floor,
+/// `along` offers it at the size the longest line allows, under the floor.
+fn legibly_along(
+    room: &mut Room,
+    words: &str,
+    lines: &[(DVec2, DVec2, &[f64])],
+    max_h: f64,
+) -> Option<(Footprint, Text)> {
+    along(room, words, lines, max_h, MIN_TEXT_MM).filter(|(_, t)| text_height(t) >= MIN_TEXT_MM)
+}
+
 /// Places every text of a piece whose strokes are final (see the module doc); writes the bend
 /// notes when `opts.bend_notes`. `textured`: the piece's faces are printed with a texture.
 pub(super) fn place(p: &mut Piece, opts: &PatternOptions, textured: bool) {
@@ -559,13 +570,12 @@ fn seam_ids(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &mu
     for mi in moved {
         let lines = id_lines(p, p.marks[mi].id, p.marks[mi].a, p.marks[mi].b);
         let words = p.marks[mi].id.to_string();
-        // `along` tries a text under the floor where no line holds it at the floor.
-        match along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM) {
-            Some((f, text)) if text_height(&text) >= MIN_TEXT_MM => {
+        match legibly_along(room, &words, &lines, opts.max_mark_height) {
+            Some((f, text)) => {
                 room.take(f);
                 p.marks[mi].text = text;
             }
-            _ => last.push((mi, lines, words)),
+            None => last.push((mi, lines, words)),
         }
     }
     for (mi, lines, words) in last {
@@ -616,11 +626,7 @@ fn bend_notes(p: &mut Piece, opts: &PatternOptions, room: &mut Room, left_out: &
             (h >= MIN_TEXT_MM && room.clear(&fp.grown(MARGIN * h))).then_some((fp, t))
         });
         let lines: [(DVec2, DVec2, &[f64]); 1] = [(f.a, f.b, &[1.0, -1.0])];
-        // `along` tries a text under the floor where the line does not hold it at the floor.
-        let placed = first.or_else(|| {
-            along(room, &words, &lines, opts.max_mark_height, MIN_TEXT_MM)
-                .filter(|(_, t)| text_height(t) >= MIN_TEXT_MM)
-        });
+        let placed = first.or_else(|| legibly_along(room, &words, &lines, opts.max_mark_height));
         match placed {
             Some((fp, t)) => {
                 room.take(fp);

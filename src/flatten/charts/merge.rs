@@ -254,9 +254,9 @@ const REBALANCE_TRIES: usize = 2;
 /// ([`bisect`]), then, where a half would be under `small` or the halves are not kept,
 /// across them into halves of equal area ([`bisect_area`]), and each half laid out,
 /// starting from the two layouts joined ([`moved_onto`]), the second beside the first where
-/// a spare thread is free. The halves
-/// (to become `done[k]` and `done[part]`) when neither is under `small` in area and each is
-/// flip-free, without overlap, within the tolerance and with its seams matched; else `None`.
+/// a spare thread is free. The halves (to become `done[k]` and `done[part]`) when neither is
+/// under `small` in area and each is flip-free, without overlap, within the tolerance and
+/// with its seams matched; else `None`.
 fn rebalance(
     ctx: &Charts,
     done: &[Laid],
@@ -269,15 +269,21 @@ fn rebalance(
     let mut faces = done[k].faces.clone();
     faces.extend(&done[part].faces);
     let is_small = |(a, b): &(Vec<usize>, Vec<usize>)| ctx.area(a) < small || ctx.area(b) < small;
-    let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
-    let cuts = both_cuts(&done[k], &done[part]);
     // Along the bisector, then into halves of equal area where those are other halves.
     let along = bisect(ctx.graph, &faces);
     let equal = bisect_area(ctx.graph, &faces).filter(|h| *h != along);
-    [Some(along), equal]
+    let halves: Vec<_> = [Some(along), equal]
         .into_iter()
         .flatten()
         .filter(|h| !is_small(h))
+        .collect();
+    if halves.is_empty() {
+        return None;
+    }
+    let joined = moved_onto(ctx, done, k, part).map(|j| Whole::new(&j.faces, &j.uv));
+    let cuts = both_cuts(&done[k], &done[part]);
+    halves
+        .into_iter()
         .find_map(|(a, b)| lay_halves(ctx, joined.as_deref(), &cuts, a, b, opts, eps))
 }
 
