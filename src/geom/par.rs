@@ -1,43 +1,32 @@
-//! Fork–join parallelism whose results do not depend on the number of threads: [`join`] runs
-//! two closures, the second on a scoped thread when one of the process's spare threads is
-//! free (one fewer than the machine's cores, shared by every caller, nested calls included),
-//! else after the first on this one; [`speculate`] runs the second only when a spare thread
-//! is free, and [`first`] tries candidates two at a time with it; [`map`] splits a list of
-//! independent jobs into halves of about equal weight and joins them, so a job may itself
-//! fork (a chart whose halves are laid in parallel). Results always come back in the jobs'
-//! order.
+//! Fork–join parallelism whose results do not depend on the number of threads, on the
+//! work-stealing pool of `rayon-core` (one thread per core): [`join`] runs two closures, the
+//! second taken by whichever thread of the pool is idle (else run after the first on this
+//! one), nested calls included, so a thread that finishes its share early takes work forked
+//! deeper in the other's; [`speculate`] runs the second only when an idle thread takes it
+//! while the first runs, and [`first`] tries candidates two at a time with it; [`map`] splits
+//! a list of independent jobs into halves of about equal weight and joins them, so a job may
+//! itself fork (a chart whose halves are laid in parallel). Results always come back in the
+//! jobs' order.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
 
-/// Threads that may run besides the callers' own (cores − 1), taken and given back by
-/// [`join`].
-fn spare() -> &'static AtomicUsize {
-    static SPARE: OnceLock<AtomicUsize> = OnceLock::new();
-    SPARE.get_or_init(|| {
-        let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
-        AtomicUsize::new(cores.saturating_sub(1))
-    })
+/// Stack of each pool thread: the main thread's usual 8 MiB, since the jobs run what the
+/// main thread would run alone (the default is 2 MiB).
+const STACK_BYTES: usize = 8 << 20;
+
+/// The pool, made on first use with [`STACK_BYTES`] (one made elsewhere first is kept).
+fn pool() {
+    static MADE: Once = Once::new();
+    MADE.call_once(|| {
+        let _ = rayon_core::ThreadPoolBuilder::new()
+            .stack_size(STACK_BYTES)
+            .build_global();
+    });
 }
 
-/// Take a spare thread if one is free.
-fn take() -> bool {
-    spare()
-        .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| n.checked_sub(1))
-        .is_ok()
-}
-
-/// Gives a spare thread back when dropped (also when the job panics).
-struct Token;
-
-impl Drop for Token {
-    fn drop(&mut self) {
-        spare().fetch_add(1, Ordering::AcqRel);
-    }
-}
-
-/// `(a(), b())`, `b` on another thread when a spare one is free. A panic in either is raised
-/// again here.
+/// `(a(), b())`, `b` taken by an idle thread of the pool when one is free, else run after
+/// `a` on this one. A panic in either is raised again here.
 pub fn join<A, B, FA, FB>(a: FA, b: FB) -> (A, B)
 where
     A: Send,
@@ -45,34 +34,11 @@ where
     FA: FnOnce() -> A + Send,
     FB: FnOnce() -> B + Send,
 {
-    if !take() {
-        let ra = a();
-        return (ra, b());
-    }
-    beside(a, b)
+    pool();
+    rayon_core::join(a, b)
 }
 
-/// `(a(), b())`, `b` on a scoped thread holding the spare thread [`take`]n for it (given back
-/// when it ends, also when it panics). A panic in either is raised again here.
-fn beside<A, B, FA, FB>(a: FA, b: FB) -> (A, B)
-where
-    A: Send,
-    B: Send,
-    FA: FnOnce() -> A + Send,
-    FB: FnOnce() -> B + Send,
-{
-    std::thread::scope(|s| {
-        let hb = s.spawn(move || {
-            let _token = Token;
-            b()
-        });
-        let ra = a();
-        let rb = hb.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-        (ra, rb)
-    })
-}
-
-/// `(a(), Some(b()))` with `b` on another thread when a spare one is free, else `(a(), None)`
+/// `(a(), Some(b()))` when an idle thread takes `b` while `a` runs, else `(a(), None)`
 /// without running `b`: for work that is only worth doing beside other work (a second
 /// candidate tried while the first is, its result used only when the first fails).
 pub fn speculate<A, B, FA, FB>(a: FA, b: FB) -> (A, Option<B>)
@@ -82,11 +48,16 @@ where
     FA: FnOnce() -> A + Send,
     FB: FnOnce() -> B + Send,
 {
-    if !take() {
-        return (a(), None);
-    }
-    let (ra, rb) = beside(a, b);
-    (ra, Some(rb))
+    pool();
+    let done = AtomicBool::new(false);
+    rayon_core::join(
+        || {
+            let r = a();
+            done.store(true, Ordering::Release);
+            r
+        },
+        || (!done.load(Ordering::Acquire)).then(b),
+    )
 }
 
 /// The first item, in order, for which `f` gives something, and what it gave: the items are
