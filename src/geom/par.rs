@@ -38,6 +38,16 @@ where
     rayon_core::join(a, b)
 }
 
+/// `f()` run by a thread of the pool, so that the forks inside it are the pool's own (a fork
+/// from outside the pool waits for a thread of it to wake and take the whole join).
+pub fn within<R: Send, F: FnOnce() -> R + Send>(f: F) -> R {
+    pool();
+    if rayon_core::current_thread_index().is_some() {
+        return f();
+    }
+    rayon_core::join(f, || ()).0
+}
+
 /// `(a(), Some(b()))` when an idle thread takes `b` while `a` runs, else `(a(), None)`
 /// without running `b`: for work that is only worth doing beside other work (a second
 /// candidate tried while the first is, its result used only when the first fails).

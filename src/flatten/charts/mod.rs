@@ -925,6 +925,11 @@ impl Charts<'_> {
 /// Lay each chart flat as one island (cutting and splitting where needed, see the module
 /// doc).
 pub fn charts(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
+    crate::geom::par::within(|| charts_in_pool(surface, opts))
+}
+
+/// [`charts`] on a thread of the pool ([`crate::geom::par::within`]).
+fn charts_in_pool(surface: Surface, opts: &FlattenOptions) -> Result<Flat, FlattenError> {
     let mesh = &surface.mesh;
     let nf = mesh.faces.len();
     let chart_of = match &surface.charts {

@@ -41,6 +41,15 @@ struct Local {
 }
 
 /// M and D of a triangle with flat corners `p` and 3D shape `shape` (see the module doc).
+/// A triangle round a moving vertex: its vertices, 3D shape and area, and the vertex's corner.
+#[derive(Clone, Copy)]
+struct Corner {
+    tri: [usize; 3],
+    shape: [DVec2; 3],
+    a3: f64,
+    c: usize,
+}
+
 fn m_and_d(p: [DVec2; 3], shape: &[DVec2; 3]) -> (DMat2, f64) {
     let e = [p[2] - p[1], p[0] - p[2], p[1] - p[0]];
     let col = |j: usize| shape[0] * e[0][j] + shape[1] * e[1][j] + shape[2] * e[2][j];
@@ -122,7 +131,7 @@ pub(super) fn minimise_stretch(
         .iter()
         .map(|s| 0.5 * (s[1] - s[0]).perp_dot(s[2] - s[0]))
         .collect();
-    // Each vertex's (triangle, corner), listed flat by vertex.
+    // Each vertex's triangles, listed flat by vertex, with what its steps read of them.
     let mut first = vec![0usize; nv + 1];
     for tri in &chart.tris {
         for &v in tri {
@@ -133,13 +142,19 @@ pub(super) fn minimise_stretch(
         first[v + 1] += first[v];
     }
     let mut next = first.clone();
-    let mut corners = vec![(0usize, 0usize); first[nv]];
+    let mut corners = vec![None; first[nv]];
     for (t, tri) in chart.tris.iter().enumerate() {
         for (c, &v) in tri.iter().enumerate() {
-            corners[next[v]] = (t, c);
+            corners[next[v]] = Some(Corner {
+                tri: *tri,
+                shape: shapes[t],
+                a3: a3[t],
+                c,
+            });
             next[v] += 1;
         }
     }
+    let corners: Vec<Corner> = corners.into_iter().flatten().collect();
     let totals = |uv: &[DVec2]| -> Option<(f64, f64)> {
         let (mut s, mut a) = (0.0, 0.0);
         for ((tri, shape), &a3) in chart.tris.iter().zip(&shapes).zip(&a3) {
@@ -162,7 +177,7 @@ pub(super) fn minimise_stretch(
             around.extend(
                 corners[first[v]..first[v + 1]]
                     .iter()
-                    .map(|&(t, c)| Local::new(chart.tris[t], &shapes[t], a3[t], c, &uv)),
+                    .map(|k| Local::new(k.tri, &k.shape, k.a3, k.c, &uv)),
             );
             if let Some(x) = step(&around, s_tot, a_tot) {
                 uv[v] += x.0;
