@@ -71,7 +71,7 @@ where
 }
 
 /// The first item, in order, for which `f` gives something, and what it gave: the items are
-/// tried two at a time where a spare thread is free ([`speculate`]), the second's result used
+/// tried two at a time where a thread is idle ([`speculate`]), the second's result used
 /// only when the first gives nothing, so the answer is the one trying them in turn finds.
 pub fn first<T, R, F>(items: &[T], f: F) -> Option<(usize, R)>
 where
@@ -164,7 +164,7 @@ mod tests {
             },
         );
         assert_eq!(a, 1);
-        // Run on a spare thread (and then its result is back) or not at all.
+        // Run on an idle thread (and then its result is back) or not at all.
         assert_eq!(b.is_some(), ran.load(Ordering::SeqCst));
         if std::thread::available_parallelism().map_or(1, |p| p.get()) == 1 {
             assert_eq!(b, None);
@@ -190,10 +190,24 @@ mod tests {
     }
 
     #[test]
+    fn within_runs_on_a_thread_of_the_pool_and_nests() {
+        let (on_pool, inner) = within(|| {
+            (
+                rayon_core::current_thread_index().is_some(),
+                within(|| join(|| 4, || 5)),
+            )
+        });
+        assert!(on_pool);
+        assert_eq!(inner, (4, 5));
+        let r = std::panic::catch_unwind(|| within(|| -> u8 { panic!("boom") }));
+        assert!(r.is_err());
+    }
+
+    #[test]
     fn a_panic_comes_back_to_the_caller() {
         let r = std::panic::catch_unwind(|| join(|| 1, || -> u8 { panic!("boom") }));
         assert!(r.is_err());
-        // The spare thread was given back: a later join can still fork.
+        // The pool is still there: a later join still runs both.
         assert_eq!(join(|| 2, || 3), (2, 3));
     }
 }
