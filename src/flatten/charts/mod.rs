@@ -492,7 +492,7 @@ impl Charts<'_> {
     /// [`Charts::lay`] without the copies.
     fn lay_anew(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
         let (local, ids) = self.opened(faces, cuts);
-        let p = match param::parameterize(&local, &ids, self.method) {
+        let p = match param::parameterize_matched(&local, &ids, self.method, self.match_below) {
             Ok(p) => p,
             // A sliver triangle cannot be laid flat in any chart: say which (mesh numbering).
             Err(param::ParamError::Degenerate { face, line, angle }) => {
@@ -519,7 +519,9 @@ impl Charts<'_> {
     ) -> Result<Layout, param::ParamError> {
         if let Some(start) = whole.and_then(|w| w.restrict(faces)) {
             let (local, ids) = self.opened(faces, cuts);
-            if let Some(p) = param::relax_from(&local, &ids, self.method, &start) {
+            if let Some(p) =
+                param::relax_from_matched(&local, &ids, self.method, &start, self.match_below)
+            {
                 return Ok(self.finish(&local, &ids, p));
             }
         }
@@ -546,15 +548,10 @@ impl Charts<'_> {
         (local, (0..faces.len()).collect())
     }
 
-    /// A layout as the charts keep it: seams matched when it is within `match_below`,
-    /// refused when not finite, counter-clockwise.
+    /// A layout as the charts keep it (its seams matched by [`param::parameterize_matched`]
+    /// or [`param::relax_from_matched`] when it is within `match_below`): refused when not
+    /// finite, counter-clockwise.
     fn finish(&self, local: &Mesh, ids: &[usize], p: param::ChartParam) -> Layout {
-        // Seams as long flat as in 3D, the stretch taken up inside (issue 20).
-        let p = if p.stretch.l2 <= self.match_below {
-            param::match_seams(local, ids, &p)
-        } else {
-            p
-        };
         let mut uv = p.uv;
         if uv.iter().any(|c| c.iter().any(|q| !q.is_finite())) {
             return Layout::Refused;

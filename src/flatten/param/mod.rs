@@ -811,21 +811,59 @@ pub fn parameterize(
     method: ParamMethod,
 ) -> Result<ChartParam, ParamError> {
     let chart = build_chart(mesh, faces)?;
-    let pin = pins(&chart);
+    parameterize_chart(mesh, faces, &chart, method)
+}
+
+/// [`parameterize`], then the seams matched ([`match_seams`]) when its L2 stretch is at
+/// most `match_below`, on one chart built for both.
+pub fn parameterize_matched(
+    mesh: &Mesh,
+    faces: &[usize],
+    method: ParamMethod,
+    match_below: f64,
+) -> Result<ChartParam, ParamError> {
+    let chart = build_chart(mesh, faces)?;
+    let p = parameterize_chart(mesh, faces, &chart, method)?;
+    Ok(matched(mesh, faces, &chart, p, match_below))
+}
+
+/// `p` with its seams matched ([`match_seams`]) when its L2 stretch is at most `match_below`.
+fn matched(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    p: ChartParam,
+    match_below: f64,
+) -> ChartParam {
+    if p.stretch.l2 <= match_below {
+        seams::match_seams_of(mesh, faces, chart, &p)
+    } else {
+        p
+    }
+}
+
+/// [`parameterize`] on the chart of `faces` already built.
+fn parameterize_chart(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    method: ParamMethod,
+) -> Result<ChartParam, ParamError> {
+    let pin = pins(chart);
     // LSCM's system has one pattern whichever shapes it is given: one ordering for both.
     let mut solver = None;
     match method {
-        ParamMethod::Lscm => run_lscm(mesh, faces, &chart, pin, &mut solver),
-        ParamMethod::Abf => run_abf(mesh, faces, &chart, pin, &mut solver),
+        ParamMethod::Lscm => run_lscm(mesh, faces, chart, pin, &mut solver),
+        ParamMethod::Abf => run_abf(mesh, faces, chart, pin, &mut solver),
         ParamMethod::Best => {
-            let l = run_lscm(mesh, faces, &chart, pin, &mut solver);
+            let l = run_lscm(mesh, faces, chart, pin, &mut solver);
             if let Ok(l) = &l {
                 // Already isometric: nothing can do better.
                 if l.stretch.flipped == 0 && l.stretch.l2 - 1.0 < ISOMETRIC {
                     return Ok(l.clone());
                 }
             }
-            let a = run_abf(mesh, faces, &chart, pin, &mut solver);
+            let a = run_abf(mesh, faces, chart, pin, &mut solver);
             let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
             let kept = match (l, a) {
                 (Ok(l), Ok(a)) => {
@@ -839,7 +877,7 @@ pub fn parameterize(
                 (Err(_), Ok(a)) => a,
                 (Err(e), Err(_)) => return Err(e),
             };
-            let refined = refine(mesh, faces, &chart, &kept);
+            let refined = refine(mesh, faces, chart, &kept);
             Ok(if key(&refined) < key(&kept) {
                 refined
             } else {
@@ -879,6 +917,31 @@ pub fn relax_from(
     start: &[Vec<DVec2>],
 ) -> Option<ChartParam> {
     let chart = build_chart(mesh, faces).ok()?;
+    relax_chart(mesh, faces, &chart, method, start)
+}
+
+/// [`relax_from`], then the seams matched ([`match_seams`]) when its L2 stretch is at most
+/// `match_below`, on one chart built for both.
+pub fn relax_from_matched(
+    mesh: &Mesh,
+    faces: &[usize],
+    method: ParamMethod,
+    start: &[Vec<DVec2>],
+    match_below: f64,
+) -> Option<ChartParam> {
+    let chart = build_chart(mesh, faces).ok()?;
+    let p = relax_chart(mesh, faces, &chart, method, start)?;
+    Some(matched(mesh, faces, &chart, p, match_below))
+}
+
+/// [`relax_from`] on the chart of `faces` already built.
+fn relax_chart(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    method: ParamMethod,
+    start: &[Vec<DVec2>],
+) -> Option<ChartParam> {
     if start.len() != chart.corners.len() {
         return None;
     }
@@ -897,8 +960,8 @@ pub fn relax_from(
     }
     let uv: Vec<DVec2> = uv.into_iter().collect::<Option<_>>()?;
     let nv = uv.len();
-    let uv = minimise_stretch(&chart, uv, &vec![false; nv], STRETCH_SWEEPS)?;
-    Some(finish(mesh, faces, &chart, method, uv))
+    let uv = minimise_stretch(chart, uv, &vec![false; nv], STRETCH_SWEEPS)?;
+    Some(finish(mesh, faces, chart, method, uv))
 }
 
 /// A layout per chart face corner as one position per local vertex.

@@ -27,7 +27,7 @@
 //!   nearer the 3D lengths; else the start is returned as it was. A chart whose boundary is
 //!   within [`EXACT`] of its 3D lengths is returned at once (an exactly developable chart).
 
-use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, ChartParam};
+use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, Chart, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
 use crate::geom::sparse::{Cholesky, Pattern};
@@ -59,8 +59,18 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
     let Ok(chart) = build_chart(mesh, faces) else {
         return start.clone();
     };
+    match_seams_of(mesh, faces, &chart, start)
+}
+
+/// [`match_seams`] with the chart of `faces` already built.
+pub(super) fn match_seams_of(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    start: &ChartParam,
+) -> ChartParam {
     let nv = chart.pos.len();
-    let uv = vertex_uv(&chart, &start.uv);
+    let uv = vertex_uv(chart, &start.uv);
     let bl = &chart.boundary_loop;
     let edges: Vec<(usize, usize, f64)> = (0..bl.len())
         .map(|k| {
@@ -73,7 +83,7 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
     if before.is_nan() || before <= EXACT || nv < 3 {
         return start.clone();
     }
-    let shapes = shapes_from_3d(&chart);
+    let shapes = shapes_from_3d(chart);
     // Per triangle corner k: ½ cot of its angle, the weight of the opposite edge.
     let cots: Vec<[f64; 3]> = shapes
         .iter()
@@ -119,7 +129,7 @@ pub fn match_seams(mesh: &Mesh, faces: &[usize], start: &ChartParam) -> ChartPar
     let relaxed = from;
     // The inside relaxed to the least L2 stretch the matched boundary allows.
     let relaxed =
-        minimise_stretch(&chart, relaxed.clone(), &chart.boundary, SWEEPS).unwrap_or(relaxed);
+        minimise_stretch(chart, relaxed.clone(), &chart.boundary, SWEEPS).unwrap_or(relaxed);
     let after = boundary_error(&relaxed, &edges);
     if after.is_nan() || after >= before {
         return start.clone();
