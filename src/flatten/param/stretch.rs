@@ -40,7 +40,6 @@ struct Local {
     n: DVec2,
 }
 
-/// M and D of a triangle with flat corners `p` and 3D shape `shape` (see the module doc).
 /// A triangle round a moving vertex: its vertices, 3D shape and area, and the vertex's corner.
 #[derive(Clone, Copy)]
 struct Corner {
@@ -50,6 +49,7 @@ struct Corner {
     c: usize,
 }
 
+/// M and D of a triangle with flat corners `p` and 3D shape `shape` (see the module doc).
 fn m_and_d(p: [DVec2; 3], shape: &[DVec2; 3]) -> (DMat2, f64) {
     let e = [p[2] - p[1], p[0] - p[2], p[1] - p[0]];
     let col = |j: usize| shape[0] * e[0][j] + shape[1] * e[1][j] + shape[2] * e[2][j];
