@@ -901,16 +901,20 @@ mod tests {
         assert!(!b3.overlaps(&b));
     }
 
+    /// The outline of a `w` × `h` mm rectangle from the origin, counter-clockwise.
+    fn rectangle(w: f64, h: f64) -> Vec<DVec2> {
+        vec![
+            DVec2::ZERO,
+            DVec2::new(w, 0.0),
+            DVec2::new(w, h),
+            DVec2::new(0.0, h),
+        ]
+    }
+
     /// A 40 × 16 mm strip with a fold every 1.5 mm: no room for its label anywhere (without the
     /// folds it would be 2.2 mm high, on two lines).
     fn crowded() -> Piece {
-        let ring = vec![
-            DVec2::ZERO,
-            DVec2::new(40.0, 0.0),
-            DVec2::new(40.0, 16.0),
-            DVec2::new(0.0, 16.0),
-        ];
-        let mut p = Piece::from_outline(1, "strip".into(), ring);
+        let mut p = Piece::from_outline(1, "strip".into(), rectangle(40.0, 16.0));
         let opts = PatternOptions::default();
         super::super::marks::finish(&mut p, &opts);
         assert!(!p.label.is_empty());
@@ -1073,13 +1077,7 @@ mod tests {
     fn a_bend_note_too_small_to_read_on_its_line_is_left_out_not_drawn() {
         // A 60 × 40 mm piece with a crease 5 mm long (a note along it would be 0.7 mm high)
         // and a bend line across it.
-        let ring = vec![
-            DVec2::ZERO,
-            DVec2::new(60.0, 0.0),
-            DVec2::new(60.0, 40.0),
-            DVec2::new(0.0, 40.0),
-        ];
-        let mut p = Piece::from_outline(1, "1".into(), ring);
+        let mut p = Piece::from_outline(1, "1".into(), rectangle(60.0, 40.0));
         let fold = |a: DVec2, b: DVec2, edge: usize| super::super::Fold {
             a,
             b,

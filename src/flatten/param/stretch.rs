@@ -142,19 +142,22 @@ pub(super) fn minimise_stretch(
         first[v + 1] += first[v];
     }
     let mut next = first.clone();
-    let mut corners = vec![None; first[nv]];
+    let mut slots = vec![(0usize, 0usize); first[nv]];
     for (t, tri) in chart.tris.iter().enumerate() {
         for (c, &v) in tri.iter().enumerate() {
-            corners[next[v]] = Some(Corner {
-                tri: *tri,
-                shape: shapes[t],
-                a3: a3[t],
-                c,
-            });
+            slots[next[v]] = (t, c);
             next[v] += 1;
         }
     }
-    let corners: Vec<Corner> = corners.into_iter().flatten().collect();
+    let corners: Vec<Corner> = slots
+        .into_iter()
+        .map(|(t, c)| Corner {
+            tri: chart.tris[t],
+            shape: shapes[t],
+            a3: a3[t],
+            c,
+        })
+        .collect();
     let totals = |uv: &[DVec2]| -> Option<(f64, f64)> {
         let (mut s, mut a) = (0.0, 0.0);
         for ((tri, shape), &a3) in chart.tris.iter().zip(&shapes).zip(&a3) {
