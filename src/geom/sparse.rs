@@ -10,15 +10,21 @@
 //! so the next system of that pattern is filled in one pass, its values summed in the same
 //! order and so the same to the bit. Its [`Cholesky`] keeps the ordering and symbolic
 //! factorisation (faer's defaults, as its `Llt` solver makes them) with the numeric factor's
-//! storage and work space, so a Newton step allocates nothing for its solve.
+//! storage and work space, so a Newton step allocates nothing for its solve. Where faer's
+//! factor is simplicial (up-looking, row by row), it also keeps what that factorisation
+//! derives from the pattern alone for every system: the permuted upper triangle and each
+//! row's elimination-tree reach, in faer's order. The numeric factorisation is then faer's
+//! loop, the same operations in the same order (the same factor to the bit), without the
+//! permutation and the tree walks; a supernodal factor is left to faer.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::sparse::utils::permute_self_adjoint_to_unsorted;
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, MatMut, Par, Side};
 
 /// The `n` × `n` matrix with the sum of the `triplets`' values at each (row, column) they
@@ -127,6 +133,154 @@ pub struct Cholesky {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
     scratch: MemBuffer,
+    /// For a simplicial factor, what its numeric factorisation reads of the pattern alone.
+    plan: Option<Plan>,
+}
+
+/// The pattern-only part of faer's simplicial up-looking LLᵀ, made once per pattern: the
+/// permuted upper triangle (each entry's row and the index of its value in the matrix given)
+/// and each row's elimination-tree reach, both in the order faer's own factorisation takes
+/// them, so [`Plan::factor`] performs faer's arithmetic in faer's order (the same factor to
+/// the bit) without permuting the matrix and walking the tree for every system.
+struct Plan {
+    a_ptr: Vec<usize>,
+    a_row: Vec<usize>,
+    a_src: Vec<usize>,
+    reach_ptr: Vec<usize>,
+    reach: Vec<usize>,
+    l_ptr: Vec<usize>,
+    l_row: Vec<usize>,
+    /// Work space: the dense row being eliminated, and each column's next free slot.
+    x: Vec<f64>,
+    next: Vec<usize>,
+}
+
+impl Plan {
+    /// The plan of `pattern` under `symbolic`; `None` where faer's factor is supernodal or
+    /// unpermuted (faer factorises those itself).
+    fn new(pattern: &Pattern, symbolic: &SymbolicCholesky<usize>) -> Option<Plan> {
+        let SymbolicCholeskyRaw::Simplicial(s) = symbolic.raw() else {
+            return None;
+        };
+        let perm = symbolic.perm()?;
+        let n = pattern.n;
+        let nnz = pattern.symbolic.row_idx().len();
+        // The matrix with each entry's own index as its value, permuted as faer permutes.
+        let index: Vec<f64> = (0..nnz).map(|i| i as f64).collect();
+        let a = SparseColMatRef::new(pattern.symbolic.as_ref(), &index);
+        let mut val = vec![0.0f64; nnz];
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = vec![0usize; nnz];
+        let mut buf = MemBuffer::try_new(StackReq::new::<usize>(n)).ok()?;
+        let permuted = permute_self_adjoint_to_unsorted(
+            &mut val,
+            &mut col_ptr,
+            &mut row_idx,
+            a,
+            perm,
+            Side::Lower,
+            Side::Upper,
+            MemStack::new(&mut buf),
+        );
+        let (a_ptr, a_row) = (
+            permuted.symbolic().col_ptr().to_vec(),
+            permuted.symbolic().row_idx().to_vec(),
+        );
+        let a_src: Vec<usize> = permuted.val().iter().map(|&v| v as usize).collect();
+        let (l_ptr, l_row) = (s.col_ptr().to_vec(), s.row_idx().to_vec());
+        // The elimination tree: each column's first row below the diagonal.
+        let parent: Vec<usize> = (0..n)
+            .map(|j| {
+                if l_ptr[j] + 1 < l_ptr[j + 1] {
+                    l_row[l_ptr[j] + 1]
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        // Each row's reach: the paths up the tree from the row's entries left of the
+        // diagonal, the later paths in front.
+        let mut visited = vec![usize::MAX; n];
+        let mut stack = vec![0usize; n];
+        let mut reach_ptr = Vec::with_capacity(n + 1);
+        let mut reach = Vec::with_capacity(l_row.len().saturating_sub(n));
+        reach_ptr.push(0);
+        for k in 0..n {
+            let mut top = n;
+            visited[k] = k;
+            for &i0 in &a_row[a_ptr[k]..a_ptr[k + 1]] {
+                if i0 >= k {
+                    continue;
+                }
+                let (mut i, mut len) = (i0, 0);
+                while visited[i] != k {
+                    stack[len] = i;
+                    len += 1;
+                    visited[i] = k;
+                    i = parent[i];
+                    if i >= n {
+                        return None;
+                    }
+                }
+                stack.copy_within(..len, top - len);
+                top -= len;
+            }
+            reach.extend_from_slice(&stack[top..]);
+            reach_ptr.push(reach.len());
+        }
+        Some(Plan {
+            a_ptr,
+            a_row,
+            a_src,
+            reach_ptr,
+            reach,
+            next: vec![0; n],
+            x: vec![0.0; n],
+            l_ptr,
+            l_row,
+        })
+    }
+
+    /// Faer's simplicial up-looking LLᵀ of the matrix with values `a` (of the pattern this
+    /// plan was made for) into `l`; false at a pivot that is not positive, or where `a` or
+    /// `l` is not of this plan's size.
+    fn factor(&mut self, a: &[f64], l: &mut [f64]) -> bool {
+        let n = self.next.len();
+        if a.len() != self.a_src.len() || l.len() != self.l_row.len() {
+            return false;
+        }
+        self.x.iter_mut().for_each(|v| *v = 0.0);
+        self.next.copy_from_slice(&self.l_ptr[..n]);
+        let x = &mut self.x;
+        for k in 0..n {
+            for p in self.a_ptr[k]..self.a_ptr[k + 1] {
+                x[self.a_row[p]] += a[self.a_src[p]];
+            }
+            let mut d = x[k];
+            x[k] = 0.0;
+            for &j in &self.reach[self.reach_ptr[k]..self.reach_ptr[k + 1]] {
+                let j_start = self.l_ptr[j];
+                let row = self.next[j] + 1;
+                self.next[j] = row;
+                let xj = x[j];
+                x[j] = 0.0;
+                let dj = 1.0 / l[j_start];
+                let lkj = xj * dj;
+                let xj = lkj;
+                for p in j_start + 1..row {
+                    x[self.l_row[p]] -= l[p] * xj;
+                }
+                d -= lkj * xj;
+                l[row] = lkj;
+            }
+            // Not positive, or NaN.
+            if d.is_nan() || d <= 0.0 {
+                return false;
+            }
+            l[self.l_ptr[k]] = d.sqrt();
+        }
+        true
+    }
 }
 
 impl Cholesky {
@@ -146,6 +300,7 @@ impl Cholesky {
         let scratch = MemBuffer::try_new(req).ok()?;
         Some(Cholesky {
             values: vec![0.0; symbolic.len_val()],
+            plan: Plan::new(pattern, &symbolic),
             symbolic,
             scratch,
         })
@@ -154,6 +309,9 @@ impl Cholesky {
     /// Factorise `a` (of the pattern this was made for, its lower triangle given); false
     /// where it is not numerically positive definite.
     pub fn factor(&mut self, a: &SparseColMat<usize, f64>) -> bool {
+        if let Some(plan) = &mut self.plan {
+            return plan.factor(a.val(), &mut self.values);
+        }
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.values,
@@ -242,6 +400,58 @@ mod tests {
         assert!(!p.fits(3, &[again[1], again[0], again[2], again[3], again[4]]));
         assert!(!p.fits(3, &again[..4]));
         assert!(!p.fits(4, &again));
+    }
+
+    #[test]
+    fn the_kept_plan_factorises_as_faer_does_to_the_bit() {
+        // A 12 x 9 grid's Laplacian with uneven weights plus a diagonal (lower triangle),
+        // with repeated entries, as the solvers assemble theirs.
+        let (w, h) = (12usize, 9usize);
+        let n = w * h;
+        let system = |k: f64| -> Vec<Triplet<usize, usize, f64>> {
+            let mut trip = Vec::new();
+            for y in 0..h {
+                for x in 0..w {
+                    let i = y * w + x;
+                    trip.push(Triplet::new(i, i, 0.1 + k * (i % 7) as f64 * 0.01));
+                    for j in [(x + 1 < w).then(|| i + 1), (y + 1 < h).then(|| i + w)]
+                        .into_iter()
+                        .flatten()
+                    {
+                        let c = 1.0 + ((i * 31 + j * 17) % 13) as f64 / (3.0 + k);
+                        trip.push(Triplet::new(j, i, -c));
+                        trip.push(Triplet::new(i, i, c));
+                        trip.push(Triplet::new(j, j, c));
+                    }
+                }
+            }
+            trip
+        };
+        let p = Pattern::new(n, &system(1.0)).unwrap();
+        let mut chol = Cholesky::new(&p).unwrap();
+        assert!(chol.plan.is_some(), "a simplicial factor gets a plan");
+        for k in [1.0, 2.5] {
+            let a = p.matrix(&system(k));
+            assert!(chol.factor(&a));
+            let mut faer_values = vec![0.0; chol.values.len()];
+            chol.symbolic
+                .factorize_numeric_llt(
+                    &mut faer_values,
+                    a.as_ref(),
+                    Side::Lower,
+                    LltRegularization::default(),
+                    Par::Seq,
+                    MemStack::new(&mut chol.scratch),
+                    Default::default(),
+                )
+                .unwrap();
+            let bits = |v: &[f64]| -> Vec<u64> { v.iter().map(|x| x.to_bits()).collect() };
+            assert_eq!(bits(&chol.values), bits(&faer_values), "k = {k}");
+        }
+        // Not positive definite: refused by the plan as by faer.
+        let mut negative = system(1.0);
+        negative[0].val = -100.0;
+        assert!(!chol.factor(&p.matrix(&negative)));
     }
 
     #[test]
