@@ -106,14 +106,17 @@ impl Segmenter<'_> {
                 push(st, &mut heaps, c, t);
             }
         }
+        // Each chart's area to the power β, kept while its area stays the same.
+        let scale = |c: usize, st: &State| st.area[c].max(1e-300).powf(self.o.beta);
+        let mut scaled: Vec<f64> = charts.iter().map(|&c| scale(c, st)).collect();
         loop {
             let mut best: Option<(f64, usize)> = None;
-            for (k, &c) in charts.iter().enumerate() {
+            for k in 0..charts.len() {
                 while heaps[k].peek().is_some_and(|e| st.assign[e.id] != NONE) {
                     heaps[k].pop();
                 }
                 if let Some(e) = heaps[k].peek() {
-                    let eff = e.key / st.area[c].max(1e-300).powf(self.o.beta);
+                    let eff = e.key / scaled[k];
                     if best.is_none_or(|(b, _)| eff < b) {
                         best = Some((eff, k));
                     }
@@ -125,6 +128,7 @@ impl Segmenter<'_> {
             st.assign[e.id] = c;
             st.dist[e.id] = e.data;
             st.area[c] += self.g.area[e.id];
+            scaled[k] = scale(c, st);
             push(st, &mut heaps, c, e.id);
         }
     }
