@@ -216,7 +216,8 @@ impl Onto<'_> {
 
     /// The first of the [`APART_NEIGHBOURS`] neighbours of `done[part]` sharing the longest
     /// boundary that it is shared out with by `share` ([`share_apart`], [`share_across`]), and
-    /// the two parts (to become the neighbour and `done[part]`).
+    /// the two parts (to become the neighbour and `done[part]`); two are tried at a time where
+    /// a spare thread is free.
     fn share(
         &self,
         done: &[Laid],
@@ -226,17 +227,14 @@ impl Onto<'_> {
         small: f64,
     ) -> Option<(usize, (Laid, Laid))> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
-        owners
-            .neighbours(ctx, done, part)
-            .into_iter()
-            .take(APART_NEIGHBOURS)
-            .find_map(|k| {
-                self.failed
-                    .attempt(trial, &done[k], &done[part], || {
-                        share(ctx, done, k, part, small, opts, eps)
-                    })
-                    .map(|h| (k, h))
+        let mut near = owners.neighbours(ctx, done, part);
+        near.truncate(APART_NEIGHBOURS);
+        crate::geom::par::first(&near, |&k| {
+            self.failed.attempt(trial, &done[k], &done[part], || {
+                share(ctx, done, k, part, small, opts, eps)
             })
+        })
+        .map(|(i, h)| (near[i], h))
     }
 
     /// The first neighbour of `done[part]` that it joins and the union: hinged onto one
@@ -255,7 +253,8 @@ impl Onto<'_> {
     }
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
-    /// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union.
+    /// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union; two are
+    /// tried at a time where a spare thread is free.
     fn hinge(
         &self,
         done: &[Laid],
@@ -264,17 +263,18 @@ impl Onto<'_> {
         allowed: &dyn Fn(usize) -> bool,
     ) -> Option<(usize, Laid)> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
-        owners
+        let near: Vec<usize> = owners
             .neighbours(ctx, done, part)
             .into_iter()
             .filter(|&k| allowed(k))
-            .find_map(|k| {
-                self.failed
-                    .attempt(Trial::Hinge, &done[k], &done[part], || {
-                        hinge(ctx, done, k, part, opts, eps)
-                    })
-                    .map(|l| (k, l))
-            })
+            .collect();
+        crate::geom::par::first(&near, |&k| {
+            self.failed
+                .attempt(Trial::Hinge, &done[k], &done[part], || {
+                    hinge(ctx, done, k, part, opts, eps)
+                })
+        })
+        .map(|(i, l)| (near[i], l))
     }
 }
 
