@@ -195,8 +195,7 @@ struct Onto<'a> {
 impl Onto<'_> {
     /// The first of the [`SLIT_TRIES`] neighbours of `done[part]` sharing the longest
     /// boundary that it merges with by `merge` ([`slit_merge`], [`dart_merge`]), and the
-    /// union; two are tried at a time where a spare thread is free
-    /// ([`crate::geom::par::first`]).
+    /// union; two are tried at a time where a thread is idle ([`Failed::first`]).
     fn merge(
         &self,
         done: &[Laid],
@@ -206,18 +205,15 @@ impl Onto<'_> {
     ) -> Option<(usize, Laid)> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
         let near: Vec<usize> = owners.nearest(ctx, done, part, SLIT_TRIES);
-        crate::geom::par::first(&near, |&k| {
-            self.failed.attempt(trial, &done[k], &done[part], || {
-                merge(ctx, done, k, part, opts, eps)
-            })
+        self.failed.first(trial, done, &near, part, |k| {
+            merge(ctx, done, k, part, opts, eps)
         })
-        .map(|(i, l)| (near[i], l))
     }
 
     /// The first of the [`APART_NEIGHBOURS`] neighbours of `done[part]` sharing the longest
     /// boundary that it is shared out with by `share` ([`share_apart`], [`share_across`]), and
     /// the two parts (to become the neighbour and `done[part]`); two are tried at a time where
-    /// a spare thread is free.
+    /// a thread is idle ([`Failed::first`]).
     fn share(
         &self,
         done: &[Laid],
@@ -229,12 +225,9 @@ impl Onto<'_> {
         let (ctx, opts, eps) = (self.ctx, self.opts, self.eps);
         let mut near = owners.neighbours(ctx, done, part);
         near.truncate(APART_NEIGHBOURS);
-        crate::geom::par::first(&near, |&k| {
-            self.failed.attempt(trial, &done[k], &done[part], || {
-                share(ctx, done, k, part, small, opts, eps)
-            })
+        self.failed.first(trial, done, &near, part, |k| {
+            share(ctx, done, k, part, small, opts, eps)
         })
-        .map(|(i, h)| (near[i], h))
     }
 
     /// The first neighbour of `done[part]` that it joins and the union: hinged onto one
@@ -254,7 +247,7 @@ impl Onto<'_> {
 
     /// The first neighbour of `done[part]` (those sharing the longest boundary first) that
     /// `allowed` lets it go onto and that it hinges onto ([`hinge`]), and the union; two are
-    /// tried at a time where a spare thread is free.
+    /// tried at a time where a thread is idle ([`Failed::first`]).
     fn hinge(
         &self,
         done: &[Laid],
@@ -268,13 +261,9 @@ impl Onto<'_> {
             .into_iter()
             .filter(|&k| allowed(k))
             .collect();
-        crate::geom::par::first(&near, |&k| {
-            self.failed
-                .attempt(Trial::Hinge, &done[k], &done[part], || {
-                    hinge(ctx, done, k, part, opts, eps)
-                })
+        self.failed.first(Trial::Hinge, done, &near, part, |k| {
+            hinge(ctx, done, k, part, opts, eps)
         })
-        .map(|(i, l)| (near[i], l))
     }
 }
 

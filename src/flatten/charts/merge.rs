@@ -64,7 +64,6 @@ use super::slit::{uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
 use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between, split_between_area};
-use crate::geom::par::first;
 use glam::DVec2;
 
 /// Pieces under this share of the surface's area are merged where they can be.
@@ -152,7 +151,7 @@ enum Fate {
 
 /// The fate of the small piece `done[si]` (see [`merge_small`]): laid out again as one with
 /// a neighbour, else shared out with one, else grafted onto the neighbours as they lie. The
-/// neighbours are tried in turn, two at a time where a thread is idle ([`first`]).
+/// neighbours are tried in turn, two at a time where a thread is idle ([`Failed::first`]).
 #[allow(clippy::too_many_arguments)]
 fn fate(
     ctx: &Charts,
@@ -173,26 +172,22 @@ fn fate(
     }
     // Without the cuts the two as one do not need, where the union with them was not over
     // the tolerance (see `Trial::Stretched`).
-    // Each neighbour in turn, two at a time where a thread is idle (a trial is a function of
-    // the two pieces alone, see `Failed`).
-    let uncut = first(&near[..near.len().min(SLIT_TRIES)], |&k| {
-        if failed.known(Trial::Stretched, &done[k], &done[si]) {
-            return None;
-        }
-        failed.attempt(Trial::Uncut, &done[k], &done[si], || {
-            uncut_merge(ctx, done, k, si, opts, eps)
-        })
-    });
-    if let Some((i, union)) = uncut {
-        return Fate::Merged(near[i], union);
+    let unstretched: Vec<usize> = near
+        .iter()
+        .take(SLIT_TRIES)
+        .copied()
+        .filter(|&k| !failed.known(Trial::Stretched, &done[k], &done[si]))
+        .collect();
+    if let Some((k, union)) = failed.first(Trial::Uncut, done, &unstretched, si, |k| {
+        uncut_merge(ctx, done, k, si, opts, eps)
+    }) {
+        return Fate::Merged(k, union);
     }
-    let shared = first(&near[..near.len().min(REBALANCE_TRIES)], |&k| {
-        failed.attempt(Trial::Share, &done[k], &done[si], || {
-            rebalance(ctx, done, k, si, small, opts, eps)
-        })
-    });
-    if let Some((i, halves)) = shared {
-        return Fate::Shared(near[i], halves);
+    let share_with = &near[..near.len().min(REBALANCE_TRIES)];
+    if let Some((k, halves)) = failed.first(Trial::Share, done, share_with, si, |k| {
+        rebalance(ctx, done, k, si, small, opts, eps)
+    }) {
+        return Fate::Shared(k, halves);
     }
     match graft(ctx, done, &near, si, opts.tolerance, eps) {
         Some(took) => Fate::Grafted(took),

@@ -392,9 +392,9 @@ pub(super) fn keeps(ctx: &Charts, l: &Laid, opts: &FlattenOptions, eps: f64) -> 
 }
 
 /// The first of the neighbours `near` that `done[part]` merges into ([`merge_into`]) and
-/// the union, as trying them in order finds it; two are tried at a time where a spare thread
-/// is free ([`crate::geom::par::first`]). A pair `failed` already is skipped; one that fails
-/// now is noted there, and so is a union over the tolerance ([`Trial::Stretched`]).
+/// the union, as trying them in order finds it ([`Failed::first`]). A pair `failed` already
+/// is skipped; one that fails now is noted there, and so is a union over the tolerance
+/// ([`Trial::Stretched`]).
 pub(super) fn first_merge(
     ctx: &Charts,
     done: &[Laid],
@@ -404,16 +404,13 @@ pub(super) fn first_merge(
     eps: f64,
     failed: &Failed,
 ) -> Option<(usize, Laid)> {
-    crate::geom::par::first(near, |&k| {
-        failed.attempt(Trial::Merge, &done[k], &done[part], || {
-            let l = laid_as_one(ctx, done, k, part)?;
-            if l.stretch.l2 > opts.tolerance {
-                failed.note(Trial::Stretched, &done[k], &done[part]);
-            }
-            Some(l).filter(|l| keeps(ctx, l, opts, eps))
-        })
+    failed.first(Trial::Merge, done, near, part, |k| {
+        let l = laid_as_one(ctx, done, k, part)?;
+        if l.stretch.l2 > opts.tolerance {
+            failed.note(Trial::Stretched, &done[k], &done[part]);
+        }
+        Some(l).filter(|l| keeps(ctx, l, opts, eps))
     })
-    .map(|(i, l)| (near[i], l))
 }
 
 /// The trials on a pair of pieces that [`Failed`] remembers.
@@ -504,6 +501,24 @@ impl Failed {
             }
         }
         out
+    }
+
+    /// The first of the neighbours `near`, in order, on which `trial` with `done[part]` gives
+    /// something (`run` of the neighbour, through [`Failed::attempt`]), and what it gave. Two
+    /// are tried at a time where a thread is idle ([`crate::geom::par::first`]): a trial is a
+    /// function of the two pieces alone, so the answer is the one trying them in turn finds.
+    pub(super) fn first<T: Send>(
+        &self,
+        trial: Trial,
+        done: &[Laid],
+        near: &[usize],
+        part: usize,
+        run: impl Fn(usize) -> Option<T> + Sync,
+    ) -> Option<(usize, T)> {
+        crate::geom::par::first(near, |&k| {
+            self.attempt(trial, &done[k], &done[part], || run(k))
+        })
+        .map(|(i, r)| (near[i], r))
     }
 }
 
