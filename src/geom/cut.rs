@@ -269,6 +269,102 @@ fn split_ordered(
         .then_some((order, second))
 }
 
+/// Corridors through `faces` from the faces `from` beside them to other regions: for each
+/// region `to` names (a face's region, `None` for a face of neither), nearest first, at most
+/// `most`, the faces of `faces` on a shortest path (through centroids) from one next to a
+/// face of `from` to the nearest next to a face of that region, from that end back.
+pub(crate) fn corridors(
+    g: &Graph,
+    faces: &[usize],
+    from: &[usize],
+    to: &dyn Fn(usize) -> Option<usize>,
+    may_end: &dyn Fn(usize) -> bool,
+    most: usize,
+) -> Vec<Vec<usize>> {
+    let mut inside = vec![false; g.area.len()];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let mut sources: Vec<usize> = from
+        .iter()
+        .flat_map(|&s| g.adj[s].iter().map(|&(f, _)| f))
+        .filter(|&f| inside[f])
+        .collect();
+    sources.sort_unstable();
+    sources.dedup();
+    let d = g.distances(&sources, &|f| inside[f]);
+    // Each face next to a region, by its distance (ties: lower face, then lower region).
+    let mut ends: Vec<(f64, usize, usize)> = faces
+        .iter()
+        .filter(|&&f| d[f].is_finite() && may_end(f))
+        .flat_map(|&f| g.adj[f].iter().filter_map(move |&(h, _)| Some((f, to(h)?))))
+        .map(|(f, region)| (d[f], f, region))
+        .collect();
+    ends.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let step = |f: usize, h: usize| d[h] + g.centroid[f].distance(g.centroid[h]);
+    let mut reached: Vec<usize> = Vec::new();
+    let mut out = Vec::new();
+    for (_, end, region) in ends {
+        if out.len() == most {
+            break;
+        }
+        if reached.contains(&region) {
+            continue;
+        }
+        reached.push(region);
+        // Back along the shortest path: each face's predecessor is the neighbour nearer the
+        // start through which its distance was reached (ties: lower face).
+        let mut path = vec![end];
+        let mut at = end;
+        while d[at] > 0.0 && path.len() <= faces.len() {
+            let back = g.adj[at]
+                .iter()
+                .map(|&(h, _)| h)
+                .filter(|&h| inside[h] && d[h] < d[at])
+                .min_by(|&x, &y| step(at, x).total_cmp(&step(at, y)).then(x.cmp(&y)));
+            let Some(h) = back else {
+                break;
+            };
+            path.push(h);
+            at = h;
+        }
+        out.push(path);
+    }
+    out
+}
+
+/// The connected parts of `faces` through the face graph restricted to them, each in the
+/// order of `faces`, in the order of their first faces.
+pub(crate) fn components(g: &Graph, faces: &[usize]) -> Vec<Vec<usize>> {
+    let mut inside = vec![false; g.area.len()];
+    for &f in faces {
+        inside[f] = true;
+    }
+    let mut part = vec![usize::MAX; g.area.len()];
+    let mut count = 0;
+    for &f in faces {
+        if part[f] != usize::MAX {
+            continue;
+        }
+        part[f] = count;
+        let mut stack = vec![f];
+        while let Some(x) = stack.pop() {
+            for &(h, _) in &g.adj[x] {
+                if inside[h] && part[h] == usize::MAX {
+                    part[h] = count;
+                    stack.push(h);
+                }
+            }
+        }
+        count += 1;
+    }
+    let mut out = vec![Vec::new(); count];
+    for &f in faces {
+        out[part[f]].push(f);
+    }
+    out
+}
+
 /// Split faces in two by which of faces `a` and `b` is nearer through the face graph restricted
 /// to `faces` (used to separate two faces whose layouts overlap). Each part is connected when
 /// `faces` is.
@@ -845,5 +941,54 @@ mod tests {
         assert_eq!(split_between_area(&g, &faces, a, b, 60.0), None);
         let apart: Vec<usize> = (0..6).chain(10..16).collect();
         assert_eq!(split_between_area(&g, &apart, 0, 12, 1.0), None);
+    }
+
+    /// The strip's cells 0–2 (faces 0..6) are the small region, cells 3–9 and the block's
+    /// first column (faces 6..40) the faces a corridor runs through, the rest of the block
+    /// two other regions (rows 0–4 and 5–9).
+    #[test]
+    fn corridors_run_from_a_region_through_the_faces_to_the_nearest_face_of_each_other() {
+        let mesh = strip_and_block();
+        let topo = mesh.topology();
+        let g = Graph::new(&mesh, &topo);
+        let from: Vec<usize> = (0..6).collect();
+        let through: Vec<usize> = (6..40).collect();
+        // Block cell (i, j) has faces 20 + 2 (10 (i − 10) + j) and the next.
+        let region = |f: usize| (f >= 40).then(|| 1 + ((f - 20) / 2 % 10 >= 5) as usize);
+        let adjacent = |f: usize, h: usize| g.adj[f].iter().any(|&(x, _)| x == h);
+        let paths = corridors(&g, &through, &from, &region, &|_| true, 4);
+        assert_eq!(paths.len(), 2, "one per other region");
+        for (path, want) in paths.iter().zip([1, 2]) {
+            let (end, start) = (path[0], path[path.len() - 1]);
+            assert!(g.adj[end].iter().any(|&(h, _)| region(h) == Some(want)));
+            assert!(from.iter().any(|&s| adjacent(start, s)), "{path:?}");
+            assert!(path.windows(2).all(|w| adjacent(w[0], w[1])), "{path:?}");
+            assert!(path.iter().all(|f| through.contains(f)));
+        }
+        // The nearer region first, along the strip to the block's first cell beside it.
+        assert_eq!(paths[0][0] / 2, 10, "cell (10, 0): {:?}", paths[0]);
+        assert!(paths[0].len() < paths[1].len());
+        assert_eq!(
+            corridors(&g, &through, &from, &region, &|_| true, 1).len(),
+            1
+        );
+        // Ends that may not be used: the corridor goes on to the next cell of the column.
+        let later = corridors(&g, &through, &from, &region, &|f| f / 2 != 10, 1);
+        assert_eq!(later[0][0] / 2, 11, "cell (10, 1): {:?}", later[0]);
+        // No corridor where no other region is next to the faces.
+        assert!(corridors(&g, &through, &from, &|_| None, &|_| true, 4).is_empty());
+    }
+
+    #[test]
+    fn components_are_the_connected_parts_in_order() {
+        let mesh = strip_and_block();
+        let topo = mesh.topology();
+        let g = Graph::new(&mesh, &topo);
+        let faces: Vec<usize> = [12, 13, 0, 1, 2, 3, 10].into();
+        assert_eq!(
+            components(&g, &faces),
+            vec![vec![12, 13, 10], vec![0, 1, 2, 3]]
+        );
+        assert!(components(&g, &[]).is_empty());
     }
 }

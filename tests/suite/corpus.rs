@@ -322,7 +322,8 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
 /// pieces); shared out where a small piece and a neighbour overlap, 6 (33 pieces); merged
 /// with darts where the two as one stretch past the tolerance, 5 (32 pieces); passed on
 /// through a neighbour to a third piece (`flatten::charts::hinge`'s `pass_on`), 4 are (31
-/// pieces).
+/// pieces); passed through the neighbour that closes round them along a corridor to a third
+/// piece (`flatten::charts::merge`'s `pass_through`), 2 are (29 pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     require_shared!();
@@ -330,8 +331,39 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 4, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 31, "{} pieces", r.pieces);
+    assert!(r.small <= 2, "{} pieces under 1 % of the area", r.small);
+    assert!(r.pieces <= 29, "{} pieces", r.pieces);
+}
+
+/// Issue 20, item 3: a small piece whose neighbour closes round it (a gusset at a saddle:
+/// the two as one turn past a full turn round a vertex) fits beside that neighbour in no
+/// way. Pig in metal kept one (4 faces, 0.17 %, in a notch of its only neighbour), homer in
+/// paper one (79 faces), homer in metal three (35 pieces). Passed through the neighbour along
+/// a corridor of its faces to a third piece and joined to that (`flatten::charts::merge`'s
+/// `pass_through`), pig in metal and homer in paper keep none and homer in metal one (32
+/// pieces).
+#[test]
+fn corpus_small_pieces_closed_round_by_a_neighbour_are_passed_through_it() {
+    require_shared!();
+    for (name, kind, tolerance, most) in [
+        ("pig.obj", MaterialKind::Metal, 1.001, 0),
+        ("homer.obj", MaterialKind::Paper, 1.003, 0),
+        ("homer.obj", MaterialKind::Metal, 1.001, 1),
+    ] {
+        let mesh = shared_data("meshes").join(name);
+        let r = run(&mesh, kind);
+        print_row(&mesh, kind, &r);
+        assert!(
+            r.worst_piece <= tolerance,
+            "{name} {kind:?}: worst piece L2 {}",
+            r.worst_piece
+        );
+        assert!(
+            r.small <= most,
+            "{name} {kind:?}: {} pieces under 1 % of the area",
+            r.small
+        );
+    }
 }
 
 /// Issue 20, item 3: cow in paper at 300 mm on A4 kept one piece under 1 % of the area (50

@@ -17,7 +17,9 @@
 //! in the piece's layout, hinged on its own: the first onto a neighbour, the second onto a piece
 //! next to it then (the one that took the first too); else it is quartered (each half halved
 //! again) and the quarters hinged so in turn. Where the whole would wrap round a saddle vertex
-//! past a full turn, each part may still fit beside the piece on its side. All parts or none.
+//! past a full turn, each part may still fit beside the piece on its side. All parts or none,
+//! and only parts that lie in one piece in the piece's layout (a part joined to itself only
+//! through the piece's cuts would be hinged by one side and leave the other lying apart).
 //!
 //! A small piece that hinges in no way is then laid out anew with a neighbour as one, with a
 //! slit where the two turn past a full turn round a vertex of their border ([`super::slit`]);
@@ -26,9 +28,11 @@
 //! it is laid out with a neighbour as one with darts where the two stretch past the tolerance
 //! ([`dart_merge`]). Last, it is passed on through a neighbour ([`pass_on`]): where the two
 //! overlap, they are split between the overlapping faces into two parts, one or both under
-//! the small share (a narrow arm of the neighbour that the piece folds over, say), and each
-//! small part joined to a piece next to it in any of the ways above; the small piece is gone,
-//! and the neighbour too where both parts were small. Last of all, it is laid out anew with
+//! the small share (a narrow arm of the neighbour that the piece folds over, say); else,
+//! where the neighbour closes round it (a gusset at a saddle), it takes a corridor of the
+//! neighbour's faces out to a third piece ([`pass_through`]); and each small part is joined
+//! to a piece next to it in any of the ways above; the small piece is gone, and the
+//! neighbour too where both parts were small. Last of all, it is laid out anew with
 //! a neighbour as one with none of their cuts but those the union needs to be a disk
 //! ([`uncut_merge`]: a piece filling a hole of its neighbour).
 //!
@@ -56,7 +60,9 @@
 //!   tolerance, so the hinge edge itself always is.
 
 use super::join::{common, fits_room, Common};
-use super::merge::{pass_apart, share_across, share_apart, small_pieces, MERGE_TRIES};
+use super::merge::{
+    corridors_out, pass_apart, pass_through, share_across, share_apart, small_pieces, MERGE_TRIES,
+};
 use super::overlap::{first_merge, keeps, self_overlap, Failed, Owners, Trial};
 use super::slit::{dart_merge, slit_merge, uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
@@ -369,7 +375,8 @@ fn hinge_parts(
             })
         })
         .collect();
-    let Some(laid) = laid else {
+    // A part joined only through the piece's cuts would lie in two places: it hinges on one.
+    let Some(laid) = laid.filter(|l| l.iter().all(|p| ctx.flat_parts(p).len() == 1)) else {
         return false;
     };
     // The parts as pieces of their own, after the others; the piece is gone meanwhile.
@@ -431,9 +438,10 @@ fn hinge_halves(onto: &Onto, done: &mut Vec<Laid>, owners: &mut Owners, si: usiz
 }
 
 /// Pass a small piece `done[si]` on through a neighbour: shared out with it where the two
-/// overlap into two parts, one or both under `small` ([`pass_apart`]), and each small part,
-/// the smaller first, joined to a piece next to it then ([`Onto::join`]: a third piece, or
-/// the other part). Of the [`PASS_NEIGHBOURS`] neighbours sharing the longest boundary,
+/// overlap into two parts, one or both under `small` ([`pass_apart`]), else along a corridor
+/// of the neighbour's faces to a third piece ([`pass_through`], [`corridors_out`]), and each
+/// small part, the smaller first, joined to a piece next to it then ([`Onto::join`]: a third
+/// piece, or the other part). Of the [`PASS_NEIGHBOURS`] neighbours sharing the longest boundary,
 /// the first through which it passes. All or none: true when it passed, the neighbour then
 /// its larger part in `done` (or marked gone in `owners` where that was small too), the
 /// pieces that took the small parts their unions, and `done[si]` marked gone; else `done`
@@ -443,6 +451,12 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
     let near: Vec<usize> = owners.nearest(ctx, done, si, PASS_NEIGHBOURS);
     near.into_iter().any(|k| {
         let pair = [done[k].clone(), done[si].clone()];
+        // Paths through the neighbour to a third piece, for a small piece it closes round.
+        let third = |f: usize| {
+            let o = owners.owner[f];
+            (o != k && o != si && !owners.gone[o]).then_some(o)
+        };
+        let through = corridors_out(ctx, &pair, &third);
         let mut take = |parts: (Laid, Laid)| -> Option<()> {
             owners.shared(done, (k, si), parts);
             // Each small part joined in turn, the smaller first.
@@ -470,6 +484,7 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
         onto.failed
             .attempt(Trial::Pass, &pair[0], &pair[1], || {
                 pass_apart(ctx, &pair, small, opts, eps, &mut take)
+                    .or_else(|| pass_through(ctx, &pair, &through, opts, eps, &mut take))
             })
             .is_some()
     })

@@ -25,8 +25,10 @@
 //! changed none of its neighbours (`merge_small_once`). What is still small once every merge below is done is hinged onto a
 //! neighbour by one edge ([`super::hinge`]), and what hinges in no way is last shared out with
 //! a neighbour where the two overlap (`share_apart`): split between two faces that fold over
-//! each other, moved across where a part would be small. A piece too long for the sheet that
-//! hinges in no parts is shared out with a neighbour across its length (`share_across`).
+//! each other, moved across where a part would be small; one its neighbour closes round
+//! takes a corridor of the neighbour's faces out to a third piece (`pass_through`). A piece
+//! too long for the sheet that hinges in no parts is shared out with a neighbour across its
+//! length (`share_across`).
 //!
 //! Then any two neighbouring pieces are joined where their layouts already fit together
 //! (`attach`): a CAD part made of developable patches meeting at folds (fandisk, the
@@ -63,7 +65,9 @@ use super::overlap::{
 use super::slit::{uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
-use crate::geom::cut::{bisect, bisect_area, farthest_apart, split_between, split_between_area};
+use crate::geom::cut::{
+    bisect, bisect_area, components, corridors, farthest_apart, split_between, split_between_area,
+};
 use glam::DVec2;
 
 /// Pieces under this share of the surface's area are merged where they can be.
@@ -362,6 +366,88 @@ pub(super) fn pass_apart<T>(
         eps,
     };
     shares.apart(pair, 0, 1, take)
+}
+
+/// Corridors of each kind a small piece is passed through its neighbour by at most
+/// ([`corridors_out`]).
+const THROUGH_TRIES: usize = 4;
+
+/// The corridors [`pass_through`] tries for the small piece `pair[1]` through its neighbour
+/// `pair[0]`, to the pieces `third` names (a face's piece, `None` for the two's): first those
+/// ending on a face that shares no vertex with the small piece, then any, each kind one per
+/// third piece, nearest first, at most [`THROUGH_TRIES`] ([`corridors`]). A corridor ending
+/// beside the small piece reaches the third piece round the vertex where the small piece and
+/// its neighbour turned past a full turn, and the corridor with the small piece may turn past
+/// one with the third piece there too.
+pub(super) fn corridors_out(
+    ctx: &Charts,
+    pair: &[Laid],
+    third: &dyn Fn(usize) -> Option<usize>,
+) -> Vec<Vec<usize>> {
+    let mut touched: Vec<usize> = pair[1]
+        .faces
+        .iter()
+        .flat_map(|&f| ctx.mesh.faces[f].verts.iter().copied())
+        .collect();
+    touched.sort_unstable();
+    touched.dedup();
+    let apart = |f: usize| {
+        let verts = &ctx.mesh.faces[f].verts;
+        verts.iter().all(|v| touched.binary_search(v).is_err())
+    };
+    let (n, s) = (&pair[0].faces, &pair[1].faces);
+    let mut out = corridors(ctx.graph, n, s, third, &apart, THROUGH_TRIES);
+    for path in corridors(ctx.graph, n, s, third, &|_| true, THROUGH_TRIES) {
+        if !out.contains(&path) {
+            out.push(path);
+        }
+    }
+    out
+}
+
+/// The share-outs of `pair[1]` (a small piece) and `pair[0]` (its neighbour) along
+/// `corridors` (each a path of the neighbour's faces from the small piece to a third piece,
+/// [`crate::geom::cut::corridors`]): the small piece takes the corridor's faces, the neighbour keeps the rest.
+/// A small piece its neighbour closes round (a gusset at a saddle, where the two as one turn
+/// past a full turn round a vertex) fits beside the neighbour in no way; with a corridor it
+/// reaches a third piece, which it may fit beside. Each laid out from the two joined as they
+/// lie ([`moved_onto`]) and kept as [`pass_apart`]'s parts are, the neighbour's part first,
+/// given to `take` in turn; the first that `take` makes something of.
+pub(super) fn pass_through<T>(
+    ctx: &Charts,
+    pair: &[Laid],
+    corridors: &[Vec<usize>],
+    opts: &FlattenOptions,
+    eps: f64,
+    take: &mut impl FnMut((Laid, Laid)) -> Option<T>,
+) -> Option<T> {
+    let joined = moved_onto(ctx, pair, 0, 1).map(|j| Whole::new(&j.faces, &j.uv));
+    let cuts = both_cuts(&pair[0], &pair[1]);
+    corridors.iter().find_map(|path| {
+        let mut taken = path.clone();
+        taken.sort_unstable();
+        let rest: Vec<usize> = pair[0]
+            .faces
+            .iter()
+            .copied()
+            .filter(|f| taken.binary_search(f).is_err())
+            .collect();
+        // Where the corridor cuts the neighbour through, the small piece takes the parts
+        // cut off too: the neighbour keeps its largest part (ties: the first).
+        let mut parts = components(ctx.graph, &rest);
+        let largest = (0..parts.len()).max_by(|&x, &y| {
+            ctx.area(&parts[x])
+                .total_cmp(&ctx.area(&parts[y]))
+                .then(y.cmp(&x))
+        })?;
+        let a = parts.swap_remove(largest);
+        let mut b = pair[1].faces.clone();
+        b.extend(path);
+        b.extend(parts.into_iter().flatten());
+        lay_halves(ctx, joined.as_deref(), &cuts, a, b, opts, eps)
+            .filter(|(ha, hb)| fits_room(opts.room, &ha.uv) && fits_room(opts.room, &hb.uv))
+            .and_then(&mut *take)
+    })
 }
 
 /// Share a piece `done[part]` too long for the sheet (and under twice `small` in area) and
@@ -846,5 +932,62 @@ mod tests {
         all.sort_unstable();
         assert_eq!(all, (0..240).collect::<Vec<_>>());
         assert!(share_across(&ctx, &done, 0, 1, 5500.0, &opts, eps).is_none());
+    }
+
+    /// A one-cell piece in a hole of its neighbour (a 5 × 5 block of cells, the piece at
+    /// column 2, row 3), a third piece beside the neighbour (columns 5–7): the corridors run
+    /// from the hole to the third piece, the first ending away from the small piece's
+    /// vertices; passed through the first, the small piece takes the corridor, the neighbour
+    /// keeps the rest, both laid out and kept.
+    #[test]
+    fn a_small_piece_in_a_hole_of_its_neighbour_is_passed_through_it_to_a_third_piece() {
+        let opts = FlattenOptions::default();
+        let (mesh, blocks) = strip_and_squares(&[(0..5, 1..6), (5..8, 1..6)]);
+        let fx = Fixture::new(mesh);
+        let ctx = fx.charts(&opts);
+        let eps = 1e-6;
+        let cell = |i: usize, j: usize| 2 * ((j - 1) * 5 + i);
+        let hole = [cell(2, 3), cell(2, 3) + 1];
+        let around: Vec<usize> = blocks[0].clone().filter(|f| !hole.contains(f)).collect();
+        let cuts = ctx.disk(&around, &[]).expect("cut to a disk");
+        assert!(!cuts.is_empty(), "an annulus needs a cut");
+        let Ok(Layout::Laid(uv, stretch)) = ctx.lay(&around, &cuts) else {
+            panic!("neighbour not laid out");
+        };
+        let neighbour = Laid {
+            faces: around.clone(),
+            cuts,
+            uv,
+            stretch,
+            gusset: false,
+        };
+        let pair = [neighbour, ctx.piece(hole.to_vec())];
+        let third_faces = blocks[1].clone();
+        let third = |f: usize| third_faces.contains(&f).then_some(2);
+        let paths = corridors_out(&ctx, &pair, &third);
+        assert!(!paths.is_empty());
+        let verts = |f: usize| fx.mesh.faces[f].verts.clone();
+        let touches_hole = |f: usize| {
+            verts(f)
+                .iter()
+                .any(|v| hole.iter().any(|&h| verts(h).contains(v)))
+        };
+        assert!(!touches_hole(paths[0][0]), "{:?}", paths[0]);
+        assert!(fx.graph.adj[paths[0][0]]
+            .iter()
+            .any(|&(h, _)| third(h).is_some()));
+        let (a, b) = pass_through(&ctx, &pair, &paths, &opts, eps, &mut Some).expect("passed");
+        assert!(hole.iter().all(|f| b.faces.contains(f)));
+        assert!(paths[0].iter().all(|f| b.faces.contains(f)));
+        let mut all = [a.faces.clone(), b.faces.clone()].concat();
+        all.sort_unstable();
+        assert_eq!(all, blocks[0].clone().collect::<Vec<_>>());
+        for part in [&a, &b] {
+            assert!(keeps(&ctx, part, &opts, eps));
+            assert!((part.stretch.l2 - 1.0).abs() < 1e-9, "{}", part.stretch.l2);
+        }
+        // Nothing to pass through where no corridor reaches a third piece.
+        assert!(corridors_out(&ctx, &pair, &|_| None).is_empty());
+        assert!(pass_through(&ctx, &pair, &[], &opts, eps, &mut Some).is_none());
     }
 }

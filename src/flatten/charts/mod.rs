@@ -622,6 +622,71 @@ impl Charts<'_> {
         disk_cuts(self.mesh, self.topo, self.graph, faces, &|_| false)
     }
 
+    /// The parts of `l` as it lies: its faces (indices into `l.faces`) joined through edges
+    /// that are not cut and whose two copies coincide, one sorted list per part, in the order
+    /// of their first faces. One part, unless a layout was put together wrongly.
+    fn flat_parts(&self, l: &Laid) -> Vec<Vec<usize>> {
+        let mut at: HashMap<usize, usize> = HashMap::with_capacity(l.faces.len());
+        for (i, &f) in l.faces.iter().enumerate() {
+            at.insert(f, i);
+        }
+        let mut part = vec![usize::MAX; l.faces.len()];
+        let mut parts = Vec::new();
+        for first in 0..l.faces.len() {
+            if part[first] != usize::MAX {
+                continue;
+            }
+            part[first] = parts.len();
+            let mut members = vec![first];
+            let mut next = 0;
+            while let Some(&a) = members.get(next) {
+                next += 1;
+                for &e in &self.topo.face_edges[l.faces[a]] {
+                    let [(f, i), (g, j)] = self.topo.edges[e].uses[..] else {
+                        continue;
+                    };
+                    let (Some(&x), Some(&y)) = (at.get(&f), at.get(&g)) else {
+                        continue;
+                    };
+                    let b = if x == a { y } else { x };
+                    if part[b] == usize::MAX
+                        && l.cuts.binary_search(&e).is_err()
+                        && coincide(&l.uv[x], i, &l.uv[y], j)
+                    {
+                        part[b] = parts.len();
+                        members.push(b);
+                    }
+                }
+            }
+            members.sort_unstable();
+            parts.push(members);
+        }
+        parts
+    }
+
+    /// `l` as the pieces it lies in ([`Charts::flat_parts`]): itself when it lies in one,
+    /// else each part with its faces, corners and cuts, its stretch measured again.
+    fn apart(&self, l: Laid) -> Vec<Laid> {
+        let parts = self.flat_parts(&l);
+        if parts.len() < 2 {
+            return vec![l];
+        }
+        parts
+            .into_iter()
+            .map(|idx| {
+                let faces: Vec<usize> = idx.iter().map(|&i| l.faces[i]).collect();
+                let uv: Vec<Vec<DVec2>> = idx.iter().map(|&i| l.uv[i].clone()).collect();
+                Laid {
+                    cuts: self.cuts_within(&faces, &l.cuts),
+                    stretch: distortion::stretch(self.mesh, &faces, &uv),
+                    faces,
+                    uv,
+                    gusset: l.gusset,
+                }
+            })
+            .collect()
+    }
+
     /// The edges of `cuts` inside `faces` (both faces of the edge in it).
     fn cuts_within(&self, faces: &[usize], cuts: &[usize]) -> Vec<usize> {
         if cuts.is_empty() {
@@ -961,6 +1026,9 @@ fn charts_in_pool(surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
     merge::merge_near(&ctx, &mut done, opts, overlap_eps);
     merge::merge_laid(&ctx, &mut done, opts, overlap_eps);
     hinge::hinge_small(&ctx, &mut done, opts, overlap_eps, &failed);
+    // Every piece lies in one part: one put together in two would be cut and nested as two
+    // outlines in one (a guard, as `refuse_overlap` is).
+    done = done.into_iter().flat_map(|l| ctx.apart(l)).collect();
     // A chart left over the tolerance gets its seams matched all the same; one whose matched
     // layout would overlap or flip is halved instead, its halves laid again (a few rounds).
     let all = Charts {
@@ -1080,5 +1148,41 @@ mod tests {
         let text = e.to_string();
         assert!(text.contains(&format!("faces 1 and {}", g + 1)), "{text}");
         assert!(text.contains(&format!("piece {}", island + 1)), "{text}");
+    }
+
+    /// A piece lies in one part; one whose faces are joined only through a cut, or through an
+    /// edge whose two copies lie apart, is taken apart into the pieces it lies in, each with
+    /// its faces, corners, cuts and stretch.
+    #[test]
+    fn a_piece_laid_in_two_places_is_taken_apart() {
+        let (mesh, blocks) = strip_and_squares(&[(0..2, 1..2)]);
+        let fx = Fixture::new(mesh);
+        let ctx = fx.charts(&FlattenOptions::default());
+        let whole = ctx.piece(blocks[0].clone().collect());
+        assert_eq!(ctx.flat_parts(&whole), vec![vec![0, 1, 2, 3]]);
+        assert_eq!(ctx.apart(whole.clone()).len(), 1);
+        // Cells 0 and 1 meet along one edge: faces 0 (cell 0) and 3 (cell 1).
+        let between = fx.topo.face_edges[0]
+            .iter()
+            .copied()
+            .find(|&e| fx.topo.edges[e].uses.iter().any(|u| u.0 == 3))
+            .expect("common edge");
+        let mut slit = whole.clone();
+        slit.cuts = vec![between];
+        let mut moved = whole.clone();
+        for p in moved.uv[2..].iter_mut().flatten() {
+            *p += DVec2::new(0.0, 50.0);
+        }
+        for l in [slit, moved] {
+            assert_eq!(ctx.flat_parts(&l), vec![vec![0, 1], vec![2, 3]]);
+            let parts = ctx.apart(l.clone());
+            assert_eq!(parts.len(), 2);
+            for (part, faces) in parts.iter().zip([[0, 1], [2, 3]]) {
+                assert_eq!(part.faces, faces);
+                assert_eq!(part.uv, faces.map(|f| l.uv[f].clone()));
+                assert!(part.cuts.is_empty());
+                assert!((part.stretch.l2 - 1.0).abs() < 1e-9, "{}", part.stretch.l2);
+            }
+        }
     }
 }
