@@ -453,8 +453,9 @@ fn pass_on(onto: &Onto, done: &mut [Laid], owners: &mut Owners, si: usize, small
         let pair = [done[k].clone(), done[si].clone()];
         // Paths through the neighbour to a third piece, for a small piece it closes round.
         let third = |f: usize| {
+            // A face of no piece (none in a whole surface) leads nowhere.
             let o = owners.owner[f];
-            (o != k && o != si && !owners.gone[o]).then_some(o)
+            (o != k && o != si && owners.gone.get(o) == Some(&false)).then_some(o)
         };
         let through = corridors_out(ctx, &pair, &third);
         let mut take = |parts: (Laid, Laid)| -> Option<()> {
