@@ -91,7 +91,11 @@
 //! still to be cut or split; a chart left over it at the end is matched then, or halved when
 //! its matched layout would overlap or flip (`MATCH_ROUNDS` rounds). So is a chart whose border
 //! edges are still further from their 3D lengths than [`FlattenOptions::seam_tolerance`] (its
-//! matching could not be had without a flip).
+//! matching could not be had without a flip). Before those rounds every piece is checked to
+//! lie in one part (`Charts::flat_parts`): one whose faces are joined only through its cuts,
+//! or through edges whose two copies lie apart, would be cut and nested as two outlines in
+//! one, so it is taken apart into the pieces it lies in (a guard; the stages above do not
+//! make such pieces).
 
 use super::distortion::{self, Stretch};
 use super::param::{self, ParamMethod};
