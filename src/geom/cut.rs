@@ -273,7 +273,7 @@ fn split_ordered(
 /// region `to` names (a face's region, `None` for a face of neither), nearest first, at most
 /// `most`, the faces of `faces` on a shortest path (through centroids) from one next to a
 /// face of `from` to the nearest next to a face of that region, from that end back.
-pub(crate) fn corridors(
+pub fn corridors(
     g: &Graph,
     faces: &[usize],
     from: &[usize],
@@ -335,7 +335,7 @@ pub(crate) fn corridors(
 
 /// The connected parts of `faces` through the face graph restricted to them, each in the
 /// order of `faces`, in the order of their first faces.
-pub(crate) fn components(g: &Graph, faces: &[usize]) -> Vec<Vec<usize>> {
+pub fn components(g: &Graph, faces: &[usize]) -> Vec<Vec<usize>> {
     let mut inside = vec![false; g.area.len()];
     for &f in faces {
         inside[f] = true;
