@@ -408,9 +408,9 @@ pub(super) fn corridors_out(
 /// The share-outs of `pair[1]` (a small piece) and `pair[0]` (its neighbour) along
 /// `corridors` (each a path of the neighbour's faces from the small piece to a third piece,
 /// [`crate::geom::cut::corridors`]): the small piece takes the corridor's faces, the
-/// neighbour keeps the rest. A small piece its neighbour closes round (a gusset at a saddle, where the two as one turn
-/// past a full turn round a vertex) fits beside the neighbour in no way; with a corridor it
-/// reaches a third piece, which it may fit beside. Each laid out from the two joined as they
+/// neighbour keeps the rest. A small piece its neighbour closes round (a gusset at a saddle,
+/// where the two as one turn past a full turn round a vertex) fits beside the neighbour in no
+/// way; with a corridor it reaches a third piece, which it may fit beside. Each laid out from the two joined as they
 /// lie ([`moved_onto`]) and kept as [`pass_apart`]'s parts are, the neighbour's part first,
 /// given to `take` in turn; the first that `take` makes something of.
 pub(super) fn pass_through<T>(
