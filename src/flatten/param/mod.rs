@@ -789,7 +789,19 @@ fn run_abf(
     pin: [usize; 2],
     solver: &mut Option<Solver>,
 ) -> Result<ChartParam, ParamError> {
-    let angles = abf_angles(chart)?;
+    abf_from(mesh, faces, chart, pin, abf_angles(chart), solver)
+}
+
+/// [`run_abf`] from ABF++'s angles (or their error) already found.
+fn abf_from(
+    mesh: &Mesh,
+    faces: &[usize],
+    chart: &Chart,
+    pin: [usize; 2],
+    angles: Result<Vec<[f64; 3]>, ParamError>,
+    solver: &mut Option<Solver>,
+) -> Result<ChartParam, ParamError> {
+    let angles = angles?;
     let shapes: Vec<[DVec2; 3]> = angles.iter().map(|a| shape_from_angles(*a)).collect();
     let d = chart.pos[pin[0]].distance(chart.pos[pin[1]]);
     let uv = lscm_solve(
@@ -856,14 +868,20 @@ fn parameterize_chart(
         ParamMethod::Lscm => run_lscm(mesh, faces, chart, pin, &mut solver),
         ParamMethod::Abf => run_abf(mesh, faces, chart, pin, &mut solver),
         ParamMethod::Best => {
-            let l = run_lscm(mesh, faces, chart, pin, &mut solver);
+            // ABF++'s angles (its Newton steps, most of its time) beside LSCM where a thread
+            // is idle; used only when LSCM's layout is not already isometric.
+            let (l, angles) = crate::geom::par::speculate(
+                || run_lscm(mesh, faces, chart, pin, &mut solver),
+                || abf_angles(chart),
+            );
             if let Ok(l) = &l {
                 // Already isometric: nothing can do better.
                 if l.stretch.flipped == 0 && l.stretch.l2 - 1.0 < ISOMETRIC {
                     return Ok(l.clone());
                 }
             }
-            let a = run_abf(mesh, faces, chart, pin, &mut solver);
+            let angles = angles.unwrap_or_else(|| abf_angles(chart));
+            let a = abf_from(mesh, faces, chart, pin, angles, &mut solver);
             let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
             let kept = match (l, a) {
                 (Ok(l), Ok(a)) => {
