@@ -48,6 +48,9 @@
 //!   no boundary (closed), several boundary loops (holes), handles. Nothing is repaired here:
 //!   charts come from a segmentation that can cut differently.
 //! - Determinism: no hash-map iteration order reaches the result; the solves are sequential.
+//!   `Best` finds ABF++'s angles beside LSCM where a thread of the pool is idle
+//!   ([`crate::geom::par::speculate`]): each works on its own data, so the result is the
+//!   same either way.
 
 use super::distortion::{self, corner_angle, face_triangles, Stretch};
 use crate::geom::mesh::Mesh;
