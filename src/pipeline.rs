@@ -176,7 +176,7 @@ fn flatten_surfaces(
             room,
             ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
         };
-        let flat = crate::flatten::charts::flatten(surface, &opts)?;
+        let flat = flatten_segmented(surface, &s.segment, &opts)?;
         if !quiet && flat.surface.charts.is_some() {
             for w in flat
                 .surface
@@ -211,6 +211,57 @@ fn flatten_surfaces(
             }
         };
     Ok((flats, pieces))
+}
+
+/// Chart counts a mesh segmented into the default number of charts is segmented into again,
+/// in turn, while some of its pieces are small ([`flatten_segmented`]).
+const CHART_RETRIES: [usize; 3] = [16, 10, 12];
+
+/// A surface laid flat (`flatten::charts::flatten`). A mesh segmented by D-Charts into its
+/// default number of charts (the spec names none) whose pieces include some under 1 % of its
+/// area that are not a whole part of it (`flatten::charts::small_islands`: a piece too small
+/// to handle, where the merges, share-outs and hinges of the flatten stage found no
+/// neighbour to join it to within the material's tolerance) is segmented again into
+/// [`CHART_RETRIES`] charts in turn, until one leaves none: which charts are cut up, and so
+/// which small pieces are left, turns on the count (issue 20). Twice the default first (the
+/// flatten stage joins back what fits), then counts between. The flat with the fewest small
+/// pieces is kept, then the one with the fewest pieces, then the first; report.json gives the
+/// count it was segmented with and the segmentations tried (`figures`).
+fn flatten_segmented(
+    surface: crate::surface::Surface,
+    seg: &crate::surface::SegmentSpec,
+    opts: &crate::flatten::charts::FlattenOptions,
+) -> Result<Flat, Error> {
+    use crate::flatten::charts::{flatten, small_islands};
+    let again = (surface.charts.is_some() && seg.charts.is_none()).then(|| surface.clone());
+    let mut best = flatten(surface, opts)?;
+    let Some(again) = again else {
+        return Ok(best);
+    };
+    let key = |f: &Flat| (small_islands(f), f.islands.len());
+    let (mut best_key, mut charts, mut tried) = (key(&best), None, 1);
+    for n in CHART_RETRIES {
+        if best_key.0 == 0 {
+            break;
+        }
+        let mut s = again.clone();
+        // A retry that fails keeps what the ones before gave.
+        if !matches!(crate::surface::dcharts::resegment(&mut s, seg, n), Ok(true)) {
+            continue;
+        }
+        tried += 1;
+        if let Ok(f) = flatten(s, opts) {
+            let k = key(&f);
+            if k < best_key {
+                (best, best_key, charts) = (f, k, Some(n));
+            }
+        }
+    }
+    let default = crate::surface::dcharts::DChartsOptions::default().charts;
+    let figures = &mut best.surface.figures;
+    figures.push(("dcharts_charts", charts.unwrap_or(default) as f64));
+    figures.push(("dcharts_segmentations", f64::from(tried)));
+    Ok(best)
 }
 
 /// A surface whose coordinates are beyond [`crate::geom::input::MAX_COORD`] is refused before

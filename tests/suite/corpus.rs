@@ -58,6 +58,9 @@ struct Row {
     worst_seam: f64,
     seams: usize,
     small: usize,
+    /// D-Charts segmentations the flatten stage tried (`dcharts_segmentations`; 1 where the
+    /// first left no small piece or the mesh was not segmented).
+    segmentations: usize,
     seconds: f64,
 }
 
@@ -140,6 +143,13 @@ fn measure(flats: &[Flat], pieces: &[Piece]) -> Row {
         worst_seam,
         seams,
         small: pieces.iter().filter(|p| p.area < 0.01 * total).count(),
+        segmentations: flats
+            .iter()
+            .flat_map(|f| &f.surface.figures)
+            .filter(|(k, _)| *k == "dcharts_segmentations")
+            .map(|&(_, v)| v as usize)
+            .max()
+            .unwrap_or(1),
         seconds: 0.0,
     }
 }
@@ -323,7 +333,10 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
 /// with darts where the two as one stretch past the tolerance, 5 (32 pieces); passed on
 /// through a neighbour to a third piece (`flatten::charts::hinge`'s `pass_on`), 4 are (31
 /// pieces); passed through the neighbour that closes round them along a corridor to a third
-/// piece (`flatten::charts::merge`'s `pass_through`), 2 are (29 pieces).
+/// piece (`flatten::charts::merge`'s `pass_through`), 2 are (29 pieces). Those two (0.74 %
+/// and 0.58 %) fit beside no neighbour within L2 1.001 in any way; segmented again when small
+/// pieces are left (`pipeline`'s `flatten_segmented`: 16 charts, 1 small piece, then 10),
+/// none is (27 pieces).
 #[test]
 fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     require_shared!();
@@ -331,8 +344,44 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
     let r = run(&mesh, MaterialKind::Metal);
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
-    assert!(r.small <= 2, "{} pieces under 1 % of the area", r.small);
-    assert!(r.pieces <= 29, "{} pieces", r.pieces);
+    assert_eq!(r.small, 0, "pieces under 1 % of the area");
+    assert!(r.pieces <= 27, "{} pieces", r.pieces);
+    assert!(
+        r.segmentations > 1,
+        "segmented once: no small piece to retry for"
+    );
+}
+
+/// Issue 20, items 3 and 5: a mesh segmented again for its small pieces
+/// (`surface::dcharts::resegment`) is segmented at the size it was first segmented at, so its
+/// charts do not depend on the size either: homer at 30 mm and at 300 mm gets the same 16
+/// charts, and segmented again into the default count, the charts it had.
+#[test]
+fn corpus_a_mesh_segmented_again_gets_the_same_charts_at_any_size() {
+    require_shared!();
+    let mesh = shared_data("meshes/homer.obj");
+    let at = |size: f64| {
+        let mut spec = Spec::from_mesh(&mesh);
+        spec.size = Some(size);
+        let seg = spec.surfaces[0].segment.clone();
+        (
+            flatcut::pipeline::sized_surfaces(&spec).unwrap().remove(0),
+            seg,
+        )
+    };
+    let (small, seg) = at(30.0);
+    let (large, _) = at(300.0);
+    let first = large.charts.clone().expect("homer is segmented");
+    let again = |s: &flatcut::surface::Surface, n: usize| {
+        let mut s = s.clone();
+        assert!(flatcut::surface::dcharts::resegment(&mut s, &seg, n).unwrap());
+        (s.charts.unwrap(), s.cuts)
+    };
+    let default = flatcut::surface::dcharts::DChartsOptions::default().charts;
+    assert_eq!(again(&large, default).0, first, "the default count again");
+    let (a, b) = (again(&small, 16), again(&large, 16));
+    assert_eq!(a, b, "16 charts at 30 mm and at 300 mm");
+    assert_ne!(b.0, first, "16 charts are the default's");
 }
 
 /// Issue 20, item 3: a small piece whose neighbour closes round it (a gusset at a saddle:
@@ -341,14 +390,15 @@ fn corpus_cow_in_metal_is_within_its_tolerance_and_grafts_small_pieces() {
 /// paper one (79 faces), homer in metal three (35 pieces). Passed through the neighbour along
 /// a corridor of its faces to a third piece and joined to that (`flatten::charts::merge`'s
 /// `pass_through`), pig in metal and homer in paper keep none and homer in metal one (32
-/// pieces).
+/// pieces), which no neighbour takes within L2 1.001; segmented again for it (16 charts,
+/// `pipeline`'s `flatten_segmented`), none (27 pieces).
 #[test]
 fn corpus_small_pieces_closed_round_by_a_neighbour_are_passed_through_it() {
     require_shared!();
     for (name, kind, tolerance, most) in [
         ("pig.obj", MaterialKind::Metal, 1.001, 0),
         ("homer.obj", MaterialKind::Paper, 1.003, 0),
-        ("homer.obj", MaterialKind::Metal, 1.001, 1),
+        ("homer.obj", MaterialKind::Metal, 1.001, 0),
     ] {
         let mesh = shared_data("meshes").join(name);
         let r = run(&mesh, kind);

@@ -101,3 +101,28 @@ pub(super) fn assemble(
         tolerance: opts.unfold.tolerance.min(0.01 * mean),
     }
 }
+
+/// The islands of `flat` under [`super::merge::SMALL_SHARE`] of its area that are not a whole
+/// connected part of the mesh (issue 20: a piece too small to handle, where a person would
+/// rather have it joined to a neighbour).
+pub fn small_islands(flat: &Flat) -> usize {
+    let mesh = &flat.surface.mesh;
+    let nf = mesh.faces.len();
+    let mut parts = crate::geom::unionfind::UnionFind::new(nf);
+    for e in &flat.topology.edges {
+        for w in e.uses.windows(2) {
+            parts.union(w[0].0, w[1].0);
+        }
+    }
+    let mut part_faces = vec![0usize; nf];
+    for f in 0..nf {
+        part_faces[parts.find(f)] += 1;
+    }
+    let area = |faces: &[usize]| faces.iter().map(|&f| mesh.face_area(f)).sum::<f64>();
+    let total: f64 = flat.islands.iter().map(|i| area(i)).sum();
+    flat.islands
+        .iter()
+        .filter(|i| !i.is_empty() && area(i) < super::merge::SMALL_SHARE * total)
+        .filter(|i| part_faces[parts.find(i[0])] != i.len())
+        .count()
+}

@@ -118,6 +118,7 @@ mod merge;
 mod overlap;
 mod slit;
 
+pub use assemble::small_islands;
 use assemble::{assemble, edge_ids};
 use darts::{darts, gussets, DART_MIN_FACES};
 use overlap::{cut_off, overlaps, reattach, self_overlap, OVERLAP_PAIRS};

@@ -294,6 +294,38 @@ pub fn apply(
     Ok(())
 }
 
+/// A surface [`apply`] segmented, segmented again into about `charts` charts (the other
+/// settings as `seg` gives them): at the size it was first segmented at (its
+/// [`super::size::Shape`]), so that its charts do not depend on the size it is made at, as the
+/// first segmentation's do not. `Ok(false)`, nothing changed, where the surface has no charts
+/// or no shape.
+pub fn resegment(
+    surface: &mut super::Surface,
+    seg: &crate::surface::SegmentSpec,
+    charts: usize,
+) -> Result<bool, super::SurfaceError> {
+    let (Some(_), Some(shape)) = (&surface.charts, &surface.shape) else {
+        return Ok(false);
+    };
+    let at_shape = Mesh {
+        vertices: shape.vertices.clone(),
+        faces: surface.mesh.faces.clone(),
+    };
+    let d = DChartsOptions::default();
+    let opts = DChartsOptions {
+        charts,
+        f_max: seg.f_max.unwrap_or(d.f_max),
+        ..d
+    };
+    let s = segment(&at_shape, &opts).map_err(|e| super::SurfaceError::Invalid {
+        path: surface.source.clone(),
+        message: format!("surface `{}`: D-Charts: {e}", surface.name),
+    })?;
+    surface.charts = Some(s.chart);
+    surface.cuts = s.cuts;
+    Ok(true)
+}
+
 /// Split every polygon with more than three corners into triangles (ear clipping in the
 /// polygon's plane), keeping its source line.
 pub fn triangulate(mesh: &mut Mesh) {
