@@ -20,7 +20,10 @@
 //! [`super::dcs`]) and stores the charts, their cuts and creases on the [`super::Surface`].
 //! When the spec leaves `segment` out, the mesh decides ([`is_smooth`]) and the surface's
 //! `figures` (report.json) say how: `bent_edges`, `gentle_bend_share` (of those, the share
-//! bending under 10°) and `segmented` (1: charts, 0: face by face).
+//! bending under 10°) and `segmented` (1: charts, 0: face by face). [`resegment`] segments
+//! such a surface again into another count of charts, at the size [`apply`] segmented it at
+//! (the pipeline does when the default count leaves pieces under 1 % of the area; report.json
+//! then gives `dcharts_charts` and `dcharts_segmentations`).
 //!
 //! Choices where the thesis is silent: the default initial chart count is 8 (the thesis gives
 //! a rough estimate per model, 6 for the fandisk); `η` defaults to 10⁻³, between the thesis'
