@@ -284,12 +284,7 @@ pub fn apply(
         return Ok(());
     }
     triangulate(&mut surface.mesh);
-    let d = DChartsOptions::default();
-    let opts = DChartsOptions {
-        charts: seg.charts.unwrap_or(d.charts),
-        f_max: seg.f_max.unwrap_or(d.f_max),
-        ..d
-    };
+    let opts = options(seg, seg.charts);
     let s = segment(&surface.mesh, &opts).map_err(|e| invalid(format!("D-Charts: {e}")))?;
     surface.bends = Some(creases(&surface.mesh, CREASE_DEG));
     surface.charts = Some(s.chart);
@@ -314,19 +309,26 @@ pub fn resegment(
         vertices: shape.vertices.clone(),
         faces: surface.mesh.faces.clone(),
     };
-    let d = DChartsOptions::default();
-    let opts = DChartsOptions {
-        charts,
-        f_max: seg.f_max.unwrap_or(d.f_max),
-        ..d
-    };
-    let s = segment(&at_shape, &opts).map_err(|e| super::SurfaceError::Invalid {
-        path: surface.source.clone(),
-        message: format!("surface `{}`: D-Charts: {e}", surface.name),
+    let s = segment(&at_shape, &options(seg, Some(charts))).map_err(|e| {
+        super::SurfaceError::Invalid {
+            path: surface.source.clone(),
+            message: format!("surface `{}`: D-Charts: {e}", surface.name),
+        }
     })?;
     surface.charts = Some(s.chart);
     surface.cuts = s.cuts;
     Ok(true)
+}
+
+/// D-Charts' options as a spec's `seg` gives them, with `charts` charts (`None`: the
+/// default count).
+fn options(seg: &crate::surface::SegmentSpec, charts: Option<usize>) -> DChartsOptions {
+    let d = DChartsOptions::default();
+    DChartsOptions {
+        charts: charts.unwrap_or(d.charts),
+        f_max: seg.f_max.unwrap_or(d.f_max),
+        ..d
+    }
 }
 
 /// Split every polygon with more than three corners into triangles (ear clipping in the
