@@ -102,7 +102,7 @@ pub(super) fn assemble(
     }
 }
 
-/// The islands of `flat` under [`super::merge::SMALL_SHARE`] of its area that are not a whole
+/// The islands of `flat` under 1 % of its area (`merge::SMALL_SHARE`) that are not a whole
 /// connected part of the mesh (issue 20: a piece too small to handle, where a person would
 /// rather have it joined to a neighbour).
 pub fn small_islands(flat: &Flat) -> usize {
