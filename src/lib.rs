@@ -49,6 +49,7 @@
 //! pipeline.rs                  The one composer of the pipeline
 //! pipeline/
 //!   printcut.rs                Print-and-cut as the pipeline composes it (issue 25 item 4)
+//!   surfaces.rs                Spec → surfaces → flats → pieces, a mesh segmented again for small pieces
 //! cli/
 //!   mod.rs                     Command line
 //!   args.rs                    Flag groups shared by several subcommands (`cut`, `flatten`, `fitting`, `nest`)
