@@ -2,20 +2,20 @@
 //! assembled from (row, column, value) triplets, and a factorisation kept for every system of
 //! one pattern ([`Cholesky`]).
 //!
-//! Choices: the triplets are bucketed by column (a counting sort, linear in their number),
-//! each column sorted by row and its repeated entries summed in the order given, so the
-//! values do not depend on anything but the input (faer's own constructor sorts every triplet
-//! with a comparison sort). A solver that assembles systems of one pattern again and again
-//! (Newton steps, one chart laid twice) keeps the [`Pattern`]: where each triplet's value goes,
-//! so the next system of that pattern is filled in one pass, its values summed in the same
-//! order and so the same to the bit. Its [`Cholesky`] keeps the ordering and symbolic
-//! factorisation (faer's defaults, as its `Llt` solver makes them) with the numeric factor's
-//! storage and work space, so a Newton step allocates nothing for its solve. Where faer's
-//! factor is simplicial (up-looking, row by row), it also keeps what that factorisation
-//! derives from the pattern alone for every system: the permuted upper triangle and each
-//! row's elimination-tree reach, in faer's order. The numeric factorisation is then faer's
-//! loop, the same operations in the same order (the same factor to the bit), without the
-//! permutation and the tree walks; a supernodal factor is left to faer.
+//! Choices: the triplets are bucketed by row, then by column (two stable counting sorts, linear
+//! in their number), so each column is sorted by row and its repeated entries are summed in the
+//! order given; the values do not depend on anything but the input (faer's own constructor
+//! sorts every triplet with a comparison sort). A solver that assembles systems of one pattern
+//! again and again (Newton steps, one chart laid twice) keeps the [`Pattern`]: where each
+//! triplet's value goes, so the next system of that pattern is filled in one pass, its values
+//! summed in the same order and so the same to the bit. Its [`Cholesky`] keeps the ordering and
+//! symbolic factorisation (faer's defaults, as its `Llt` solver makes them) with the numeric
+//! factor's storage and work space, so a Newton step allocates nothing for its solve. Where
+//! faer's factor is simplicial (up-looking, row by row), it also keeps what that factorisation
+//! derives from the pattern alone for every system: the permuted upper triangle and each row's
+//! elimination-tree reach, in faer's order. The numeric factorisation is then faer's loop, the
+//! same operations in the same order (the same factor to the bit), without the permutation and
+//! the tree walks; a supernodal factor is left to faer.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
@@ -55,7 +55,20 @@ impl Pattern {
         if triplets.iter().any(|t| t.row >= n || t.col >= n) {
             return None;
         }
-        // Bucket by column, keeping the triplets' order within a column.
+        // Two stable counting sorts: by row, then that order by column. Each column then
+        // holds its entries by row, equal ones in the triplets' order (summed as given).
+        let mut by_row = vec![0usize; n + 1];
+        for t in triplets {
+            by_row[t.row + 1] += 1;
+        }
+        for r in 0..n {
+            by_row[r + 1] += by_row[r];
+        }
+        let mut rows = vec![0usize; triplets.len()];
+        for (i, t) in triplets.iter().enumerate() {
+            rows[by_row[t.row]] = i;
+            by_row[t.row] += 1;
+        }
         let mut start = vec![0usize; n + 1];
         for t in triplets {
             start[t.col + 1] += 1;
@@ -64,20 +77,19 @@ impl Pattern {
             start[c + 1] += start[c];
         }
         let mut next = start.clone();
-        let mut entries = vec![(0usize, 0usize); triplets.len()];
-        for (i, t) in triplets.iter().enumerate() {
-            entries[next[t.col]] = (t.row, i);
-            next[t.col] += 1;
+        let mut entries = vec![0usize; triplets.len()];
+        for &i in &rows {
+            let c = triplets[i].col;
+            entries[next[c]] = i;
+            next[c] += 1;
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx: Vec<usize> = Vec::with_capacity(triplets.len());
         let mut slot = vec![0usize; triplets.len()];
         col_ptr.push(0);
         for c in 0..n {
-            let column = &mut entries[start[c]..start[c + 1]];
-            // Stable: equal rows keep their order, so they are summed as given.
-            column.sort_by_key(|e| e.0);
-            for &(r, i) in column.iter() {
+            for &i in &entries[start[c]..start[c + 1]] {
+                let r = triplets[i].row;
                 if row_idx.len() == col_ptr[c] || row_idx.last() != Some(&r) {
                     row_idx.push(r);
                 }
