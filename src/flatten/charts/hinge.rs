@@ -11,7 +11,9 @@
 //! cross a little (the two layouts of one curve differ by their stretch): then the best
 //! candidates are tried once more with every common edge whose ends land within
 //! [`HINGE_REACH`] of a mean common edge's length joined, and the union relaxed as a merged
-//! piece is ([`Charts::lay_from`]: started from the two as they lie) and checked as one is.
+//! piece is ([`Charts::lay_from`]: started from the two as they lie) and checked as one is;
+//! only where the piece so placed crosses its neighbour in fewer than [`RELAX_CROSSINGS`] face
+//! pairs (relaxing separates sides that cross a little, not a piece folded over another).
 //!
 //! A piece that hinges whole onto no neighbour is halved ([`bisect`]) and each half, as it lies
 //! in the piece's layout, hinged on its own: the first onto a neighbour, the second onto a piece
@@ -63,7 +65,7 @@ use super::join::{common, fits_room, Common};
 use super::merge::{
     corridors_out, pass_apart, pass_through, share_across, share_apart, small_pieces, MERGE_TRIES,
 };
-use super::overlap::{first_merge, keeps, self_overlap, Failed, Owners, Trial};
+use super::overlap::{first_merge, keeps, overlaps, Failed, Owners, Trial};
 use super::slit::{dart_merge, slit_merge, uncut_merge, SLIT_TRIES};
 use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion;
@@ -86,6 +88,10 @@ const RELAX_TRIES: usize = 2;
 /// How near (in mean common edge lengths) a common edge's ends must land to be joined when
 /// the union is relaxed.
 const HINGE_REACH: f64 = 0.5;
+/// Face pairs the piece as it lies may cross its neighbour (or itself) in for the union to be
+/// relaxed: relaxing moves faces by a fraction of the stretch, which separates sides that cross
+/// a little, never a piece folded over its neighbour.
+const RELAX_CROSSINGS: usize = 32;
 
 /// A rigid motion of the plane: a unit complex number (the turn) and a shift.
 type Motion = (DVec2, DVec2);
@@ -550,7 +556,10 @@ fn hinged(
     if !fits_room(opts.room, &[done[k].uv.as_slice(), &moved].concat()) {
         return None;
     }
-    if !relax && overlaps_near(&done[k].uv, &moved, eps) {
+    // A rigid hinge must not overlap; a relaxed one is tried only where the two cross a
+    // little (fewer than `RELAX_CROSSINGS` face pairs).
+    let limit = if relax { RELAX_CROSSINGS } else { 1 };
+    if overlaps_near(&done[k].uv, &moved, eps, limit) >= limit {
         return None;
     }
     let mut faces = done[k].faces.clone();
@@ -584,11 +593,11 @@ fn hinged(
     kept.then_some(l)
 }
 
-/// Whether the `moved` piece overlaps itself or the faces of `fixed` near it (deeper than
-/// `eps`).
-fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
+/// How many face pairs, `limit` at most, overlap (deeper than `eps`) where the `moved` piece
+/// lies on the faces of `fixed` near it: its own faces and those faces.
+fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64, limit: usize) -> usize {
     let Some((lo, hi)) = polygon::bounds(moved.iter().flatten().copied()) else {
-        return false;
+        return 0;
     };
     let nearby: Vec<Vec<DVec2>> = fixed
         .iter()
@@ -600,11 +609,12 @@ fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64) -> bool {
         .chain(moved)
         .cloned()
         .collect();
-    self_overlap(&nearby, eps).is_some()
+    overlaps(&nearby, eps, limit).len()
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::overlap::self_overlap;
     use super::*;
     use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
     use crate::geom::mesh::{Face, Mesh};
