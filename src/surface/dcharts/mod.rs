@@ -227,10 +227,6 @@ pub fn apply(
     seg: &crate::surface::SegmentSpec,
 ) -> Result<(), super::SurfaceError> {
     use crate::surface::{Fixed, Segment};
-    let invalid = |message: String| super::SurfaceError::Invalid {
-        path: surface.source.clone(),
-        message: format!("surface `{}`: {message}", surface.name),
-    };
     if let Some(ap) = &seg.approximate {
         let nv = surface.mesh.vertices.len();
         let mut fixed = Vec::new();
@@ -244,10 +240,13 @@ pub fn apply(
                 }
                 Fixed::Vertex(v) if v < nv => fixed.push(v),
                 Fixed::Vertex(v) => {
-                    return Err(invalid(format!(
-                        "approximate.fixed names vertex {}, but the mesh has {nv} vertices",
-                        v + 1
-                    )))
+                    return Err(invalid(
+                        surface,
+                        format!(
+                            "approximate.fixed names vertex {}, but the mesh has {nv} vertices",
+                            v + 1
+                        ),
+                    ))
                 }
             }
         }
@@ -259,7 +258,7 @@ pub fn apply(
             ..Default::default()
         };
         dcs::approximate(&mut surface.mesh, &opts)
-            .map_err(|e| invalid(format!("DCS approximation: {e}")))?;
+            .map_err(|e| invalid(surface, format!("DCS approximation: {e}")))?;
     }
     let mode = match seg.mode {
         Some(m) => m,
@@ -285,7 +284,8 @@ pub fn apply(
     }
     triangulate(&mut surface.mesh);
     let opts = options(seg, seg.charts);
-    let s = segment(&surface.mesh, &opts).map_err(|e| invalid(format!("D-Charts: {e}")))?;
+    let s =
+        segment(&surface.mesh, &opts).map_err(|e| invalid(surface, format!("D-Charts: {e}")))?;
     surface.bends = Some(creases(&surface.mesh, CREASE_DEG));
     surface.charts = Some(s.chart);
     surface.cuts = s.cuts;
@@ -309,15 +309,19 @@ pub fn resegment(
         vertices: shape.vertices.clone(),
         faces: surface.mesh.faces.clone(),
     };
-    let s = segment(&at_shape, &options(seg, Some(charts))).map_err(|e| {
-        super::SurfaceError::Invalid {
-            path: surface.source.clone(),
-            message: format!("surface `{}`: D-Charts: {e}", surface.name),
-        }
-    })?;
+    let s = segment(&at_shape, &options(seg, Some(charts)))
+        .map_err(|e| invalid(surface, format!("D-Charts: {e}")))?;
     surface.charts = Some(s.chart);
     surface.cuts = s.cuts;
     Ok(true)
+}
+
+/// The error for `surface`'s settings: its file, its name and `message`.
+fn invalid(surface: &super::Surface, message: String) -> super::SurfaceError {
+    super::SurfaceError::Invalid {
+        path: surface.source.clone(),
+        message: format!("surface `{}`: {message}", surface.name),
+    }
 }
 
 /// D-Charts' options as a spec's `seg` gives them, with `charts` charts (`None`: the
