@@ -27,6 +27,7 @@
 use crate::geom::mesh::Mesh;
 use crate::geom::polygon;
 use glam::{DVec2, DVec3};
+use std::borrow::Cow;
 use std::f64::consts::PI;
 
 /// Distortion figures of a flat layout (one chart, or a whole surface via `combine`).
@@ -50,20 +51,20 @@ pub struct Stretch {
 /// Triangles of a face as corner-index triples (indices into `mesh.faces[f].verts`), in the
 /// face's winding: a triangle is itself; a polygon is ear-clipped in its best-fit plane (Newell
 /// normal). Fewer than three corners: none.
-pub(crate) fn face_triangles(mesh: &Mesh, f: usize) -> Vec<[usize; 3]> {
+pub(crate) fn face_triangles(mesh: &Mesh, f: usize) -> Cow<'static, [[usize; 3]]> {
     let Some(face) = mesh.faces.get(f) else {
-        return Vec::new();
+        return Cow::Borrowed(&[]);
     };
     let n = face.verts.len();
     if n < 3 {
-        return Vec::new();
+        return Cow::Borrowed(&[]);
     }
     if n == 3 {
-        return vec![[0, 1, 2]];
+        return Cow::Borrowed(polygon::ONE_TRIANGLE);
     }
     let normal = mesh.newell(f).normalize_or_zero();
     if normal == DVec3::ZERO || !normal.is_finite() {
-        return (1..n - 1).map(|k| [0, k, k + 1]).collect();
+        return Cow::Owned((1..n - 1).map(|k| [0, k, k + 1]).collect());
     }
     let e1 = normal.any_orthonormal_vector();
     let e2 = normal.cross(e1);
@@ -127,7 +128,7 @@ pub fn stretch(mesh: &Mesh, faces: &[usize], uv: &[Vec<DVec2>]) -> Stretch {
             unmeasured += 1;
             continue;
         }
-        for t in face_triangles(mesh, f) {
+        for t in face_triangles(mesh, f).iter() {
             let q = t.map(|i| mesh.vertices[face.verts[i]]);
             let pp = t.map(|i| p[i]);
             tris.push(measure(q, pp));
@@ -230,7 +231,7 @@ pub fn angle_defect(mesh: &Mesh) -> Vec<f64> {
         if face.verts.iter().any(|&v| v >= nv) {
             continue;
         }
-        for t in face_triangles(mesh, f) {
+        for t in face_triangles(mesh, f).iter() {
             let v = t.map(|i| face.verts[i]);
             let p = v.map(|i| mesh.vertices[i]);
             for k in 0..3 {

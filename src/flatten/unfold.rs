@@ -29,6 +29,7 @@ use crate::geom::mesh::{Mesh, Topology};
 use crate::geom::polygon;
 use crate::surface::Surface;
 use glam::{DVec2, DVec3};
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// Options of the unfolder.
@@ -147,7 +148,7 @@ fn plane_of(mesh: &Mesh, f: usize) -> Option<Vec<DVec2>> {
 /// Islands being built: face positions, island membership and a grid per island.
 struct Unfolder {
     pos: Vec<Vec<DVec2>>,
-    tris: Vec<Vec<[usize; 3]>>,
+    tris: Vec<Cow<'static, [[usize; 3]]>>,
     face_island: Vec<usize>,
     members: Vec<Vec<usize>>,
     cells: Vec<HashMap<Cell, Vec<usize>>>,
@@ -166,7 +167,8 @@ impl Unfolder {
     /// face's size (`longest`: the longest edge).
     fn new(pos: Vec<Vec<DVec2>>, longest: f64, eps: f64) -> Unfolder {
         let nf = pos.len();
-        let tris: Vec<Vec<[usize; 3]>> = pos.iter().map(|p| polygon::triangulate(p)).collect();
+        let tris: Vec<Cow<'static, [[usize; 3]]>> =
+            pos.iter().map(|p| polygon::triangulate(p)).collect();
         let mut sizes: Vec<f64> = pos
             .iter()
             .map(|p| {
@@ -496,7 +498,7 @@ fn faces_overlap(
 /// the island (O(n log n) for pieces that are not one long column of faces).
 pub fn find_overlap(flat: &Flat) -> Option<(usize, usize)> {
     let eps = flat.tolerance;
-    let tris: Vec<Vec<[usize; 3]>> = flat
+    let tris: Vec<Cow<'static, [[usize; 3]]>> = flat
         .face_2d
         .iter()
         .map(|p| polygon::triangulate(p))

@@ -9,6 +9,7 @@
 //! cutter needs (two faces joined along a fold touch but never cover each other).
 
 use glam::DVec2;
+use std::borrow::Cow;
 
 /// Signed area (positive for counter-clockwise).
 pub fn signed_area(poly: &[DVec2]) -> f64 {
@@ -173,16 +174,20 @@ pub fn hull_rect_angle(hull: &[DVec2]) -> f64 {
     best.1
 }
 
+/// The triangles of a triangle, as [`triangulate`] gives them (borrowed: the flattening asks
+/// for those of every face many times, and most faces are triangles).
+pub const ONE_TRIANGLE: &[[usize; 3]] = &[[0, 1, 2]];
+
 /// Ear-clipping triangulation of a simple polygon (either orientation). Returns index triples
-/// in the polygon's own orientation. Falls back to a fan when no ear is found (degenerate
+/// in the polygon's own orientation ([`ONE_TRIANGLE`] for a triangle). Falls back to a fan when no ear is found (degenerate
 /// input), so it always returns `n - 2` triangles for `n >= 3`.
-pub fn triangulate(poly: &[DVec2]) -> Vec<[usize; 3]> {
+pub fn triangulate(poly: &[DVec2]) -> Cow<'static, [[usize; 3]]> {
     let n = poly.len();
     if n < 3 {
-        return Vec::new();
+        return Cow::Borrowed(&[]);
     }
     if n == 3 {
-        return vec![[0, 1, 2]];
+        return Cow::Borrowed(ONE_TRIANGLE);
     }
     let sign = if signed_area(poly) >= 0.0 { 1.0 } else { -1.0 };
     let mut idx: Vec<usize> = (0..n).collect();
@@ -211,11 +216,11 @@ pub fn triangulate(poly: &[DVec2]) -> Vec<[usize; 3]> {
             for k in 1..idx.len() - 1 {
                 out.push([idx[0], idx[k], idx[k + 1]]);
             }
-            return out;
+            return Cow::Owned(out);
         }
     }
     out.push([idx[0], idx[1], idx[2]]);
-    out
+    Cow::Owned(out)
 }
 
 fn point_in_triangle_closed(p: DVec2, t: &[DVec2; 3], sign: f64) -> bool {

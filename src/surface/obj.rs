@@ -384,7 +384,7 @@ pub fn validate(raw: RawMesh, scale: f64) -> Result<(Mesh, Vec<String>), Surface
             let (planar, flat) = planarity(&pts);
             if !planar || !polygon::is_simple_ring(&flat) {
                 split.push(face.line);
-                for t in polygon::triangulate(&flat) {
+                for t in polygon::triangulate(&flat).iter() {
                     mesh.faces.push(Face {
                         verts: t.iter().map(|&k| face.verts[k]).collect(),
                         line: face.line,

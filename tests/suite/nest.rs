@@ -12,8 +12,8 @@ use serde_json::Value;
 
 fn triangles(poly: &[DVec2]) -> Vec<[DVec2; 3]> {
     triangulate(poly)
-        .into_iter()
-        .map(|[a, b, c]| [poly[a], poly[b], poly[c]])
+        .iter()
+        .map(|&[a, b, c]| [poly[a], poly[b], poly[c]])
         .collect()
 }
 

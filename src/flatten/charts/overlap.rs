@@ -26,7 +26,7 @@ pub(super) fn overlaps(uv: &[Vec<DVec2>], eps: f64, limit: usize) -> Vec<(usize,
     let mut out = Vec::new();
     let mut tris: Vec<([DVec2; 3], usize)> = Vec::new();
     for (k, c) in uv.iter().enumerate() {
-        for t in polygon::triangulate(c) {
+        for t in polygon::triangulate(c).iter() {
             tris.push(([c[t[0]], c[t[1]], c[t[2]]], k));
         }
     }

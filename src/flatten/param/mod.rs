@@ -320,7 +320,7 @@ fn local_triangles(mesh: &Mesh, faces: &[usize]) -> Result<LocalTriangles, Param
                 angle: 0.0,
             });
         }
-        for t in tri_list {
+        for t in tri_list.iter() {
             let lt = t.map(|i| cs[i]);
             let p = lt.map(|i| pos[i]);
             let mut min = f64::INFINITY;

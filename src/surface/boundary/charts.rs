@@ -295,7 +295,8 @@ impl Search<'_> {
             let ring: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(u), p.dot(v))).collect();
             if crate::geom::polygon::is_simple_ring(&ring) {
                 let tris: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&ring)
-                    .into_iter()
+                    .iter()
+                    .copied()
                     .map(sorted)
                     .collect();
                 if tris.len() == q - 2 && Self::non_crossing(&tris) && self.valid(&tris) {

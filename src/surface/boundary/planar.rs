@@ -56,7 +56,7 @@ pub(super) fn planar(input: &Input, prep: &Prepared) -> Option<Output> {
         .map(|p| DVec2::new((*p - origin).dot(u), (*p - origin).dot(w)))
         .collect();
     let faces: Vec<[usize; 3]> = crate::geom::polygon::triangulate(&flat)
-        .into_iter()
+        .iter()
         .map(|t| t.map(|k| ids[k]))
         .collect();
     if faces.len() + 2 != ids.len() {

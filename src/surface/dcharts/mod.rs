@@ -360,7 +360,7 @@ pub fn triangulate(mesh: &mut Mesh) {
             faces.push(face.clone());
             continue;
         }
-        for t in tris {
+        for t in tris.iter() {
             faces.push(crate::geom::mesh::Face {
                 verts: vec![face.verts[t[0]], face.verts[t[1]], face.verts[t[2]]],
                 line: face.line,

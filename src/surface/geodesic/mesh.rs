@@ -294,7 +294,7 @@ pub(super) fn fold_triangles(
         if polygon::signed_area(&poly) <= 1e-12 {
             continue;
         }
-        for t in polygon::triangulate(&poly) {
+        for t in polygon::triangulate(&poly).iter() {
             let tri = [ids[t[0]], ids[t[1]], ids[t[2]]];
             let area = (pos[tri[1]] - pos[tri[0]]).perp_dot(pos[tri[2]] - pos[tri[0]]);
             if area > 1e-12 {
