@@ -179,8 +179,9 @@ pub fn hull_rect_angle(hull: &[DVec2]) -> f64 {
 pub const ONE_TRIANGLE: &[[usize; 3]] = &[[0, 1, 2]];
 
 /// Ear-clipping triangulation of a simple polygon (either orientation). Returns index triples
-/// in the polygon's own orientation ([`ONE_TRIANGLE`] for a triangle). Falls back to a fan when no ear is found (degenerate
-/// input), so it always returns `n - 2` triangles for `n >= 3`.
+/// in the polygon's own orientation ([`ONE_TRIANGLE`] for a triangle). Falls back to a fan
+/// when no ear is found (degenerate input), so it always returns `n - 2` triangles for
+/// `n >= 3`.
 pub fn triangulate(poly: &[DVec2]) -> Cow<'static, [[usize; 3]]> {
     let n = poly.len();
     if n < 3 {
