@@ -26,6 +26,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::utils::permute_self_adjoint_to_unsorted;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, MatMut, Par, Side};
+use std::sync::Arc;
 
 /// The `n` × `n` matrix with the sum of the `triplets`' values at each (row, column) they
 /// name; `None` when an index is `n` or more.
@@ -140,13 +141,26 @@ impl Pattern {
 
 /// A sparse Cholesky factorisation kept for systems of one [`Pattern`]: the fill-reducing
 /// ordering and symbolic factorisation made once, the numeric factor and the work space
-/// reused by every system factorised with it.
+/// reused by every system factorised with it. A copy ([`Clone`]) shares the pattern-only part
+/// and has its own numeric factor and work space: one symbolic factorisation serves every
+/// system of one structure (a chart's stretch minimisation and its seam matching).
 pub struct Cholesky {
-    symbolic: SymbolicCholesky<usize>,
+    shared: Arc<Symbolic>,
     values: Vec<f64>,
     scratch: MemBuffer,
-    /// For a simplicial factor, what its numeric factorisation reads of the pattern alone.
+    /// Work space of [`Plan::factor`]: the dense row being eliminated, and each column's next
+    /// free slot.
+    x: Vec<f64>,
+    next: Vec<usize>,
+}
+
+/// What a [`Cholesky`] derives from its pattern alone: faer's ordering and symbolic
+/// factorisation, the [`Plan`] of a simplicial factor, and the structure it was made for.
+struct Symbolic {
+    symbolic: SymbolicCholesky<usize>,
     plan: Option<Plan>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
 }
 
 /// The pattern-only part of faer's simplicial up-looking LLᵀ, made once per pattern: the
@@ -162,9 +176,6 @@ struct Plan {
     reach: Vec<usize>,
     l_ptr: Vec<usize>,
     l_row: Vec<usize>,
-    /// Work space: the dense row being eliminated, and each column's next free slot.
-    x: Vec<f64>,
-    next: Vec<usize>,
 }
 
 impl Plan {
@@ -246,8 +257,6 @@ impl Plan {
             a_src,
             reach_ptr,
             reach,
-            next: vec![0; n],
-            x: vec![0.0; n],
             l_ptr,
             l_row,
         })
@@ -256,14 +265,13 @@ impl Plan {
     /// Faer's simplicial up-looking LLᵀ of the matrix with values `a` (of the pattern this
     /// plan was made for) into `l`; false at a pivot that is not positive, or where `a` or
     /// `l` is not of this plan's size.
-    fn factor(&mut self, a: &[f64], l: &mut [f64]) -> bool {
-        let n = self.next.len();
-        if a.len() != self.a_src.len() || l.len() != self.l_row.len() {
+    fn factor(&self, a: &[f64], l: &mut [f64], x: &mut [f64], next: &mut [usize]) -> bool {
+        let n = next.len();
+        if a.len() != self.a_src.len() || l.len() != self.l_row.len() || x.len() != n {
             return false;
         }
-        self.x.iter_mut().for_each(|v| *v = 0.0);
-        self.next.copy_from_slice(&self.l_ptr[..n]);
-        let x = &mut self.x;
+        x.iter_mut().for_each(|v| *v = 0.0);
+        next.copy_from_slice(&self.l_ptr[..n]);
         for k in 0..n {
             for p in self.a_ptr[k]..self.a_ptr[k + 1] {
                 x[self.a_row[p]] += a[self.a_src[p]];
@@ -272,8 +280,8 @@ impl Plan {
             x[k] = 0.0;
             for &j in &self.reach[self.reach_ptr[k]..self.reach_ptr[k + 1]] {
                 let j_start = self.l_ptr[j];
-                let row = self.next[j] + 1;
-                self.next[j] = row;
+                let row = next[j] + 1;
+                next[j] = row;
                 let xj = x[j];
                 x[j] = 0.0;
                 let dj = 1.0 / l[j_start];
@@ -306,25 +314,52 @@ impl Cholesky {
             CholeskySymbolicParams::default(),
         )
         .ok()?;
+        let plan = Plan::new(pattern, &symbolic);
+        Cholesky::from_shared(Arc::new(Symbolic {
+            symbolic,
+            plan,
+            col_ptr: pattern.symbolic.col_ptr().to_vec(),
+            row_idx: pattern.symbolic.row_idx().to_vec(),
+        }))
+    }
+
+    /// A factorisation of the pattern-only part `shared`, with its own numeric factor and
+    /// work space; `None` where these cannot be allocated.
+    fn from_shared(shared: Arc<Symbolic>) -> Option<Cholesky> {
+        let symbolic = &shared.symbolic;
         let req = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(2, Par::Seq));
         let scratch = MemBuffer::try_new(req).ok()?;
+        let n = symbolic.nrows();
         Some(Cholesky {
             values: vec![0.0; symbolic.len_val()],
-            plan: Plan::new(pattern, &symbolic),
-            symbolic,
+            x: vec![0.0; n],
+            next: vec![0; n],
             scratch,
+            shared,
         })
+    }
+
+    /// A factorisation for `pattern` made from this one's symbolic part where `pattern` has
+    /// the same structure (the same rows in the same columns), else anew ([`Cholesky::new`]).
+    pub fn for_pattern(&self, pattern: &Pattern) -> Option<Cholesky> {
+        let s = &self.shared;
+        if pattern.symbolic.col_ptr() == s.col_ptr && pattern.symbolic.row_idx() == s.row_idx {
+            Cholesky::from_shared(s.clone())
+        } else {
+            Cholesky::new(pattern)
+        }
     }
 
     /// Factorise `a` (of the pattern this was made for, its lower triangle given); false
     /// where it is not numerically positive definite.
     pub fn factor(&mut self, a: &SparseColMat<usize, f64>) -> bool {
-        if let Some(plan) = &mut self.plan {
-            return plan.factor(a.val(), &mut self.values);
+        if let Some(plan) = &self.shared.plan {
+            return plan.factor(a.val(), &mut self.values, &mut self.x, &mut self.next);
         }
-        self.symbolic
+        self.shared
+            .symbolic
             .factorize_numeric_llt(
                 &mut self.values,
                 a.as_ref(),
@@ -341,11 +376,11 @@ impl Cholesky {
     /// them one after the other (`cols` of them), then the solutions; false (and `x` as it
     /// was) when `x` is not `cols` times the system's size.
     pub fn solve(&mut self, x: &mut [f64], cols: usize) -> bool {
-        let n = self.symbolic.nrows();
+        let n = self.shared.symbolic.nrows();
         if !(1..=2).contains(&cols) || x.len() != n * cols {
             return false;
         }
-        let llt = LltRef::new(&self.symbolic, &self.values);
+        let llt = LltRef::new(&self.shared.symbolic, &self.values);
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(x, n, cols),
@@ -441,12 +476,16 @@ mod tests {
         };
         let p = Pattern::new(n, &system(1.0)).unwrap();
         let mut chol = Cholesky::new(&p).unwrap();
-        assert!(chol.plan.is_some(), "a simplicial factor gets a plan");
+        assert!(
+            chol.shared.plan.is_some(),
+            "a simplicial factor gets a plan"
+        );
         for k in [1.0, 2.5] {
             let a = p.matrix(&system(k));
             assert!(chol.factor(&a));
             let mut faer_values = vec![0.0; chol.values.len()];
-            chol.symbolic
+            chol.shared
+                .symbolic
                 .factorize_numeric_llt(
                     &mut faer_values,
                     a.as_ref(),
@@ -459,6 +498,20 @@ mod tests {
                 .unwrap();
             let bits = |v: &[f64]| -> Vec<u64> { v.iter().map(|x| x.to_bits()).collect() };
             assert_eq!(bits(&chol.values), bits(&faer_values), "k = {k}");
+            // A pattern of the same structure (its triplets in another order) shares the
+            // symbolic part, and the copy factorises the matrix to the same bits; another
+            // structure is factorised anew.
+            let mut reversed = system(k);
+            reversed.reverse();
+            let q = Pattern::new(n, &reversed).unwrap();
+            let mut copy = chol.for_pattern(&q).unwrap();
+            assert!(Arc::ptr_eq(&copy.shared, &chol.shared));
+            assert!(copy.factor(&a));
+            assert_eq!(bits(&copy.values), bits(&chol.values), "k = {k}");
+            let diagonal: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
+            let d = Pattern::new(n, &diagonal).unwrap();
+            let other = chol.for_pattern(&d).unwrap();
+            assert!(!Arc::ptr_eq(&other.shared, &chol.shared));
         }
         // Not positive definite: refused by the plan as by faer.
         let mut negative = system(1.0);

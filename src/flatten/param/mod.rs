@@ -59,6 +59,7 @@ use crate::geom::unionfind::UnionFind;
 use faer::sparse::Triplet;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
+use std::sync::OnceLock;
 
 mod abf;
 mod seams;
@@ -201,9 +202,24 @@ struct Chart {
     /// For messages: the first face and its line.
     first: (usize, Option<usize>),
     nfaces: usize,
+    /// The symbolic factorisation of the first system over the chart's vertices with the
+    /// cotangent Laplacian's structure ([`Chart::vertex_cholesky`]).
+    vertex_symbolic: OnceLock<Option<Cholesky>>,
 }
 
 impl Chart {
+    /// A factorisation for `pattern`, a system over the chart's vertices: made from the
+    /// chart's first such system's symbolic factorisation where the two have one structure
+    /// (the seam matching's Laplacian, made again for each of its attempts), else anew.
+    /// Faer orders a structure the same way whichever system it comes from, so the factors
+    /// are those each would make alone.
+    fn vertex_cholesky(&self, pattern: &Pattern) -> Option<Cholesky> {
+        match self.vertex_symbolic.get_or_init(|| Cholesky::new(pattern)) {
+            Some(first) => first.for_pattern(pattern),
+            None => Cholesky::new(pattern),
+        }
+    }
+
     fn solver_error(&self, method: &'static str, message: impl Into<String>) -> ParamError {
         ParamError::Solver {
             method,
@@ -251,6 +267,7 @@ fn build_chart(mesh: &Mesh, faces: &[usize]) -> Result<Chart, ParamError> {
         boundary_loop: loops.swap_remove(0),
         first: (faces[0], line(faces[0])),
         nfaces: faces.len(),
+        vertex_symbolic: OnceLock::new(),
     })
 }
 

@@ -106,7 +106,7 @@ pub(super) fn match_seams_of(
     let allowed = flips(&uv);
     let mut from = uv.clone();
     for _ in 0..ATTEMPTS {
-        let Some(r) = relax(&chart.tris, &shapes, &cots, &edges, from.clone()) else {
+        let Some(r) = relax(chart, &shapes, &cots, &edges, from.clone()) else {
             break;
         };
         if flips(&r) <= allowed {
@@ -157,13 +157,13 @@ pub(super) fn match_seams_of(
 
 /// The local/global iteration of the module doc from `uv`; `None` when a solve fails.
 fn relax(
-    tris: &[[usize; 3]],
+    chart: &Chart,
     shapes: &[[DVec2; 3]],
     cots: &[[f64; 3]],
     edges: &[(usize, usize, f64)],
     mut uv: Vec<DVec2>,
 ) -> Option<Vec<DVec2>> {
-    let n = uv.len();
+    let (n, tris) = (uv.len(), &chart.tris);
     // The pinned vertex keeps its place softly: translation is free in the energy.
     let pin = edges.first().map_or(0, |e| e.0);
     let mut solver: Option<(Pattern, Cholesky)> = None;
@@ -187,7 +187,7 @@ fn relax(
         // factorisation.
         if !solver.as_ref().is_some_and(|s| s.0.fits(n, &trip)) {
             let pattern = Pattern::new(n, &trip)?;
-            let factor = Cholesky::new(&pattern)?;
+            let factor = chart.vertex_cholesky(&pattern)?;
             solver = Some((pattern, factor));
         }
         let (pattern, factor) = solver.as_mut()?;
