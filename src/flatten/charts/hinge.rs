@@ -38,11 +38,14 @@
 //! a neighbour as one with none of their cuts but those the union needs to be a disk
 //! ([`uncut_merge`]: a piece filling a hole of its neighbour).
 //!
-//! A piece too large for the sheet ([`FlattenOptions::room`]) and under twice the small
-//! share is hinged in parts so too (after the small pieces): the pattern stage would split it
-//! to fit the sheet, and one of its parts would be small. Where its parts hinge onto no
-//! neighbour, it is shared out with one across its length ([`share_across`]): two pieces,
-//! each with one end of it and some of the neighbour, neither small, both fitting the sheet.
+//! A piece too large for the sheet ([`FlattenOptions::room`]) and under k times the small
+//! share, k the fewest parts it is cut into to fit ([`room_parts`], at least two), is hinged
+//! in parts so too (after the small pieces): the pattern stage would split it to fit the
+//! sheet, and one of its parts would be small. Where its parts hinge onto no neighbour, it is
+//! shared out with one across its length ([`share_across`]): two pieces, each with one end of
+//! it and some of the neighbour, neither small, both fitting the sheet. Where that fails too,
+//! it is laid out as one with a neighbour ([`first_merge`]), whether the union fits the sheet
+//! or not: the pattern stage then cuts the larger union into parts none of which is small.
 //!
 //! Choices where the thesis is silent (§5.3 only merges charts whose union lies flat):
 //! - **Which edge.** Every common edge is a candidate hinge; the motion that puts it in place
@@ -61,7 +64,7 @@
 //!   of its 3D length of the neighbour's: each side was matched to the 3D length within that
 //!   tolerance, so the hinge edge itself always is.
 
-use super::join::{common, fits_room, Common};
+use super::join::{common, fits_room, room_parts, Common};
 use super::merge::{
     corridors_out, pass_apart, pass_through, share_across, share_apart, small_pieces, MERGE_TRIES,
 };
@@ -125,11 +128,17 @@ pub(super) fn hinge_small(
     };
     for _ in 0..HINGE_ROUNDS {
         let (small, mut order) = small_pieces(ctx, done);
-        // Then those too large for the sheet that it would split into a small part.
+        // Then those too large for the sheet that it would split into a small part: a piece
+        // cut into k parts to fit has one under 1 / k of its area.
         let fits = |l: &Laid| fits_room(opts.room, &l.uv);
         let mut large: Vec<(f64, usize)> = (0..done.len())
             .map(|k| (ctx.area(&done[k].faces), k))
-            .filter(|&(a, k)| small <= a && a < 2.0 * small && !fits(&done[k]))
+            .filter(|&(a, k)| {
+                small <= a && !fits(&done[k]) && {
+                    let parts = room_parts(opts.room, &done[k].uv);
+                    a < parts.max(2) as f64 * small
+                }
+            })
             .collect();
         large.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         order.extend(large.into_iter().map(|(_, k)| k));
@@ -150,6 +159,15 @@ pub(super) fn hinge_small(
                     try_onto.share(done, &owners, si, (Trial::Across, share_across), small)
                 {
                     owners.shared(done, (k, si), (ha, hb));
+                    any = true;
+                } else if let Some((k, l)) = {
+                    // Else laid out as one with a neighbour, fitting the sheet or not: the
+                    // pattern stage cuts the larger union into parts none of which is small.
+                    let near: Vec<usize> = owners.nearest(ctx, done, si, MERGE_TRIES);
+                    first_merge(ctx, done, &near, si, opts, eps, failed)
+                } {
+                    done[k] = l;
+                    owners.absorb(done, k, si);
                     any = true;
                 }
                 continue;
@@ -959,6 +977,59 @@ mod tests {
             }
         }
         assert!(owned.iter().all(|&n| n == 1));
+    }
+
+    /// A strip 200 mm long and 1.5 mm wide (1.48 % of the area) along the bottom of a
+    /// 200 × 100 mm rectangle, the sheet's room 90 × 150 mm: neither the strip nor the
+    /// rectangle fits, so the pattern stage would cut the strip into parts under 1 %. Its
+    /// halves hinge onto the rectangle only into a piece that does not fit, and shared out
+    /// across with it the two parts do not fit either; laid out as one with the rectangle, the
+    /// union is cut by the pattern stage into parts none of which is small. Without a room
+    /// the strip fits and is left as it is.
+    #[test]
+    fn a_strip_too_long_for_the_sheet_that_hinges_nowhere_is_merged() {
+        let (mesh, ranges) = strip_and_squares(&[(0..20, 1..11), (0..20, 0..1)]);
+        let fx = Fixture::new(mesh);
+        let (mesh, graph) = (&fx.mesh, &fx.graph);
+        let lay = |room: Option<[f64; 2]>| {
+            let opts = FlattenOptions {
+                room,
+                ..FlattenOptions::default()
+            };
+            let ctx = fx.charts(&opts);
+            let mut done: Vec<Laid> = ranges
+                .iter()
+                .map(|r| {
+                    let uv = r
+                        .clone()
+                        .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
+                        .collect();
+                    piece(mesh, r.clone().collect(), uv)
+                })
+                .collect();
+            if room.is_some() {
+                let total: f64 = (0..mesh.faces.len()).map(|f| graph.area[f]).sum();
+                let strip = ctx.area(&done[1].faces) / total;
+                assert!(0.01 < strip && strip < 0.02, "{strip}");
+                assert!(!fits_room(opts.room, &done[0].uv));
+                assert_eq!(room_parts(opts.room, &done[1].uv), 2);
+            }
+            hinge_small(&ctx, &mut done, &opts, 1e-6, &Failed::default());
+            done
+        };
+        let done = lay(Some([90.0, 150.0]));
+        assert_eq!(done.len(), 1);
+        let mut faces = done[0].faces.clone();
+        faces.sort_unstable();
+        assert_eq!(faces, (0..mesh.faces.len()).collect::<Vec<_>>());
+        assert!(
+            (done[0].stretch.l2 - 1.0).abs() < 1e-9,
+            "{}",
+            done[0].stretch.l2
+        );
+        assert_eq!(done[0].stretch.flipped, 0);
+        assert!(self_overlap(&done[0].uv, 1e-6).is_none());
+        assert_eq!(lay(None).len(), 2);
     }
 
     /// The zigzag cone's sector 0 (the small piece) beside sectors 1–4 (its neighbour) turns

@@ -167,16 +167,36 @@ fn fit(pairs: &[(DVec2, DVec2)]) -> Option<(DVec2, DVec2)> {
 /// Whether a layout fits `room` (width, height; see [`super::FlattenOptions::room`]), if
 /// any: the box of its minimum-area rectangle, at a quarter turn.
 pub(super) fn fits_room(room: Option<[f64; 2]>, uv: &[Vec<DVec2>]) -> bool {
+    room_parts(room, uv) <= 1
+}
+
+/// The fewest parts a layout is cut into to fit `room` (see [`fits_room`]): the box of its
+/// minimum-area rectangle cut into a grid of room-sized cells, at the better quarter turn (1
+/// where it fits, or there is no room). The pattern stage cuts along the piece's own edges,
+/// so it may need more.
+pub(super) fn room_parts(room: Option<[f64; 2]>, uv: &[Vec<DVec2>]) -> usize {
     let Some(room) = room else {
-        return true;
+        return 1;
     };
     let pts: Vec<DVec2> = uv.iter().flatten().copied().collect();
     let turn = DVec2::from_angle(polygon::min_area_rect_angle(&pts));
     let Some((lo, hi)) = polygon::bounds(pts.iter().map(|&p| turn.rotate(p))) else {
-        return true;
+        return 1;
     };
     let size = hi - lo;
-    (size.x <= room[0] && size.y <= room[1]) || (size.y <= room[0] && size.x <= room[1])
+    let cells = |w: f64, h: f64| {
+        let across = |len: f64, cell: f64| match (len / cell).ceil() {
+            n if n.is_nan() => f64::INFINITY,
+            n => n.max(1.0),
+        };
+        across(w, room[0]) * across(h, room[1])
+    };
+    let k = cells(size.x, size.y).min(cells(size.y, size.x));
+    if k.is_finite() {
+        k.min(usize::MAX as f64) as usize
+    } else {
+        usize::MAX
+    }
 }
 
 #[cfg(test)]
@@ -199,5 +219,17 @@ mod tests {
         // Judged as the nest turns it (its least rectangle square to the sheet), not as it
         // lies: its box as it lies is 96.6 x 67.3 mm.
         assert!(!fits_room(Some([97.0, 68.0]), &uv));
+        // Parts: the least rectangle in room-sized cells, at the better quarter turn.
+        assert_eq!(room_parts(Some([100.5, 20.5]), &uv), 1);
+        assert_eq!(room_parts(Some([40.5, 20.5]), &uv), 3);
+        assert_eq!(room_parts(Some([20.5, 40.5]), &uv), 3, "a quarter turn");
+        assert_eq!(
+            room_parts(Some([40.5, 10.5]), &uv),
+            6,
+            "3 cells along, 2 across"
+        );
+        assert_eq!(room_parts(Some([30.0, f64::INFINITY]), &uv), 1, "a roll");
+        assert_eq!(room_parts(Some([15.0, f64::INFINITY]), &uv), 2);
+        assert_eq!(room_parts(None, &uv), 1);
     }
 }
