@@ -141,9 +141,10 @@ impl Pattern {
 
 /// A sparse Cholesky factorisation kept for systems of one [`Pattern`]: the fill-reducing
 /// ordering and symbolic factorisation made once, the numeric factor and the work space
-/// reused by every system factorised with it. A copy ([`Clone`]) shares the pattern-only part
-/// and has its own numeric factor and work space: one symbolic factorisation serves every
-/// system of one structure (a chart's stretch minimisation and its seam matching).
+/// reused by every system factorised with it. A copy for another pattern of the same
+/// structure ([`Cholesky::for_pattern`]) shares the pattern-only part and has its own numeric
+/// factor and work space: one symbolic factorisation serves every system of one structure
+/// (the attempts of a chart's seam matching).
 pub struct Cholesky {
     shared: Arc<Symbolic>,
     values: Vec<f64>,

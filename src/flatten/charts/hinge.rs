@@ -695,6 +695,20 @@ mod tests {
         }
     }
 
+    /// The pieces of faces `ranges` of a mesh on the plane, laid as they lie.
+    fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
+        ranges
+            .iter()
+            .map(|r| {
+                let uv = r
+                    .clone()
+                    .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
+                    .collect();
+                piece(mesh, r.clone().collect(), uv)
+            })
+            .collect()
+    }
+
     fn try_hinge(mesh: &Mesh) -> Option<Laid> {
         let opts = FlattenOptions::default();
         let fx = Fixture::new(mesh.clone());
@@ -949,17 +963,7 @@ mod tests {
         let fx = Fixture::new(mesh);
         let (mesh, graph) = (&fx.mesh, &fx.graph);
         let ctx = fx.charts(&opts);
-        // Laid as they lie on the plane.
-        let mut done: Vec<Laid> = ranges
-            .into_iter()
-            .map(|r| {
-                let uv = r
-                    .clone()
-                    .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
-                    .collect();
-                piece(mesh, r.collect(), uv)
-            })
-            .collect();
+        let mut done = as_they_lie(mesh, &ranges);
         let total: f64 = (0..mesh.faces.len()).map(|f| graph.area[f]).sum();
         let strip = ctx.area(&done[2].faces) / total;
         assert!(0.01 < strip && strip < 0.02, "{strip}");
@@ -997,16 +1001,7 @@ mod tests {
                 ..FlattenOptions::default()
             };
             let ctx = fx.charts(&opts);
-            let mut done: Vec<Laid> = ranges
-                .iter()
-                .map(|r| {
-                    let uv = r
-                        .clone()
-                        .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
-                        .collect();
-                    piece(mesh, r.clone().collect(), uv)
-                })
-                .collect();
+            let mut done = as_they_lie(mesh, &ranges);
             if room.is_some() {
                 let total: f64 = (0..mesh.faces.len()).map(|f| graph.area[f]).sum();
                 let strip = ctx.area(&done[1].faces) / total;
