@@ -89,13 +89,20 @@ fn flatten_surfaces(
         }
         // Charted (smooth) surfaces are parameterised, the rest unfolded exactly; pieces are
         // not merged past what fits the sheet when pieces are split to fit it.
-        let room = match spec.pattern.split.unwrap_or_default() {
-            crate::pattern::split::Split::Auto => Some(sheet_room(spec).for_faces(&pattern)),
-            crate::pattern::split::Split::None => None,
+        let (room, sheet) = match spec.pattern.split.unwrap_or_default() {
+            crate::pattern::split::Split::Auto => {
+                let r = sheet_room(spec);
+                (
+                    Some(r.for_faces(&pattern)),
+                    Some([r.width, r.height.unwrap_or(f64::INFINITY)]),
+                )
+            }
+            crate::pattern::split::Split::None => (None, None),
         };
         let opts = crate::flatten::charts::FlattenOptions {
             unfold: crate::flatten::UnfoldOptions::default(),
             room,
+            sheet,
             ..crate::flatten::charts::FlattenOptions::for_material(spec.material.kind)
         };
         let flat = flatten_segmented(surface, &s.segment, &opts)?;

@@ -634,7 +634,7 @@ fn overlaps_near(fixed: &[Vec<DVec2>], moved: &[Vec<DVec2>], eps: f64, limit: us
 mod tests {
     use super::super::overlap::self_overlap;
     use super::*;
-    use crate::flatten::charts::{strip_and_squares, zigzag_cone, Fixture};
+    use crate::flatten::charts::{as_they_lie, strip_and_squares, zigzag_cone, Fixture};
     use crate::geom::mesh::{Face, Mesh};
     use glam::DVec3;
 
@@ -693,20 +693,6 @@ mod tests {
             uv,
             gusset: false,
         }
-    }
-
-    /// The pieces of faces `ranges` of a mesh on the plane, laid as they lie.
-    fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
-        ranges
-            .iter()
-            .map(|r| {
-                let uv = r
-                    .clone()
-                    .map(|f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
-                    .collect();
-                piece(mesh, r.clone().collect(), uv)
-            })
-            .collect()
     }
 
     fn try_hinge(mesh: &Mesh) -> Option<Laid> {

@@ -74,7 +74,13 @@
 //! start opens too slowly). A part the whole's layout does not fit (its corners at one vertex
 //! apart, a triangle flipped) is laid anew.
 //!
-//! **Few pieces** (issue 20): once every chart is laid, a piece under 1 % of the area is
+//! **Pieces that fit the sheet** (`room`): once every chart is laid, a piece that does not fit
+//! the sheet ([`FlattenOptions::sheet`]) is halved and each half laid again from the whole, in
+//! rounds until its parts fit [`FlattenOptions::room`]; the pattern stage would cut it as it
+//! lies, and a part of a layout can stretch more than the whole or be a small tip. The sheet
+//! does not scale with the model: these halves are the only pieces that depend on its size.
+//!
+//! **Few pieces** (issue 20): then a piece under 1 % of the area is
 //! merged into a neighbour where the two laid out as one stay within the tolerance, flip-free,
 //! without overlap and with their seams matched (`merge`), else grafted onto its neighbours as
 //! they lie: its faces unfolded exactly onto their layouts (`exact::graft`). Then neighbouring
@@ -116,6 +122,7 @@ mod hinge;
 mod join;
 mod merge;
 mod overlap;
+mod room;
 mod slit;
 
 pub use assemble::small_islands;
@@ -156,10 +163,17 @@ pub struct FlattenOptions {
     /// differ by at most that (default paper's, 0.001).
     pub seam_tolerance: f64,
     /// The box (width, height in mm; the height infinite on a roll) a piece may take before
-    /// the pattern stage splits it to fit the sheet: two pieces that each fit it are not
-    /// merged into one that does not (at a quarter turn of its minimum-area rectangle, as the
-    /// nest places it). `None` (default): no limit.
+    /// the pattern stage splits it to fit the sheet (the sheet less what the material adds
+    /// round a piece): the parts of a piece halved for the sheet are halved until they fit it
+    /// (see the module doc), and two pieces that each fit it are not merged into one that does
+    /// not (at a quarter turn of its minimum-area rectangle, as the nest
+    /// places it). `None` (default): no limit.
     pub room: Option<[f64; 2]>,
+    /// The sheet inside its margins (width, height in mm; the height infinite on a roll): a
+    /// piece that does not fit it is halved here until its parts fit [`FlattenOptions::room`]
+    /// (see the module doc); one that fits it but not the room is left to the pattern stage,
+    /// which knows what it adds round it. `None` (default): nothing is halved.
+    pub sheet: Option<[f64; 2]>,
 }
 
 impl Default for FlattenOptions {
@@ -175,6 +189,7 @@ impl Default for FlattenOptions {
             reattach_eta: 1e-3,
             seam_tolerance: seam_tolerance(MaterialKind::Paper),
             room: None,
+            sheet: None,
         }
     }
 }
@@ -430,6 +445,28 @@ pub(super) fn strip_and_squares(
         ranges.push(first..faces.len());
     }
     (Mesh { vertices, faces }, ranges)
+}
+
+/// The pieces of faces `ranges` of a mesh on the plane, laid as they lie, for tests.
+#[cfg(test)]
+pub(super) fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
+    ranges
+        .iter()
+        .map(|r| {
+            let faces: Vec<usize> = r.clone().collect();
+            let uv: Vec<Vec<DVec2>> = faces
+                .iter()
+                .map(|&f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
+                .collect();
+            Laid {
+                stretch: distortion::stretch(mesh, &faces, &uv),
+                faces,
+                cuts: Vec::new(),
+                uv,
+                gusset: false,
+            }
+        })
+        .collect()
 }
 
 /// A cone over a zigzag, for tests: ten flat sectors round an apex (vertex 0), each of 80°
@@ -1024,6 +1061,7 @@ fn charts_in_pool(surface: Surface, opts: &FlattenOptions) -> Result<Flat, Flatt
     };
     let mut done = ctx.lay_trees(opts, overlap_eps, todo, &degenerate)?;
     reattach(&ctx, &mut done, opts, overlap_eps);
+    room::fit_room(&ctx, &mut done, opts, overlap_eps, &degenerate)?;
     // The trials that failed on pairs of pieces as they are, for every stage below: a trial
     // is a function of the two pieces, so a pair no stage has changed since fails again.
     let failed = overlap::Failed::default();
