@@ -284,7 +284,10 @@ fn split_couplingdown_in_fabric_fits_every_part_on_a4() {
 /// split into two pieces of 0.6 %, is now shared out across with a neighbour
 /// (`flatten::charts::merge::share_across`): 1 piece was under 1 % (35 pieces became 33);
 /// passed on through one of its six nearest neighbours (`flatten::charts::hinge`'s
-/// `pass_on`), none is (32 pieces).
+/// `pass_on`), none is (32 pieces). Since pieces too large for the sheet are halved and laid
+/// again in the flatten stage (`flatten::charts::room`), no part stretches past the tolerance
+/// (the pattern stage's part 8a of the piece as it lay had L2 1.00375), with two pieces more
+/// (34).
 #[test]
 fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
     require_shared!();
@@ -295,7 +298,8 @@ fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
         &r,
     );
     assert_eq!(r.small, 0, "pieces under 1 % of the area");
-    assert!(r.pieces <= 32, "{} pieces", r.pieces);
+    assert!(r.worst_piece <= 1.003, "worst piece L2 {}", r.worst_piece);
+    assert!(r.pieces <= 34, "{} pieces", r.pieces);
 }
 
 /// Issue 20, item 3: couplingdown in metal at 300 mm on A4 has a strip of 1.2 % of the area,
@@ -309,7 +313,8 @@ fn corpus_small_pieces_of_couplingdown_are_merged_in_rounds() {
 /// within the tolerance), none is (33 pieces). Since a small piece shared out with a
 /// neighbour is also halved into equal areas where the bisector's halves are not kept
 /// (`rebalance`), the small pieces go other ways (one share-out more, which keeps the count
-/// where a graft lowers it): 34 pieces, none small.
+/// where a graft lowers it): 34 pieces, none small. Pieces too large for the sheet halved and
+/// laid again in the flatten stage (`flatten::charts::room`) make two more (36), none small.
 #[test]
 fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     require_shared!();
@@ -318,7 +323,7 @@ fn corpus_couplingdown_in_metal_hinges_a_strip_too_long_for_the_sheet() {
     print_row(&mesh, MaterialKind::Metal, &r);
     assert!(r.worst_piece <= 1.001, "worst piece L2 {}", r.worst_piece);
     assert_eq!(r.small, 0, "pieces under 1 % of the area");
-    assert!(r.pieces <= 34, "{} pieces", r.pieces);
+    assert!(r.pieces <= 36, "{} pieces", r.pieces);
 }
 
 /// Issue 20, items 2 and 3: cow in metal (L2 1.001) at 300 mm on A4. Charts still over the

@@ -449,7 +449,7 @@ pub(super) fn strip_and_squares(
 
 /// The pieces of faces `ranges` of a mesh on the plane, laid as they lie, for tests.
 #[cfg(test)]
-pub(super) fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
+fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
     ranges
         .iter()
         .map(|r| {

@@ -1,6 +1,6 @@
 //! Pieces split to fit the sheet (issue 20: no piece over the tolerance, none under 1 % of the
 //! area): a piece that does not fit the sheet ([`FlattenOptions::sheet`]) at any quarter turn
-//! of its least rectangle is halved ([`Charts::split_in_two`]: along the bisector of its two
+//! of its least rectangle nor at any whole degree of turn is halved ([`Charts::split_in_two`]: along the bisector of its two
 //! most distant faces, across its length) and each half laid out again from the whole's layout
 //! ([`Charts::lay_from`]), its seams matched, as the halves of a chart split for stretch are;
 //! the halves again, until each fits the room ([`FlattenOptions::room`]: the sheet less what
@@ -13,8 +13,8 @@
 //! goes on as any chart does (darts, gussets, laid out exactly), not split for stretch again. A
 //! piece that fits the sheet but not the room is left to the pattern stage, which knows what it
 //! adds round it (tabs and seam allowance only along seams), and so is a piece that fits the
-//! sheet only turned at a whole degree (the nest turns a whole piece so), so that a piece that
-//! fits as built is never cut.
+//! sheet turned at a whole degree only (the nest turns a whole piece so): a piece that fits as
+//! built is never cut.
 
 use super::join::fits_room;
 use super::{Charts, Degenerate, FlattenOptions, Laid, Start, Todo, Whole};
@@ -25,7 +25,8 @@ use glam::DVec2;
 /// Rounds of halving at most (a piece 2⁸ times the room is left to the pattern stage).
 const ROOM_ROUNDS: usize = 8;
 
-/// Halve every piece of `done` that does not fit the room, in rounds (see the module doc).
+/// Halve every piece of `done` that does not fit the sheet, and its parts until they fit the
+/// room, in rounds (see the module doc).
 pub(super) fn fit_room(
     ctx: &Charts,
     done: &mut Vec<Laid>,
@@ -43,26 +44,24 @@ pub(super) fn fit_room(
         let mut keep = Vec::with_capacity(done.len());
         let mut kept_part = Vec::with_capacity(done.len());
         for (l, was_halved) in done.drain(..).zip(std::mem::take(&mut part)) {
-            let halve = !fits_room(opts.room, &l.uv) && (was_halved || !fits_turned(sheet, &l.uv));
-            let t = Todo {
-                faces: l.faces.clone(),
-                splits: opts.max_splits,
-                cuts: l.cuts.clone(),
-                cut_off: l.gusset,
-                start: Start::Anew,
-            };
-            if !halve
-                || l.faces.len() < 2
-                || !ctx.split_in_two(
-                    &mut todo,
-                    &t,
-                    opts.max_splits,
-                    Some(Whole::new(&l.faces, &l.uv)),
-                )
-            {
-                keep.push(l);
-                kept_part.push(was_halved);
+            let halve = l.faces.len() > 1
+                && !fits_room(opts.room, &l.uv)
+                && (was_halved || !fits_turned(sheet, &l.uv));
+            if halve {
+                let t = Todo {
+                    faces: l.faces.clone(),
+                    splits: opts.max_splits,
+                    cuts: l.cuts.clone(),
+                    cut_off: l.gusset,
+                    start: Start::Anew,
+                };
+                let whole = Whole::new(&l.faces, &l.uv);
+                if ctx.split_in_two(&mut todo, &t, opts.max_splits, Some(whole)) {
+                    continue;
+                }
             }
+            keep.push(l);
+            kept_part.push(was_halved);
         }
         (*done, part) = (keep, kept_part);
         if todo.is_empty() {
@@ -101,8 +100,9 @@ mod tests {
 
     /// A 200 × 100 mm rectangle and a 200 × 1.5 mm strip along its bottom, on the plane, the
     /// sheet 160 mm square and the room (what a piece may take before growing by its tabs)
-    /// 150 mm: neither fits the sheet, so each is halved across its length and every half
-    /// fits the room, laid flat (L2 1) without overlap, every face in one piece. Without a
+    /// 150 mm: the rectangle does not fit the sheet, so it is halved across its length and
+    /// each half fits the room, laid flat (L2 1) without overlap, every face in one piece; the
+    /// strip fits the sheet turned across its diagonal and is left as it is. Without a
     /// sheet nothing changes; nor do a rectangle and strip 160 mm long, which fit the sheet
     /// but not the room (the pattern stage knows whether they fit once built).
     #[test]
@@ -135,9 +135,17 @@ mod tests {
         };
         let both = [(0..20, 1..11), (0..20, 0..1)];
         let done = fit(&both, sheet);
-        assert_eq!(done.len(), 4);
-        assert!(done.iter().all(|l| fits_room(room, &l.uv)));
-        assert!(done.iter().all(|l| l.faces.len() < 400));
+        // The rectangle (faces 0..400) in two halves that fit the room; the strip (40 faces)
+        // fits the sheet across its diagonal, so it is left as it is.
+        assert_eq!(done.len(), 3);
+        for l in &done {
+            if l.faces[0] < 400 {
+                assert!(l.faces.len() < 400 && fits_room(room, &l.uv));
+            } else {
+                assert_eq!(l.faces.len(), 40);
+                assert!(!fits_room(sheet, &l.uv) && fits_turned(sheet.unwrap(), &l.uv));
+            }
+        }
         assert_eq!(fit(&both, None).len(), 2);
         // 160 mm long: within the sheet, over the room.
         let near = fit(&[(0..16, 1..11), (0..16, 0..1)], sheet);
