@@ -686,13 +686,7 @@ mod tests {
 
     /// `faces` of `mesh` laid out as `uv`, without cuts.
     fn piece(mesh: &Mesh, faces: Vec<usize>, uv: Vec<Vec<DVec2>>) -> Laid {
-        Laid {
-            stretch: distortion::stretch(mesh, &faces, &uv),
-            faces,
-            cuts: Vec::new(),
-            uv,
-            gusset: false,
-        }
+        crate::flatten::charts::piece_as_laid(mesh, faces, uv)
     }
 
     fn try_hinge(mesh: &Mesh) -> Option<Laid> {

@@ -458,15 +458,21 @@ fn as_they_lie(mesh: &Mesh, ranges: &[std::ops::Range<usize>]) -> Vec<Laid> {
                 .iter()
                 .map(|&f| mesh.face_points(f).iter().map(|q| q.truncate()).collect())
                 .collect();
-            Laid {
-                stretch: distortion::stretch(mesh, &faces, &uv),
-                faces,
-                cuts: Vec::new(),
-                uv,
-                gusset: false,
-            }
+            piece_as_laid(mesh, faces, uv)
         })
         .collect()
+}
+
+/// `faces` laid out as `uv` without cuts, their stretch measured, for tests.
+#[cfg(test)]
+fn piece_as_laid(mesh: &Mesh, faces: Vec<usize>, uv: Vec<Vec<DVec2>>) -> Laid {
+    Laid {
+        stretch: distortion::stretch(mesh, &faces, &uv),
+        faces,
+        cuts: Vec::new(),
+        uv,
+        gusset: false,
+    }
 }
 
 /// A cone over a zigzag, for tests: ten flat sectors round an apex (vertex 0), each of 80°
