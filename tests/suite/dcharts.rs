@@ -1374,7 +1374,9 @@ fn gussets_fill_the_slits_of_a_saddle() {
             assert!(s.l2 <= tol, "gusset {k}: L2 {}", s.l2);
         }
     }
-    assert!(s1.l2 < s0.l2 && s1.linf < s0.linf, "{s1:?} vs {s0:?}");
+    // L2 is what the flattening lowers (Sander et al.'s energy); L∞ is reported, never
+    // decided on, and the minimiser may raise it where it lowers L2.
+    assert!(s1.l2 < s0.l2, "{s1:?} vs {s0:?}");
     // Every gusset shares a seam with the chart it was cut from (the slit's side and the
     // edge it was cut along make one chain); laid flat its two sides differ by the stretch.
     assert!(seams >= gus.islands.len() - 1, "{seams}");

@@ -12,7 +12,7 @@
 //! bent edges counting shorter (as the seams of [`crate::geom::cut::disk_cuts`]).
 
 use super::overlap::{cut_off, overlaps, self_overlap, OVERLAP_PAIRS};
-use super::{Charts, FlattenOptions, Laid, Layout};
+use super::{Charts, FlattenOptions, Laid, Layout, Whole};
 use crate::flatten::distortion::{self, Stretch};
 use crate::flatten::FlattenError;
 use crate::geom::cut::{self, open};
@@ -21,6 +21,10 @@ use glam::DVec2;
 
 /// Charts with fewer faces get no darts (they are split or reported as they are).
 pub(super) const DART_MIN_FACES: usize = 24;
+
+/// A chart that can still be halved gets gussets only when its L2 excess (L2 − 1) is at most
+/// this many times the tolerance's ([`gussets`]).
+pub(super) const GUSSET_REACH: f64 = 1.5;
 
 /// Darts (thesis §5.2.3, "partial cuts ... from the boundaries toward the regions with high
 /// fitting error"; McCartney et al.): while the chart's L2 stretch is over the tolerance, at
@@ -38,6 +42,13 @@ pub(super) const DART_MIN_FACES: usize = 24;
 /// than that dart is long (a seam relieves a disc of its own length around its tip). The path:
 /// the shortest from the chart's boundary (cuts included) to the tip, bent edges counting
 /// shorter (as the seams of [`crate::geom::cut::disk_cuts`]).
+///
+/// A trial starts from the chart as it lies, the dart still closed, and the stretch minimiser
+/// opens it: one relaxation, where laying the chart anew costs the conformal map and the
+/// whole minimisation. A trial within the tolerance has its seams matched and the chart over
+/// it has not; matching costs stretch that grows with the boundary, so such a trial that is
+/// not lower is compared again with both laid without matching. Shortening lays each trial
+/// anew: a shorter dart joins corners that lie apart.
 pub(super) fn darts(
     ctx: &Charts,
     laid: &mut Laid,
@@ -46,13 +57,26 @@ pub(super) fn darts(
 ) -> Result<(), FlattenError> {
     let mesh = ctx.mesh;
     let topo = ctx.topo;
-    let try_lay = |cuts: &[usize]| -> Option<(Vec<Vec<DVec2>>, Stretch)> {
-        match ctx.lay(&laid.faces, cuts) {
+    let try_lay = |cuts: &[usize], from: Option<&Whole>| -> Option<(Vec<Vec<DVec2>>, Stretch)> {
+        match ctx.lay_from(&laid.faces, cuts, from) {
             Ok(Layout::Laid(uv, s)) if s.flipped == 0 && self_overlap(&uv, eps).is_none() => {
                 Some((uv, s))
             }
             _ => None,
         }
+    };
+    // Whether the chart opened along `cuts` lies with less stretch than along `was`, both
+    // laid from `from` without their seams matched.
+    let free = Charts {
+        match_below: 0.0,
+        ..*ctx
+    };
+    let relieves = |faces: &[usize], was: &[usize], cuts: &[usize], from: &Whole| {
+        let l2 = |c: &[usize]| match free.lay_from(faces, c, Some(from)) {
+            Ok(Layout::Laid(_, s)) if s.flipped == 0 => Some(s.l2),
+            _ => None,
+        };
+        matches!((l2(cuts), l2(was)), (Some(a), Some(b)) if a < b)
     };
     let mut made: Vec<Vec<usize>> = Vec::new(); // each dart's edges, tip first
     let mut tips: Vec<(usize, f64)> = Vec::new();
@@ -67,10 +91,9 @@ pub(super) fn darts(
         cuts.extend(&path);
         cuts.sort_unstable();
         cuts.dedup();
-        let Some((uv, s)) = try_lay(&cuts) else { break };
-        if s.l2 >= laid.stretch.l2 {
-            break;
-        }
+        // From the chart as it lies, the dart closed: the minimiser opens it.
+        let from = Whole::new(&laid.faces, &laid.uv);
+        let trial = try_lay(&cuts, Some(&from));
         let len: f64 = path
             .iter()
             .map(|&e| {
@@ -78,6 +101,10 @@ pub(super) fn darts(
                 mesh.vertices[a].distance(mesh.vertices[b])
             })
             .sum();
+        let Some((uv, s)) = trial else { break };
+        if s.l2 >= laid.stretch.l2 && !relieves(&laid.faces, &laid.cuts, &cuts, &from) {
+            break;
+        }
         tips.push((tip, len));
         made.push(path);
         laid.cuts = cuts;
@@ -107,7 +134,7 @@ pub(super) fn darts(
         let mut best: Option<(usize, Vec<Vec<DVec2>>, Stretch)> = None;
         while lo < hi {
             let mid = (lo + hi) / 2;
-            match try_lay(&with_last(mid)) {
+            match try_lay(&with_last(mid), None) {
                 Some((uv, s)) if s.l2 <= opts.tolerance => {
                     best = Some((mid, uv, s));
                     hi = mid;
@@ -251,6 +278,12 @@ fn path_length(ctx: &Charts, path: &[usize]) -> f64 {
 /// flip, no overlap, and every gusset is within the tolerance. A slit that opens after all
 /// (no overlap) is kept as a dart when it lowers L2. Returns the gussets (laid, marked for
 /// [`super::reattach`]).
+///
+/// Where the thesis is silent: a chart that can still be halved is given gussets only when
+/// its L2 excess is at most [`GUSSET_REACH`] times the tolerance's (the caller decides). A
+/// chart further over is nearly always halved all the same, and the trials on it cost a
+/// layout of the whole chart each and leave gussets of a few faces for the merges to join
+/// back; a chart that cannot be halved any more tries them whatever its stretch.
 pub(super) fn gussets(ctx: &Charts, laid: &mut Laid, opts: &FlattenOptions, eps: f64) -> Vec<Laid> {
     let mut out: Vec<Laid> = Vec::new();
     let mut tips: Vec<(usize, f64)> = Vec::new();

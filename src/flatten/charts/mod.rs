@@ -127,7 +127,7 @@ mod slit;
 
 pub use assemble::small_islands;
 use assemble::{assemble, edge_ids};
-use darts::{darts, gussets, DART_MIN_FACES};
+use darts::{darts, gussets, DART_MIN_FACES, GUSSET_REACH};
 use overlap::{cut_off, overlaps, reattach, self_overlap, OVERLAP_PAIRS};
 
 /// How a surface is laid flat.
@@ -509,7 +509,7 @@ pub(super) fn zigzag_cone() -> Mesh {
 }
 
 /// The layouts of [`Charts::laid`] by key, and the faces they hold in all.
-type LayCache = std::sync::Mutex<(HashMap<(Vec<usize>, Vec<usize>, bool), Layout>, usize)>;
+type LayCache = std::sync::Mutex<(HashMap<(Vec<usize>, Vec<usize>, u64), Layout>, usize)>;
 
 /// Faces the kept layouts may hold in all (about 80 bytes each); past it layouts are made
 /// again instead of kept, so memory stays bounded on any mesh.
@@ -519,11 +519,7 @@ impl Charts<'_> {
     /// The chart's faces opened along `cuts` and laid flat: the opened chart becomes a mesh of
     /// its own (vertices split along the cuts), parameterised, then turned counter-clockwise.
     fn lay(&self, faces: &[usize], cuts: &[usize]) -> Result<Layout, param::ParamError> {
-        let key = (
-            faces.to_vec(),
-            cuts.to_vec(),
-            self.match_below.is_infinite(),
-        );
+        let key = (faces.to_vec(), cuts.to_vec(), self.match_below.to_bits());
         if let Some(l) = self.laid.lock().ok().and_then(|m| m.0.get(&key).cloned()) {
             return Ok(l);
         }
@@ -559,7 +555,7 @@ impl Charts<'_> {
     /// whole was laid anew, so its part starts near its own optimum and only needs relaxing.
     /// A part the whole's layout does not fit (corners of one vertex apart where the part has
     /// no cut, a flipped triangle) is laid anew ([`Charts::lay`]).
-    fn lay_from(
+    pub(super) fn lay_from(
         &self,
         faces: &[usize],
         cuts: &[usize],
@@ -999,14 +995,17 @@ impl Charts<'_> {
         {
             darts(self, &mut laid, opts, eps)?;
         }
+        // A chart that can still be halved gets gussets only within their reach.
+        let halves = t.splits < opts.max_splits && laid.faces.len() >= 8;
         if laid.stretch.l2 > opts.tolerance
             && opts.gussets > 0
             && laid.faces.len() >= DART_MIN_FACES
+            && (!halves || laid.stretch.l2 - 1.0 <= GUSSET_REACH * (opts.tolerance - 1.0))
         {
             let gussets = gussets(self, &mut laid, opts, eps);
             done.extend(gussets);
         }
-        if laid.stretch.l2 > opts.tolerance && t.splits < opts.max_splits && laid.faces.len() >= 8 {
+        if laid.stretch.l2 > opts.tolerance && halves {
             // Darts are dropped: each half gets its own.
             let t = Todo {
                 faces: laid.faces,

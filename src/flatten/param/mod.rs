@@ -25,20 +25,25 @@
 //!   it came out clockwise (it never should: both energies penalise mirror images), and moved so
 //!   its bounding box starts at (0, 0). Counter-clockwise = seen from the side the face normals
 //!   point to, like [`super::Flat`].
-//! - **Best**: both methods run; the result with fewer flipped triangles wins, then the lower L2
-//!   stretch; a tie keeps LSCM. If one method fails (singular system, ABF++ not converging in
-//!   `ABF_MAX_ITER` Newton steps) the other is kept; if both fail, the LSCM
-//!   error is returned. ABF++ steps are damped when a full Newton step would take an angle
-//!   out of (0, π) (the paper takes full steps). If both results have flipped triangles the one with fewer is returned
-//!   and `stretch.flipped` says how many: the caller must split such a chart (D-Charts does).
-//!   An LSCM layout already isometric (L2 within `ISOMETRIC` of 1, no flip) is returned at
-//!   once. A flip-free winner is otherwise relaxed by free-boundary L2 stretch minimisation (Sander et
-//!   al. 2001 §4, the parameterisation the thesis evaluates its charts with, §5.4), which never
-//!   raises L2 and never flips a triangle (a developable chart, already at 1.0, stays as it
-//!   is); `method` still names the conformal method it started from. It lowers L2 at the cost
-//!   of conformality (shear) and, on strongly curved charts, of L∞: `Lscm` and `Abf` give the
-//!   pure conformal layouts. [`relax_from`] runs the same minimisation from a given layout
-//!   (a part of a larger chart, as it lay in the whole) instead of laying the chart anew.
+//! - **Best**: LSCM first. A flip-free LSCM layout that is already isometric (L2 within
+//!   `ISOMETRIC` of 1) is returned at once; any other flip-free one is relaxed by free-boundary
+//!   L2 stretch minimisation (Sander et al. 2001 §4, the parameterisation the thesis evaluates
+//!   its charts with, §5.4) over all vertices at once ([`lbfgs`]), which never raises L2 and
+//!   never flips a triangle (a developable chart, already at 1.0, stays as it is). ABF++ runs
+//!   only where LSCM fails (a singular system) or flips a triangle: the result with fewer
+//!   flipped triangles wins, then the lower L2 stretch (a tie keeps LSCM), and a flip-free
+//!   winner is relaxed the same way. If one method fails (ABF++ not converging in
+//!   `ABF_MAX_ITER` Newton steps) the other is kept; if both fail, the LSCM error is
+//!   returned. ABF++ steps are damped when a full Newton step would take an angle out of
+//!   (0, π) (the paper takes full steps). If both results have flipped triangles the one with
+//!   fewer is returned and `stretch.flipped` says how many: the caller must split such a
+//!   chart (D-Charts does). ABF++'s angles start the minimisation no better than LSCM's
+//!   layout: the quasi-Newton steps reach a lower L2 from either than vertex-by-vertex sweeps
+//!   reach from the better of the two. `method` names the conformal method the minimisation
+//!   started from. It lowers L2 at the cost of conformality (shear) and, on strongly curved
+//!   charts, of L∞: `Lscm` and `Abf` give the pure conformal layouts. [`relax_from`] runs the
+//!   same minimisation from a given layout (a part of a larger chart, as it lay in the whole)
+//!   instead of laying the chart anew.
 //! - **Polygon faces** (more than 3 corners) are ear-clipped in their best-fit plane
 //!   (`distortion::face_triangles`); their `uv` is still one point per original corner.
 //! - **Refused** (a [`ParamError`] naming the face and its OBJ line): no faces, a face index out
@@ -48,9 +53,6 @@
 //!   no boundary (closed), several boundary loops (holes), handles. Nothing is repaired here:
 //!   charts come from a segmentation that can cut differently.
 //! - Determinism: no hash-map iteration order reaches the result; the solves are sequential.
-//!   `Best` finds ABF++'s angles beside LSCM where a thread of the pool is idle
-//!   ([`crate::geom::par::speculate`]): each works on its own data, so the result is the
-//!   same either way.
 
 use super::distortion::{self, corner_angle, face_triangles, Stretch};
 use crate::geom::mesh::Mesh;
@@ -62,6 +64,7 @@ use std::collections::HashMap;
 use std::sync::OnceLock;
 
 mod abf;
+mod lbfgs;
 mod seams;
 mod solve;
 mod stretch;
@@ -212,9 +215,9 @@ struct Chart {
 impl Chart {
     /// A factorisation for `pattern`, a system over the chart's vertices: made from the
     /// chart's first such system's symbolic factorisation where the two have one structure
-    /// (the seam matching's Laplacian, made again for each of its attempts), else anew.
-    /// Faer orders a structure the same way whichever system it comes from, so the factors
-    /// are those each would make alone.
+    /// (the stretch minimiser's and the seam matching's Laplacians, softly pinned at different
+    /// vertices), else anew. Faer orders a structure the same way whichever system it comes
+    /// from, so the factors are those each would make alone.
     fn vertex_cholesky(&self, pattern: &Pattern) -> Option<Cholesky> {
         match self.vertex_symbolic.get_or_init(|| Cholesky::new(pattern)) {
             Some(first) => first.for_pattern(pattern),
@@ -823,32 +826,26 @@ fn parameterize_chart(
         ParamMethod::Lscm => run_lscm(mesh, faces, chart, pin, &mut solver),
         ParamMethod::Abf => run_abf(mesh, faces, chart, pin, &mut solver),
         ParamMethod::Best => {
-            // ABF++'s angles (its Newton steps, most of its time) beside LSCM where a thread
-            // is idle; used only when LSCM's layout is not already isometric.
-            let (l, angles) = crate::geom::par::speculate(
-                || run_lscm(mesh, faces, chart, pin, &mut solver),
-                || abf_angles(chart),
-            );
-            if let Ok(l) = &l {
-                // Already isometric: nothing can do better.
-                if l.stretch.flipped == 0 && l.stretch.l2 - 1.0 < ISOMETRIC {
-                    return Ok(l.clone());
-                }
-            }
-            let angles = angles.unwrap_or_else(|| abf_angles(chart));
-            let a = abf_from(mesh, faces, chart, pin, angles, &mut solver);
+            let l = run_lscm(mesh, faces, chart, pin, &mut solver);
             let key = |c: &ChartParam| (c.stretch.flipped, c.stretch.l2);
-            let kept = match (l, a) {
-                (Ok(l), Ok(a)) => {
-                    if key(&a) < key(&l) {
-                        a
-                    } else {
-                        l
+            let kept = match l {
+                // Already isometric: nothing can do better.
+                Ok(l) if l.stretch.flipped == 0 && l.stretch.l2 - 1.0 < ISOMETRIC => return Ok(l),
+                // Flip-free: the stretch minimisation takes it from there.
+                Ok(l) if l.stretch.flipped == 0 => l,
+                // Flipped or failed: ABF++'s layout where it is better.
+                l => match (l, run_abf(mesh, faces, chart, pin, &mut solver)) {
+                    (Ok(l), Ok(a)) => {
+                        if key(&a) < key(&l) {
+                            a
+                        } else {
+                            l
+                        }
                     }
-                }
-                (Ok(l), Err(_)) => l,
-                (Err(_), Ok(a)) => a,
-                (Err(e), Err(_)) => return Err(e),
+                    (Ok(l), Err(_)) => l,
+                    (Err(_), Ok(a)) => a,
+                    (Err(e), Err(_)) => return Err(e),
+                },
             };
             let refined = refine(mesh, faces, chart, &kept);
             Ok(if key(&refined) < key(&kept) {
@@ -860,7 +857,21 @@ fn parameterize_chart(
     }
 }
 
-/// Sweeps of the stretch minimisation that `Best` runs on the kept layout.
+/// Steps of the stretch minimisation that `Best` runs on the kept layout ([`lbfgs`]).
+pub(crate) const STRETCH_STEPS: usize = 200;
+/// The stretch minimisation stops when a step lowers E by less than this share of it.
+pub(crate) const STRETCH_GAIN: f64 = 1e-6;
+
+/// The free-boundary stretch minimisation of a flip-free layout `uv` ([`lbfgs::minimise`];
+/// where the chart's Laplacian cannot be factored, the sweeps of [`minimise_stretch`]).
+fn minimise_free(chart: &Chart, uv: Vec<DVec2>) -> Option<Vec<DVec2>> {
+    match lbfgs::minimise(chart, uv.clone(), STRETCH_STEPS, STRETCH_GAIN) {
+        Some(uv) => Some(uv),
+        None => minimise_stretch(chart, uv, &vec![false; chart.pos.len()], STRETCH_SWEEPS),
+    }
+}
+
+/// Sweeps of the vertex-by-vertex minimisation where [`lbfgs`] cannot run.
 pub(crate) const STRETCH_SWEEPS: usize = 60;
 
 /// Free-boundary L2 stretch minimisation (Sander et al. 2001 §4, [`stretch`]) from a
@@ -869,9 +880,8 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
     if start.stretch.flipped > 0 {
         return start.clone();
     }
-    let nv = chart.pos.len();
     let uv = vertex_uv(chart, &start.uv);
-    match minimise_stretch(chart, uv, &vec![false; nv], STRETCH_SWEEPS) {
+    match minimise_free(chart, uv) {
         Some(uv) => finish(mesh, faces, chart, start.method, uv),
         None => start.clone(),
     }
@@ -932,8 +942,7 @@ fn relax_chart(
         }
     }
     let uv: Vec<DVec2> = uv.into_iter().collect::<Option<_>>()?;
-    let nv = uv.len();
-    let uv = minimise_stretch(chart, uv, &vec![false; nv], STRETCH_SWEEPS)?;
+    let uv = minimise_free(chart, uv)?;
     Some(finish(mesh, faces, chart, method, uv))
 }
 
@@ -956,7 +965,7 @@ mod tests {
 
     /// A 6 x 6 grid lifted into a saddle-and-bump: not developable, every interior vertex has
     /// a non-zero angle defect.
-    fn bumpy_grid() -> Mesh {
+    pub(super) fn bumpy_grid() -> Mesh {
         let n = 6;
         let mut vertices = Vec::new();
         for y in 0..=n {

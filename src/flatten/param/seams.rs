@@ -23,11 +23,15 @@
 //!   most), and relaxed again from there ([`ATTEMPTS`] relaxations at most): the boundary
 //!   comes nearer its lengths each time, and a chart whose lengths cannot all be had without a
 //!   flip keeps the nearest flip-free layout.
+//! - Where the relaxations leave a boundary edge further than [`RESCUE_ABOVE`] from its
+//!   length (every attempt flipped), the lengths are reached instead by a rising penalty on
+//!   them while the stretch is minimised over every vertex, the boundary's included
+//!   ([`super::lbfgs::match_lengths`]): its steps never flip a triangle.
 //! - The result is kept only if it flips no triangle the start did not and its boundary is
 //!   nearer the 3D lengths; else the start is returned as it was. A chart whose boundary is
 //!   within [`EXACT`] of its 3D lengths is returned at once (an exactly developable chart).
 
-use super::{build_chart, minimise_stretch, shapes_from_3d, vertex_uv, Chart, ChartParam};
+use super::{build_chart, lbfgs, minimise_stretch, shapes_from_3d, vertex_uv, Chart, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
 use crate::geom::sparse::{Cholesky, Pattern};
@@ -44,6 +48,10 @@ pub(crate) const SWEEPS: usize = 15;
 pub(crate) const ATTEMPTS: usize = 4;
 /// Largest relative difference between a boundary edge's flat and 3D length left alone.
 pub(crate) const EXACT: f64 = 1e-7;
+/// A relaxation that leaves a boundary edge further than this from its 3D length (relative)
+/// is matched again by [`lbfgs::match_lengths`]: ten times what the stiffest weight leaves
+/// where nothing flipped, under every material's seam tolerance (metal: 5e-4).
+pub(crate) const RESCUE_ABOVE: f64 = 1e-4;
 
 /// Largest relative difference between flat and 3D length over the boundary edges.
 fn boundary_error(uv: &[DVec2], edges: &[(usize, usize, f64)]) -> f64 {
@@ -128,8 +136,17 @@ pub(super) fn match_seams_of(
     }
     let relaxed = from;
     // The inside relaxed to the least L2 stretch the matched boundary allows.
-    let relaxed =
+    let mut relaxed =
         minimise_stretch(chart, relaxed.clone(), &chart.boundary, SWEEPS).unwrap_or(relaxed);
+    // Lengths the rigid matching could not reach without a flip: every vertex moved at once
+    // under a rising penalty on them, flip-free throughout.
+    if boundary_error(&relaxed, &edges) > RESCUE_ABOVE {
+        if let Some(r) = lbfgs::match_lengths(chart, relaxed.clone(), &edges) {
+            if boundary_error(&r, &edges) < boundary_error(&relaxed, &edges) {
+                relaxed = r;
+            }
+        }
+    }
     let after = boundary_error(&relaxed, &edges);
     if after.is_nan() || after >= before {
         return start.clone();

@@ -18,6 +18,10 @@
 //!   halved (at most 12 times) until E decreases without a flip. Exact local steps leave the
 //!   smooth part of the error to many sweeps; over-relaxed ones carry it further per sweep.
 //! - **Stopping.** After `sweeps` sweeps, or when a sweep lowers E by less than 1e-5 of it.
+//!
+//! The free-boundary minimisation moves every vertex at once ([`super::lbfgs`]); these sweeps
+//! relax the inside of a chart whose boundary is held (seam matching, [`super::seams`]) and
+//! stand in where the quasi-Newton preconditioner cannot be factored.
 
 use super::{shapes_from_3d, Chart};
 use glam::{DMat2, DVec2};
