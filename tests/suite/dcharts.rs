@@ -1386,6 +1386,42 @@ fn gussets_fill_the_slits_of_a_saddle() {
     assert_eq!(again.face_2d, gus.face_2d);
 }
 
+/// Gussets go only to a chart within their reach while it can still be halved: the saddle,
+/// its L2 excess nearly four times paper's, is halved (and its halves laid) exactly as with
+/// no gussets at all, where with no halving left it gets them (above).
+#[test]
+fn a_chart_beyond_the_gussets_reach_is_halved_without_them() {
+    let mesh = saddle(50.0, 30.0, 24);
+    let n = mesh.faces.len();
+    let lay = |gussets: usize| {
+        let o = FlattenOptions {
+            gussets,
+            ..FlattenOptions::default()
+        };
+        fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap()
+    };
+    let whole = FlattenOptions {
+        max_splits: 0,
+        gussets: 0,
+        exact: false,
+        ..FlattenOptions::default()
+    };
+    let (_, s) = fcharts::stretch(
+        &fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &whole).unwrap(),
+    );
+    let tol = FlattenOptions::default().tolerance;
+    assert!(
+        s.l2 - 1.0 > 3.0 * (tol - 1.0),
+        "the saddle is far over: {}",
+        s.l2
+    );
+    let (with, without) = (lay(2), lay(0));
+    check_flat(&with);
+    assert!(with.islands.len() >= 2, "halved");
+    assert_eq!(with.islands, without.islands);
+    assert_eq!(with.face_2d, without.face_2d);
+}
+
 /// Issue 20 (few pieces): a plane folded by 60° along a line, finely triangulated, given as
 /// two charts (its flat halves). The halves' layouts fit together along the fold, so the
 /// flatten stage joins them into one piece, the fold edges joined.

@@ -38,7 +38,8 @@
 //!   region, then shortened while it stays within the tolerance), then gussets where the
 //!   surface is saddle-shaped (`gussets`: a slit toward the most negative angle defect
 //!   overlaps instead of opening; the overlapping region is cut off as a small piece of its
-//!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits);
+//!   own, sewn into the gap the slit leaves, and re-attached to a neighbour when it fits;
+//!   tried on a chart that can still be split only within `GUSSET_REACH` of the tolerance);
 //!
 //! and is split along the bisector of its two most distant faces
 //! (`bisect` of [`crate::geom::cut`]) when

@@ -888,9 +888,9 @@ fn refine(mesh: &Mesh, faces: &[usize], chart: &Chart, start: &ChartParam) -> Ch
 }
 
 /// The chart of `faces` laid out from `start` (a position per face corner, counter-clockwise:
-/// a larger chart's layout restricted to these faces, or this chart's own) by the sweeps of
-/// [`refine`], without laying it anew: the start is already near the chart's optimum, so the
-/// sweeps stop early. `None` when `start` is not a layout of this chart (the corners of one
+/// a larger chart's layout restricted to these faces, or this chart's own) by the stretch
+/// minimisation of [`refine`], without laying it anew: the start is already near the chart's
+/// optimum, so the minimisation stops early. `None` when `start` is not a layout of this chart (the corners of one
 /// vertex apart, a flipped or collapsed triangle) or the chart is refused; the caller then
 /// lays it anew ([`parameterize`]).
 pub fn relax_from(
