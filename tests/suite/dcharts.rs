@@ -1393,29 +1393,24 @@ fn gussets_fill_the_slits_of_a_saddle() {
 fn a_chart_beyond_the_gussets_reach_is_halved_without_them() {
     let mesh = saddle(50.0, 30.0, 24);
     let n = mesh.faces.len();
-    let lay = |gussets: usize| {
-        let o = FlattenOptions {
-            gussets,
-            ..FlattenOptions::default()
-        };
-        fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap()
-    };
-    let whole = FlattenOptions {
-        max_splits: 0,
-        gussets: 0,
-        exact: false,
+    let lay =
+        |o: FlattenOptions| fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &o).unwrap();
+    let gussets = |gussets: usize| FlattenOptions {
+        gussets,
         ..FlattenOptions::default()
     };
-    let (_, s) = fcharts::stretch(
-        &fcharts::charts(surface(mesh.clone(), Some(vec![0; n])), &whole).unwrap(),
-    );
+    let (_, s) = fcharts::stretch(&lay(FlattenOptions {
+        max_splits: 0,
+        exact: false,
+        ..gussets(0)
+    }));
     let tol = FlattenOptions::default().tolerance;
     assert!(
         s.l2 - 1.0 > 3.0 * (tol - 1.0),
         "the saddle is far over: {}",
         s.l2
     );
-    let (with, without) = (lay(2), lay(0));
+    let (with, without) = (lay(gussets(2)), lay(gussets(0)));
     check_flat(&with);
     assert!(with.islands.len() >= 2, "halved");
     assert_eq!(with.islands, without.islands);

@@ -71,8 +71,8 @@ pub(super) fn darts(
         match_below: 0.0,
         ..*ctx
     };
-    let relieves = |faces: &[usize], was: &[usize], cuts: &[usize], from: &Whole| {
-        let l2 = |c: &[usize]| match free.lay_from(faces, c, Some(from)) {
+    let relieves = |was: &[usize], cuts: &[usize], from: &Whole| {
+        let l2 = |c: &[usize]| match free.lay_from(&laid.faces, c, Some(from)) {
             Ok(Layout::Laid(_, s)) if s.flipped == 0 => Some(s.l2),
             _ => None,
         };
@@ -102,7 +102,7 @@ pub(super) fn darts(
             })
             .sum();
         let Some((uv, s)) = trial else { break };
-        if s.l2 >= laid.stretch.l2 && !relieves(&laid.faces, &laid.cuts, &cuts, &from) {
+        if s.l2 >= laid.stretch.l2 && !relieves(&laid.cuts, &cuts, &from) {
             break;
         }
         tips.push((tip, len));

@@ -24,6 +24,7 @@
 //!   the as-rigid-as-possible matching of [`super::seams`] cannot reach the lengths without
 //!   a flip.
 
+use super::solve::{half_cotangents, push_cotangent_laplacian};
 use super::{shapes_from_3d, Chart};
 use crate::geom::sparse::{Cholesky, Pattern};
 use faer::sparse::Triplet;
@@ -134,17 +135,7 @@ fn dot(a: &[DVec2], b: &[DVec2]) -> f64 {
 fn laplacian(chart: &Chart, shapes: &[[DVec2; 3]]) -> Option<Cholesky> {
     let n = chart.pos.len();
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(chart.tris.len() * 9 + 1);
-    for (t, s) in chart.tris.iter().zip(shapes) {
-        for k in 0..3 {
-            let (p, q, r) = (s[k], s[(k + 1) % 3], s[(k + 2) % 3]);
-            let (u, v) = (q - p, r - p);
-            let c = 0.5 * u.dot(v) / u.perp_dot(v).abs().max(1e-300);
-            let (i, j) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-            trip.push(Triplet::new(i.max(j), i.min(j), -c));
-            trip.push(Triplet::new(i, i, c));
-            trip.push(Triplet::new(j, j, c));
-        }
-    }
+    push_cotangent_laplacian(&mut trip, &chart.tris, &half_cotangents(shapes));
     trip.push(Triplet::new(0, 0, 1.0));
     let pattern = Pattern::new(n, &trip)?;
     let mut chol = chart.vertex_cholesky(&pattern)?;

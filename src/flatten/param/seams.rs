@@ -31,6 +31,7 @@
 //!   nearer the 3D lengths; else the start is returned as it was. A chart whose boundary is
 //!   within [`EXACT`] of its 3D lengths is returned at once (an exactly developable chart).
 
+use super::solve::{half_cotangents, push_cotangent_laplacian, push_edge};
 use super::{build_chart, lbfgs, minimise_stretch, shapes_from_3d, vertex_uv, Chart, ChartParam};
 use crate::flatten::distortion;
 use crate::geom::mesh::Mesh;
@@ -92,17 +93,7 @@ pub(super) fn match_seams_of(
         return start.clone();
     }
     let shapes = shapes_from_3d(chart);
-    // Per triangle corner k: ½ cot of its angle, the weight of the opposite edge.
-    let cots: Vec<[f64; 3]> = shapes
-        .iter()
-        .map(|s| {
-            std::array::from_fn(|k| {
-                let (p, q, r) = (s[k], s[(k + 1) % 3], s[(k + 2) % 3]);
-                let (u, v) = (q - p, r - p);
-                0.5 * u.dot(v) / u.perp_dot(v).abs().max(1e-300)
-            })
-        })
-        .collect();
+    let cots = half_cotangents(&shapes);
     // Where the relaxed layout flips a triangle, the next attempt starts partway there.
     let flips = |uv: &[DVec2]| {
         chart
@@ -186,18 +177,9 @@ fn relax(
     let mut solver: Option<(Pattern, Cholesky)> = None;
     for &w in &WEIGHTS {
         let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(tris.len() * 9);
-        let mut add = |i: usize, j: usize, c: f64| {
-            trip.push(Triplet::new(i.max(j), i.min(j), -c));
-            trip.push(Triplet::new(i, i, c));
-            trip.push(Triplet::new(j, j, c));
-        };
-        for (tri, c) in tris.iter().zip(cots) {
-            for k in 0..3 {
-                add(tri[(k + 1) % 3], tri[(k + 2) % 3], c[k]);
-            }
-        }
+        push_cotangent_laplacian(&mut trip, tris, cots);
         for &(a, b, _) in edges {
-            add(a, b, w);
+            push_edge(&mut trip, a, b, w);
         }
         trip.push(Triplet::new(pin, pin, 1.0));
         // Every weight has the same pattern: one assembly pattern, ordering and symbolic

@@ -2,11 +2,50 @@
 //! its lower-triangle triplets, solved by the Cholesky factorisation of [`crate::geom::sparse`]
 //! with its pattern and symbolic factorisation kept for the next system of that pattern, and
 //! refined iteratively where asked (LSCM's two steps bring an exactly developable chart to
-//! isometry within rounding).
+//! isometry within rounding); and the cotangent Laplacian of a chart's 3D triangles that the
+//! seam matching and the stretch minimiser assemble.
 
 use super::{Chart, ParamError};
 use crate::geom::sparse::{Cholesky, Pattern};
 use faer::sparse::Triplet;
+use glam::DVec2;
+
+/// Per triangle corner k of `shapes` (each triangle in its own plane): ½ cot of its angle, the
+/// weight of the opposite edge in the cotangent Laplacian.
+pub(super) fn half_cotangents(shapes: &[[DVec2; 3]]) -> Vec<[f64; 3]> {
+    shapes
+        .iter()
+        .map(|s| {
+            std::array::from_fn(|k| {
+                let (p, q, r) = (s[k], s[(k + 1) % 3], s[(k + 2) % 3]);
+                let (u, v) = (q - p, r - p);
+                0.5 * u.dot(v) / u.perp_dot(v).abs().max(1e-300)
+            })
+        })
+        .collect()
+}
+
+/// The lower-triangle triplets of weight `c` on the edge `i j` of a graph Laplacian, pushed
+/// onto `trip`.
+pub(super) fn push_edge(trip: &mut Vec<Triplet<usize, usize, f64>>, i: usize, j: usize, c: f64) {
+    trip.push(Triplet::new(i.max(j), i.min(j), -c));
+    trip.push(Triplet::new(i, i, c));
+    trip.push(Triplet::new(j, j, c));
+}
+
+/// The cotangent Laplacian's triplets of the triangles `tris` (local vertices) with the
+/// weights `cots` ([`half_cotangents`]), pushed onto `trip`.
+pub(super) fn push_cotangent_laplacian(
+    trip: &mut Vec<Triplet<usize, usize, f64>>,
+    tris: &[[usize; 3]],
+    cots: &[[f64; 3]],
+) {
+    for (t, c) in tris.iter().zip(cots) {
+        for k in 0..3 {
+            push_edge(trip, t[(k + 1) % 3], t[(k + 2) % 3], c[k]);
+        }
+    }
+}
 
 /// A system's pattern ([`Pattern`]) with its ordering and symbolic factorisation, which
 /// depend on the pattern only: kept by a solver for its next system, used again when that
